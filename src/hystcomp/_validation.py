@@ -1,0 +1,135 @@
+"""Input checks shared by the public functions (the boundary layer).
+
+Kernels trust their input; everything a user passes goes through one of these first.
+Messages follow one pattern: what the argument must be, what was found, and the fix.
+"""
+
+from __future__ import annotations
+
+import numbers
+
+import numpy as np
+
+from hystcomp.errors import InvalidParameterError, InvalidSignalError, InvalidTypeError
+
+
+def check_int(value, name: str, owner: str, *, minimum: int = 1) -> int:
+    """Return ``value`` as an int ``>= minimum`` or raise a message that names it."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+        raise InvalidTypeError(
+            f"The {name!r} parameter of {owner} must be an int >= {minimum}. "
+            f"Got {value!r} of type {type(value).__name__} instead."
+        )
+    if value < minimum:
+        raise InvalidParameterError(
+            f"The {name!r} parameter of {owner} must be an int >= {minimum}. Got {value!r} instead."
+        )
+    return int(value)
+
+
+def check_real(value, name: str, owner: str, *, positive: bool = False) -> float:
+    """Return ``value`` as a finite float (``> 0`` if ``positive``) or raise."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise InvalidTypeError(
+            f"The {name!r} parameter of {owner} must be a real number. "
+            f"Got {value!r} of type {type(value).__name__} instead."
+        )
+    value = float(value)
+    if not np.isfinite(value) or (positive and value <= 0):
+        need = "a finite number > 0" if positive else "a finite number"
+        raise InvalidParameterError(
+            f"The {name!r} parameter of {owner} must be {need}. Got {value!r} instead."
+        )
+    return value
+
+
+def check_range(value, name: str, owner: str) -> tuple[float, float]:
+    """Return ``(low, high)`` with finite ``low < high`` or raise."""
+    try:
+        low, high = (float(v) for v in value)
+    except (TypeError, ValueError):
+        raise InvalidParameterError(
+            f"The {name!r} parameter of {owner} must be a pair (low, high) of numbers. "
+            f"Got {value!r} instead."
+        ) from None
+    if not (np.isfinite(low) and np.isfinite(high) and low < high):
+        raise InvalidParameterError(
+            f"The {name!r} parameter of {owner} must be a pair (low, high) of finite numbers "
+            f"with low < high. Got ({low!r}, {high!r}) instead."
+        )
+    return low, high
+
+
+def as_vector(value, name: str, owner: str, *, length: int | None = None) -> np.ndarray:
+    """Return a read-only 1-D finite float64 copy of ``value`` or raise."""
+    try:
+        arr = np.array(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise InvalidTypeError(
+            f"The {name!r} parameter of {owner} must be a 1-D array of numbers. "
+            f"Got a {type(value).__name__} that does not convert to numbers."
+        ) from None
+    if arr.ndim != 1 or arr.size == 0:
+        raise InvalidParameterError(
+            f"The {name!r} parameter of {owner} must be a non-empty 1-D array. "
+            f"Got an array of shape {arr.shape} instead."
+        )
+    if length is not None and arr.size != length:
+        raise InvalidParameterError(
+            f"The {name!r} parameter of {owner} must have {length} entries, one per operator. "
+            f"Got {arr.size} instead."
+        )
+    if not np.all(np.isfinite(arr)):
+        bad = int(np.flatnonzero(~np.isfinite(arr))[0])
+        raise InvalidParameterError(
+            f"The {name!r} parameter of {owner} must be finite. Entry {bad} is {float(arr[bad])!r}."
+        )
+    arr.setflags(write=False)
+    return arr
+
+
+def check_thresholds(value, name: str, owner: str) -> np.ndarray:
+    """Thresholds ``0 = r_0 < r_1 < ... < r_n`` (paper, after eqs. 12 and 15)."""
+    r = as_vector(value, name, owner)
+    if r[0] != 0.0:
+        raise InvalidParameterError(
+            f"The {name!r} parameter of {owner} must start at 0 (r_0 = 0, as in eqs. 12 and 15). "
+            f"Got r_0 = {float(r[0])!r}; shift the thresholds so that the first is 0."
+        )
+    if r.size > 1 and not np.all(np.diff(r) > 0):
+        bad = int(np.flatnonzero(np.diff(r) <= 0)[0]) + 1
+        raise InvalidParameterError(
+            f"The {name!r} parameter of {owner} must be strictly increasing. "
+            f"Entry {bad} ({float(r[bad])!r}) is not above entry {bad - 1} ({float(r[bad - 1])!r})."
+        )
+    return r
+
+
+def as_signal(value, name: str, *, min_samples: int = 1) -> np.ndarray:
+    """Return a 1-D finite float64 array of samples (a copy if conversion is needed)."""
+    try:
+        arr = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise InvalidTypeError(
+            f"{name!r} must be a 1-D array of numbers (samples). "
+            f"Got a {type(value).__name__} that does not convert to numbers."
+        ) from None
+    if arr.ndim == 0:
+        arr = arr.reshape(1)
+    if arr.ndim != 1:
+        raise InvalidSignalError(
+            f"{name!r} must be a 1-D array of samples. Got an array of shape {arr.shape}; "
+            "pass one channel at a time (for example x[:, 0])."
+        )
+    if arr.size < min_samples:
+        raise InvalidSignalError(
+            f"{name!r} must have at least {min_samples} samples. Got {arr.size}."
+        )
+    finite = np.isfinite(arr)
+    if not finite.all():
+        bad = int(np.flatnonzero(~finite)[0])
+        raise InvalidSignalError(
+            f"{name!r} must be finite. Sample {bad} is {float(arr[bad])!r}; "
+            "remove or interpolate non-finite samples first."
+        )
+    return np.ascontiguousarray(arr)

@@ -1,0 +1,101 @@
+"""What the Prandtl-Ishlinskii-type models share: parameters, fitted check, serialisation."""
+
+from __future__ import annotations
+
+from typing import Any, ClassVar
+
+import numpy as np
+
+from hystcomp._validation import as_vector, check_range, check_real
+from hystcomp.errors import NotFittedError
+from hystcomp.models.compensator import ChainSystem
+
+DEFAULT_VOLTAGE_RANGE = (0.0, 120.0)
+
+
+class HysteresisModel(ChainSystem):
+    """Base of the forward models: voltage (V) in, displacement (µm) out.
+
+    Subclasses list their learned parameters in ``_learned`` (names without the trailing
+    underscore) and their hyperparameters in ``_hyper``; the learned attributes end in ``_``
+    as in scikit-learn. A model without learned parameters can only be fitted.
+    """
+
+    kind: ClassVar[str]
+    _hyper: ClassVar[tuple[str, ...]]
+    _learned: ClassVar[tuple[str, ...]]
+
+    def _check_fitted(self) -> None:
+        if not hasattr(self, self._learned[0] + "_"):
+            name = type(self).__name__
+            raise NotFittedError(
+                f"This {name} has no parameters yet. Call fit(v, x) on measured data, "
+                f"build it with {name}.from_parameters(...), or load one with "
+                "hystcomp.load_model(path)."
+            )
+
+    def get_params(self) -> dict[str, Any]:
+        """The hyperparameters given to ``__init__``."""
+        return {name: getattr(self, name) for name in self._hyper}
+
+    def parameters(self) -> dict[str, Any]:
+        """The learned parameters as plain Python values (lists and floats)."""
+        self._check_fitted()
+        out = {}
+        for name in self._learned:
+            value = getattr(self, name + "_")
+            out[name] = value.tolist() if isinstance(value, np.ndarray) else value
+        return out
+
+    def to_dict(self) -> dict[str, Any]:
+        """Kind, hyperparameters, parameters and fit report, ready for JSON."""
+        out = {
+            "kind": self.kind,
+            "hyperparameters": self.get_params(),
+            "parameters": self.parameters(),
+        }
+        report = getattr(self, "fit_report_", None)
+        if report is not None:
+            out["fit_report"] = dict(report)
+        return out
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]):
+        """Inverse of :meth:`to_dict` (validates everything through ``from_parameters``)."""
+        model = cls.from_parameters(**data["parameters"])
+        for name, value in data.get("hyperparameters", {}).items():
+            if name in cls._hyper:
+                setattr(model, name, value)
+        if "fit_report" in data:
+            model.fit_report_ = dict(data["fit_report"])
+        return model
+
+    def __repr__(self) -> str:
+        args = ", ".join(f"{k}={v!r}" for k, v in self.get_params().items())
+        state = "" if hasattr(self, self._learned[0] + "_") else ", unfitted"
+        return f"{type(self).__name__}({args}{state})"
+
+
+def set_common_parameters(model, owner, *, voltage_range, input_offset, output_offset):
+    """Validate and set the parameters every PI-type model has."""
+    model.voltage_range_ = check_range(voltage_range, "voltage_range", owner)
+    model.input_offset_ = check_real(input_offset, "input_offset", owner)
+    model.output_offset_ = check_real(output_offset, "output_offset", owner)
+
+
+def initial_state_or_zero(initial_state, length, owner):
+    """Eq. (18): play states start at 0 unless given."""
+    if initial_state is None:
+        out = np.zeros(length)
+        out.setflags(write=False)
+        return out
+    return as_vector(initial_state, "initial_state", owner, length=length)
+
+
+def slew_to_step(slew_rate, sample_rate, owner) -> float:
+    """Largest voltage change per sample from a slew-rate limit in V/s (``inf`` if None)."""
+    if slew_rate is None:
+        return np.inf
+    slew_rate = check_real(slew_rate, "slew_rate", owner, positive=True)
+    sample_rate = check_real(sample_rate, "sample_rate", owner, positive=True)
+    return slew_rate / sample_rate

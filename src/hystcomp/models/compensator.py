@@ -1,0 +1,132 @@
+"""Systems that run a packed operator chain: batch ``simulate`` and a streaming ``Stepper``.
+
+A :class:`ChainSystem` is immutable: it holds a packed chain (see :mod:`hystcomp.operators`)
+whose state part is the initial state. ``simulate`` runs a copy, so calling it twice gives
+the same answer; a :class:`Stepper` owns its own copy and can be reset or copied.
+"""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+
+import numpy as np
+
+from hystcomp import operators
+from hystcomp._validation import as_signal
+
+
+class Stepper:
+    """Streaming evaluation, one sample per call, bit for bit equal to the batch run.
+
+    A non-finite input sample holds the last output (the amplifier keeps its voltage) and
+    is counted in :attr:`nonfinite_count`; nothing is raised inside a real-time loop.
+    """
+
+    __slots__ = ("_initial", "_p", "_start")
+
+    def __init__(self, packed: np.ndarray):
+        self._initial = packed
+        self._p = packed.copy()
+        self._start = int(operators.chain_state_start(packed))
+
+    def step(self, u: float) -> float:
+        """Advance one sample and return the output."""
+        return operators.chain_step(self._p, u)
+
+    def step_block(self, u) -> np.ndarray:
+        """Advance over a block of samples and return the outputs (non-finite samples held)."""
+        u = np.ascontiguousarray(u, dtype=np.float64).reshape(-1)
+        out = np.empty_like(u)
+        operators.chain_run(self._p, u, out)
+        return out
+
+    def reset(self) -> None:
+        """Return to the initial state."""
+        self._p[:] = self._initial
+
+    def copy(self) -> Stepper:
+        """An independent stepper in the same state."""
+        twin = Stepper(self._initial)
+        twin._p[:] = self._p
+        return twin
+
+    @property
+    def nonfinite_count(self) -> int:
+        """How many non-finite input samples were held since the last reset."""
+        return int(self._p[self._start + operators.STATE_NONFINITE])
+
+    @property
+    def last_output(self) -> float:
+        """The last output (before the first sample: the clamped rest value, 0 if in range)."""
+        return float(self._p[self._start + operators.STATE_LAST])
+
+
+class ChainSystem(ABC):
+    """A static hysteretic map evaluated by the chain kernel (a model or a compensator)."""
+
+    _input_name = "v"
+
+    @abstractmethod
+    def _packed(self) -> np.ndarray:
+        """The packed chain: parameters and initial state."""
+
+    def simulate(self, signal) -> np.ndarray:
+        """Run a whole signal from the initial state; the system is not changed.
+
+        Parameters
+        ----------
+        signal : array_like
+            1-D finite samples.
+
+        Returns
+        -------
+        ndarray
+            The output, one sample per input sample.
+        """
+        u = as_signal(signal, self._input_name)
+        p = self._packed().copy()
+        out = np.empty_like(u)
+        operators.chain_run(p, u, out)
+        return out
+
+    def stepper(self) -> Stepper:
+        """A :class:`Stepper` starting from the initial state."""
+        return Stepper(self._packed())
+
+
+class Compensator(ChainSystem):
+    """Inverse-based feedforward: reference displacement (µm) in, voltage (V) out.
+
+    Built by ``model.inverse()``; the output is always inside ``voltage_range``.
+
+    Attributes
+    ----------
+    kind : str
+        The kind of the model it inverts (``"pi"`` or ``"mpi"``).
+    voltage_range : tuple of float
+        The clamp on the output, in V.
+    max_step : float
+        Largest output change per sample, in V (``inf`` without a slew-rate limit).
+    """
+
+    _input_name = "x_ref"
+
+    def __init__(self, packed: np.ndarray, *, kind: str, voltage_range: tuple[float, float]):
+        packed = packed.copy()
+        packed.setflags(write=False)
+        self._chain = packed
+        self.kind = kind
+        self.voltage_range = voltage_range
+        self.max_step = float(packed[operators.MAX_STEP])
+
+    def _packed(self) -> np.ndarray:
+        return self._chain
+
+    @property
+    def packed(self) -> np.ndarray:
+        """The read-only packed chain (parameters and initial state), e.g. for C export."""
+        return self._chain
+
+    def __repr__(self) -> str:
+        lo, hi = self.voltage_range
+        return f"Compensator(kind={self.kind!r}, voltage_range=({lo:g}, {hi:g}) V)"

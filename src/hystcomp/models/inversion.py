@@ -1,0 +1,72 @@
+"""Analytic inversion of Prandtl-Ishlinskii superpositions (paper eqs. 24-26).
+
+The same transform inverts a superposition of play operators (the PI model, eq. 12) and a
+superposition of one-sided dead-zones (the saturation operator, eq. 14): both are piecewise
+linear in the input with slope ``w_0 + ... + w_i`` past threshold ``r_i``, so both invert to
+a superposition of the same kind with thresholds (24) and weights (25). The transform is an
+involution: applied twice it returns the original parameters.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from hystcomp.errors import NotInvertibleError
+
+
+def check_invertible(weights: np.ndarray, what: str) -> None:
+    """Raise :class:`NotInvertibleError` unless every partial sum of ``weights`` is positive.
+
+    Examples
+    --------
+    >>> check_invertible(np.array([1.0, -0.5, 0.2]), "the model")
+    >>> check_invertible(np.array([1.0, -1.5, 0.2]), "the model")
+    Traceback (most recent call last):
+    ...
+    hystcomp.errors.NotInvertibleError: the model is not invertible: ...(index 1)...
+    """
+    partial = np.cumsum(weights)
+    bad = np.flatnonzero(~(partial > 0))
+    if bad.size:
+        i = int(bad[0])
+        raise NotInvertibleError(
+            f"{what} is not invertible: the partial sum of weights w_0 + ... + w_{i} = "
+            f"{partial[i]:.6g} is not positive (index {i}). Eqs. 24-26 need every partial sum "
+            f"> 0: identify the model with the invertibility constraint, or change weights[{i}].",
+            index=i,
+        )
+
+
+def invert_superposition(
+    thresholds: np.ndarray, weights: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Thresholds and weights of the inverse superposition, eqs. (24) and (25).
+
+    ``r'_i = sum_{j<=i} w_j (r_i - r_j)`` and ``w'_0 = 1/w_0``,
+    ``w'_i = -w_i / ((w_0+...+w_i)(w_0+...+w_{i-1}))``. The caller checks invertibility.
+
+    Examples
+    --------
+    >>> r, w = np.array([0.0, 1.0]), np.array([2.0, -1.0])
+    >>> r_inv, w_inv = invert_superposition(r, w)
+    >>> r_inv.tolist(), w_inv.tolist()
+    ([0.0, 2.0], [0.5, 0.5])
+    """
+    partial = np.cumsum(weights)
+    r_inv = partial * thresholds - np.cumsum(weights * thresholds)
+    w_inv = np.empty_like(weights)
+    w_inv[0] = 1.0 / weights[0]
+    w_inv[1:] = -weights[1:] / (partial[1:] * partial[:-1])
+    return r_inv, w_inv
+
+
+def inverse_initial_state(weights: np.ndarray, initial_state: np.ndarray) -> np.ndarray:
+    """Initial states of the inverse play operators, eq. (26).
+
+    ``z_i = (w_0+...+w_i) y_i + sum_{j>i} w_j y_j``, which makes the inverse start exactly
+    where the forward model starts.
+    """
+    partial = np.cumsum(weights)
+    weighted = weights * initial_state
+    tail = weighted.sum() - np.cumsum(weighted)
+    return partial * initial_state + tail

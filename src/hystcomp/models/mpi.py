@@ -1,0 +1,164 @@
+"""The Modified Prandtl-Ishlinskii model (paper eq. 15) and its analytic inverse (eq. 23)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from hystcomp import operators
+from hystcomp._validation import as_vector, check_thresholds
+from hystcomp.models.base import (
+    HysteresisModel,
+    initial_state_or_zero,
+    set_common_parameters,
+    slew_to_step,
+)
+from hystcomp.models.compensator import Compensator
+from hystcomp.models.inversion import (
+    check_invertible,
+    inverse_initial_state,
+    invert_superposition,
+)
+
+
+class ModifiedPrandtlIshlinskii(HysteresisModel):
+    """Modified Prandtl-Ishlinskii model, eq. (15): ``x = x_0 + S[H[v - v_0]]``.
+
+    ``H`` is a PI model (eq. 12) of plays, ``S`` a superposition of one-sided dead-zones
+    (eqs. 13-14), which makes the loops asymmetric and lets them saturate.
+
+    Parameters
+    ----------
+    n_operators : int, default 16
+        Number of play operators in ``H`` (``n + 1``; the paper uses 16).
+    n_deadzones : int, default 16
+        Number of dead-zones in ``S`` (``m + 1``; the paper uses 16).
+    voltage_range : (float, float) or None, default None
+        The amplifier's range in V; ``None`` takes the range of the identification data.
+
+    Attributes
+    ----------
+    thresholds_, weights_, initial_state_ : ndarray
+        The plays of ``H``: V, µm/V, V.
+    deadzone_thresholds_, deadzone_weights_ : ndarray
+        The dead-zones of ``S``: thresholds in µm (of ``H``'s output) and unitless weights.
+        Identification finds the *inverse* dead-zones (eq. 19); these are the forward ones,
+        computed with eqs. (24)-(25) as the paper says after eq. 19.
+    voltage_range_, input_offset_, output_offset_
+        As in :class:`~hystcomp.models.pi.PrandtlIshlinskii`.
+
+    Examples
+    --------
+    >>> model = ModifiedPrandtlIshlinskii.from_parameters(
+    ...     thresholds=[0, 10], weights=[0.2, 0.1],
+    ...     deadzone_thresholds=[0, 4], deadzone_weights=[1.0, -0.5])
+    >>> v = np.array([0.0, 20.0, 5.0])
+    >>> x = model.simulate(v)
+    >>> x.round(6).tolist()
+    [0.0, 4.5, 2.0]
+    >>> model.inverse().simulate(x).round(9).tolist()
+    [0.0, 20.0, 5.0]
+    """
+
+    kind = "mpi"
+    _hyper = ("n_operators", "n_deadzones", "voltage_range")
+    _learned = (
+        "thresholds",
+        "weights",
+        "initial_state",
+        "deadzone_thresholds",
+        "deadzone_weights",
+        "voltage_range",
+        "input_offset",
+        "output_offset",
+    )
+
+    def __init__(self, *, n_operators=16, n_deadzones=16, voltage_range=None):
+        self.n_operators = n_operators
+        self.n_deadzones = n_deadzones
+        self.voltage_range = voltage_range
+
+    @classmethod
+    def from_parameters(
+        cls,
+        *,
+        thresholds,
+        weights,
+        deadzone_thresholds,
+        deadzone_weights,
+        initial_state=None,
+        voltage_range=(0.0, 120.0),
+        input_offset=0.0,
+        output_offset=0.0,
+    ) -> ModifiedPrandtlIshlinskii:
+        """A model with the given parameters (V, µm/V, µm, unitless); all validated."""
+        owner = cls.__name__
+        r = check_thresholds(thresholds, "thresholds", owner)
+        rs = check_thresholds(deadzone_thresholds, "deadzone_thresholds", owner)
+        model = cls(n_operators=r.size, n_deadzones=rs.size, voltage_range=None)
+        model.thresholds_ = r
+        model.weights_ = as_vector(weights, "weights", owner, length=r.size)
+        model.initial_state_ = initial_state_or_zero(initial_state, r.size, owner)
+        model.deadzone_thresholds_ = rs
+        model.deadzone_weights_ = as_vector(
+            deadzone_weights, "deadzone_weights", owner, length=rs.size
+        )
+        set_common_parameters(
+            model,
+            owner,
+            voltage_range=voltage_range,
+            input_offset=input_offset,
+            output_offset=output_offset,
+        )
+        return model
+
+    def _packed(self) -> np.ndarray:
+        self._check_fitted()
+        return operators.pack_chain(
+            plays=(self.thresholds_, self.weights_, self.initial_state_),
+            post=(self.deadzone_thresholds_, self.deadzone_weights_),
+            in_offset=self.input_offset_,
+            out_offset=self.output_offset_,
+        )
+
+    def inverse(self, *, slew_rate=None, sample_rate=20_000.0) -> Compensator:
+        """The analytic inverse MPI, eq. (23): ``v = v_0 + H^-1[S^-1[x - x_0]]``, clamped.
+
+        ``S^-1`` is a dead-zone superposition and ``H^-1`` a PI model, both from eqs. 24-25
+        (and eq. 26 for the initial states). ``slew_rate`` (V/s) and ``sample_rate`` (Hz)
+        are as in :meth:`PrandtlIshlinskii.inverse`.
+
+        Raises
+        ------
+        NotInvertibleError
+            If a partial sum of the play weights or of the dead-zone weights is not positive.
+        """
+        self._check_fitted()
+        owner = type(self).__name__
+        check_invertible(self.weights_, f"The hysteresis operator H of this {owner} model")
+        check_invertible(self.deadzone_weights_, f"The saturation operator S of this {owner} model")
+        max_step = slew_to_step(slew_rate, sample_rate, owner)
+        lo, hi = self.voltage_range_
+        packed = operators.pack_chain(
+            pre=invert_superposition(self.deadzone_thresholds_, self.deadzone_weights_),
+            plays=(
+                *invert_superposition(self.thresholds_, self.weights_),
+                inverse_initial_state(self.weights_, self.initial_state_),
+            ),
+            in_offset=self.output_offset_,
+            out_offset=self.input_offset_,
+            low=lo,
+            high=hi,
+            max_step=max_step,
+        )
+        return Compensator(packed, kind=self.kind, voltage_range=self.voltage_range_)
+
+    @staticmethod
+    def forward_deadzones(inverse_thresholds, inverse_weights) -> tuple[np.ndarray, np.ndarray]:
+        """Forward dead-zones ``(r_S, w_S)`` from the identified inverse ones ``(r'_S, w'_S)``.
+
+        The paper's remark after eq. (19): the same transform as eqs. (24)-(25).
+        """
+        r = check_thresholds(inverse_thresholds, "inverse_thresholds", "forward_deadzones")
+        w = as_vector(inverse_weights, "inverse_weights", "forward_deadzones", length=r.size)
+        check_invertible(w, "The inverse saturation operator")
+        return invert_superposition(r, w)

@@ -1,0 +1,153 @@
+"""The classical Prandtl-Ishlinskii model (paper eq. 12) and its analytic inverse (eqs. 24-26)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from hystcomp import operators
+from hystcomp._validation import as_vector, check_int, check_thresholds
+from hystcomp.models.base import (
+    HysteresisModel,
+    initial_state_or_zero,
+    set_common_parameters,
+    slew_to_step,
+)
+from hystcomp.models.compensator import Compensator
+from hystcomp.models.inversion import (
+    check_invertible,
+    inverse_initial_state,
+    invert_superposition,
+)
+
+
+class PrandtlIshlinskii(HysteresisModel):
+    """Classical Prandtl-Ishlinskii model, eq. (12): ``x = x_0 + sum_i w_i play_{r_i}(v - v_0)``.
+
+    The paper's model has ``v_0 = x_0 = 0``; the offsets let the same model describe records
+    with a sensor offset or a bipolar input (the plays then act on ``v - v_0``, so that the
+    thresholds of eq. 16 span the input range from its lower end).
+
+    Parameters
+    ----------
+    n_operators : int, default 16
+        Number of play operators ``n + 1`` (the paper uses 16).
+    voltage_range : (float, float) or None, default None
+        The amplifier's range in V, to which the compensator clamps its output. ``None``
+        takes the range of the identification data.
+
+    Attributes
+    ----------
+    thresholds_ : ndarray
+        Play thresholds ``0 = r_0 < ... < r_n`` in V (eq. 16 when identified).
+    weights_ : ndarray
+        Play weights in µm/V.
+    initial_state_ : ndarray
+        Initial play states in V (eq. 18: zero).
+    voltage_range_ : (float, float)
+        Output clamp of the compensator, in V.
+    input_offset_, output_offset_ : float
+        ``v_0`` in V and ``x_0`` in µm.
+
+    Examples
+    --------
+    >>> model = PrandtlIshlinskii.from_parameters(thresholds=[0, 10], weights=[0.2, 0.1])
+    >>> v = np.array([0.0, 20.0, 5.0, 20.0])
+    >>> model.simulate(v).round(6).tolist()
+    [0.0, 5.0, 2.0, 5.0]
+    >>> model.inverse().simulate(model.simulate(v)).round(9).tolist()
+    [0.0, 20.0, 5.0, 20.0]
+    """
+
+    kind = "pi"
+    _hyper = ("n_operators", "voltage_range")
+    _learned = (
+        "thresholds",
+        "weights",
+        "initial_state",
+        "voltage_range",
+        "input_offset",
+        "output_offset",
+    )
+
+    def __init__(self, *, n_operators=16, voltage_range=None):
+        self.n_operators = n_operators
+        self.voltage_range = voltage_range
+
+    @classmethod
+    def from_parameters(
+        cls,
+        *,
+        thresholds,
+        weights,
+        initial_state=None,
+        voltage_range=(0.0, 120.0),
+        input_offset=0.0,
+        output_offset=0.0,
+    ) -> PrandtlIshlinskii:
+        """A model with the given parameters (V, µm/V, µm); every value is validated."""
+        owner = cls.__name__
+        r = check_thresholds(thresholds, "thresholds", owner)
+        model = cls(n_operators=r.size, voltage_range=None)
+        model.thresholds_ = r
+        model.weights_ = as_vector(weights, "weights", owner, length=r.size)
+        model.initial_state_ = initial_state_or_zero(initial_state, r.size, owner)
+        set_common_parameters(
+            model,
+            owner,
+            voltage_range=voltage_range,
+            input_offset=input_offset,
+            output_offset=output_offset,
+        )
+        return model
+
+    def _packed(self) -> np.ndarray:
+        self._check_fitted()
+        return operators.pack_chain(
+            plays=(self.thresholds_, self.weights_, self.initial_state_),
+            in_offset=self.input_offset_,
+            out_offset=self.output_offset_,
+        )
+
+    def inverse(self, *, slew_rate=None, sample_rate=20_000.0) -> Compensator:
+        """The analytic inverse PI (eqs. 24-26) as a compensator clamped to the voltage range.
+
+        Parameters
+        ----------
+        slew_rate : float, optional
+            Largest output slew rate in V/s (none by default).
+        sample_rate : float, default 20000
+            Sample rate in Hz at which the compensator runs; sets the per-sample slew step.
+
+        Raises
+        ------
+        NotInvertibleError
+            If a partial sum of the weights is not positive; its ``index`` names it.
+        """
+        self._check_fitted()
+        owner = type(self).__name__
+        check_invertible(self.weights_, f"This {owner} model")
+        max_step = slew_to_step(slew_rate, sample_rate, owner)
+        r_inv, w_inv = invert_superposition(self.thresholds_, self.weights_)
+        z0 = inverse_initial_state(self.weights_, self.initial_state_)
+        lo, hi = self.voltage_range_
+        packed = operators.pack_chain(
+            plays=(r_inv, w_inv, z0),
+            in_offset=self.output_offset_,
+            out_offset=self.input_offset_,
+            low=lo,
+            high=hi,
+            max_step=max_step,
+        )
+        return Compensator(packed, kind=self.kind, voltage_range=self.voltage_range_)
+
+
+def paper_thresholds(n_operators: int, span: float) -> np.ndarray:
+    """Eq. (16)/(17): ``r_i = i / (n+1) * span`` for ``i = 0..n`` (``n_operators = n + 1``).
+
+    Examples
+    --------
+    >>> paper_thresholds(4, 120.0).tolist()
+    [0.0, 30.0, 60.0, 90.0]
+    """
+    n_operators = check_int(n_operators, "n_operators", "paper_thresholds")
+    return np.arange(n_operators) / n_operators * float(span)

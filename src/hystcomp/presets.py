@@ -1,0 +1,145 @@
+"""The models identified in the paper, in hystcomp's units (V in, µm out).
+
+Unit conversion: the paper's weights (eqs. 20-21) are in m/V (the ``10^-6`` factor in front);
+multiplied by ``10^6`` they are µm/V. The dead-zone weights of eq. (22) are unitless.
+
+Assumptions, since the paper leaves them implicit:
+
+* Thresholds follow eq. (16) with ``max{v} = 120 V`` and ``n + 1 = 16`` plays, initial states
+  zero (eq. 18), voltage range 0..120 V, no offsets.
+* Eq. (22) lists the *inverse* dead-zone weights ``w'_S`` that eq. (19) identifies (the paper
+  labels them ``w_xS``). Read as forward weights they would give a 170 µm stroke; read as
+  inverse weights the stroke is 36 µm, in line with eq. (20)'s PI (38 µm) and eq. (6)'s
+  Preisach model (37 µm), so this is the reading we take.
+* Eq. (17) needs ``max{x_p}``, the largest measured displacement, which the paper does not
+  give. We take the self-consistent value: the ``M`` for which the model's own largest
+  displacement on the paper's identification triangle (30..120 V) equals ``M``
+  (:data:`PAPER_MPI_MAX_DISPLACEMENT`, about 36 µm, found by fixed-point iteration).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from hystcomp.models.mpi import ModifiedPrandtlIshlinskii
+from hystcomp.models.pi import PrandtlIshlinskii, paper_thresholds
+
+PAPER_V_MAX = 120.0  # V, eq. (16)
+
+#: Eq. (20), PI play weights in µm/V.
+PAPER_PI_WEIGHTS = np.array(
+    [
+        0.1386,
+        0.1101,
+        0.0276,
+        -0.0651,
+        0.1568,
+        -0.0698,
+        0.0491,
+        -0.0413,
+        0.0396,
+        0.0105,
+        -0.0016,
+        0.0232,
+        -0.0957,
+        0.0954,
+        0.0323,
+        -0.0685,
+    ]
+)
+#: Eq. (21), MPI play weights in µm/V.
+PAPER_MPI_WEIGHTS = np.array(
+    [
+        0.4001,
+        0.0492,
+        0.0814,
+        -0.0242,
+        0.0886,
+        0.0074,
+        0.0548,
+        0.0265,
+        -0.0374,
+        0.0378,
+        0.0093,
+        0.1146,
+        -0.2047,
+        0.0989,
+        0.1547,
+        -0.1286,
+    ]
+)
+#: Eq. (22), MPI inverse dead-zone weights (unitless).
+PAPER_MPI_INVERSE_DEADZONE_WEIGHTS = np.array(
+    [
+        3.0803,
+        -1.2216,
+        0.1782,
+        -0.2045,
+        0.0502,
+        0.0478,
+        0.0894,
+        -0.0221,
+        -0.0336,
+        0.0163,
+        0.0620,
+        0.2135,
+        -0.0247,
+        -0.1913,
+        0.4753,
+        -0.2476,
+    ]
+)
+
+
+def paper_identification_triangle(sample_rate: float = 1000.0) -> np.ndarray:
+    """The paper's identification input: triangles of 30, 60, 90, 120 V at 1 Hz from 0 V."""
+    t = np.arange(round(sample_rate)) / sample_rate
+    tri = np.minimum(t, 1.0 - t) * 2.0  # 0 -> 1 -> 0 over one second
+    return np.concatenate([a * tri for a in (30.0, 60.0, 90.0, 120.0)] + [np.zeros(1)])
+
+
+def paper_pi() -> PrandtlIshlinskii:
+    """The PI model of eq. (20): 16 plays on 0..120 V.
+
+    Examples
+    --------
+    >>> model = paper_pi()
+    >>> round(float(model.simulate([0.0, 120.0])[-1]), 3)
+    37.789
+    """
+    return PrandtlIshlinskii.from_parameters(
+        thresholds=paper_thresholds(16, PAPER_V_MAX),
+        weights=PAPER_PI_WEIGHTS,
+        voltage_range=(0.0, PAPER_V_MAX),
+    )
+
+
+def paper_mpi_with(max_displacement: float) -> ModifiedPrandtlIshlinskii:
+    """The MPI of eqs. (21)-(22) with eq. (17)'s thresholds for ``max{x_p} = max_displacement`` µm."""
+    r_inv = paper_thresholds(16, max_displacement)  # eq. (17)
+    rs, ws = ModifiedPrandtlIshlinskii.forward_deadzones(r_inv, PAPER_MPI_INVERSE_DEADZONE_WEIGHTS)
+    return ModifiedPrandtlIshlinskii.from_parameters(
+        thresholds=paper_thresholds(16, PAPER_V_MAX),
+        weights=PAPER_MPI_WEIGHTS,
+        deadzone_thresholds=rs,
+        deadzone_weights=ws,
+        voltage_range=(0.0, PAPER_V_MAX),
+    )
+
+
+#: The ``max{x_p}`` of eq. (17) behind the MPI preset, in µm: the fixed point ``M`` of
+#: ``M = max(paper MPI with M on paper_identification_triangle())`` (see the module
+#: docstring; ``tests/test_presets.py`` checks that it is one).
+PAPER_MPI_MAX_DISPLACEMENT = 35.886667354280206
+
+
+def paper_mpi() -> ModifiedPrandtlIshlinskii:
+    """The MPI model of eqs. (21)-(22) (16 plays, 16 dead-zones) on 0..120 V.
+
+    Examples
+    --------
+    >>> model = paper_mpi()
+    >>> round(float(model.simulate([0.0, 120.0])[-1]), 2)
+    35.89
+    """
+    return paper_mpi_with(PAPER_MPI_MAX_DISPLACEMENT)
