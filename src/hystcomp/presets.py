@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from hystcomp.identify.excitation import triangle_sequence
 from hystcomp.models.mpi import ModifiedPrandtlIshlinskii
 from hystcomp.models.pi import PrandtlIshlinskii, paper_thresholds
 
@@ -92,10 +93,8 @@ PAPER_MPI_INVERSE_DEADZONE_WEIGHTS = np.array(
 
 
 def paper_identification_triangle(sample_rate: float = 1000.0) -> np.ndarray:
-    """The paper's identification input: triangles of 30, 60, 90, 120 V at 1 Hz from 0 V."""
-    t = np.arange(round(sample_rate)) / sample_rate
-    tri = np.minimum(t, 1.0 - t) * 2.0  # 0 -> 1 -> 0 over one second
-    return np.concatenate([a * tri for a in (30.0, 60.0, 90.0, 120.0)] + [np.zeros(1)])
+    """The paper's identification input (eq. 19): triangles of 30..120 V at 1 Hz from 0 V."""
+    return triangle_sequence(sample_rate=sample_rate)[1]
 
 
 def paper_pi() -> PrandtlIshlinskii:

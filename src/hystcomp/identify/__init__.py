@@ -1,0 +1,1 @@
+"""Identification from measured data, and the paper's identification signals."""

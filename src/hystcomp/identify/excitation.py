@@ -1,0 +1,85 @@
+"""The paper's identification signals (Section III-A for Preisach, Section IV-A for PI/MPI).
+
+All signals start at the lower end of the voltage range, with the piezo at rest there.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from hystcomp._validation import check_range, check_real
+
+DEFAULT_SAMPLE_RATE = 20_000.0  # Hz, the paper's rig (Section II)
+PI_AMPLITUDES = (30.0, 60.0, 90.0, 120.0)  # V, Section IV-A (ii)
+PREISACH_AMPLITUDES = tuple(float(a) for a in range(5, 125, 5))  # V, Section III-A (i)
+
+
+def _periods(sample_rate: float, frequency: float) -> np.ndarray:
+    n = round(sample_rate / frequency)
+    return np.arange(n) / n  # phase of one period, in [0, 1)
+
+
+def triangle_sequence(
+    amplitudes=PI_AMPLITUDES,
+    *,
+    frequency: float = 1.0,
+    sample_rate: float = DEFAULT_SAMPLE_RATE,
+    v_min: float = 0.0,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Triangles ``v_min -> v_min + A -> v_min``, one period per amplitude, then ``v_min``.
+
+    With the defaults this is the PI/MPI identification signal of Section IV-A (ii):
+    triangles of 30, 60, 90 and 120 V at 1 Hz, 80,001 samples at 20 kHz.
+
+    Returns
+    -------
+    t, v : ndarray
+        Time in s (from 0) and voltage in V.
+
+    Examples
+    --------
+    >>> t, v = triangle_sequence([10.0, 20.0], sample_rate=4.0)
+    >>> v.tolist()
+    [0.0, 5.0, 10.0, 5.0, 0.0, 10.0, 20.0, 10.0, 0.0]
+    """
+    phase = _periods(
+        check_real(sample_rate, "sample_rate", "triangle_sequence", positive=True),
+        check_real(frequency, "frequency", "triangle_sequence", positive=True),
+    )
+    shape = 1.0 - np.abs(1.0 - 2.0 * phase)  # 0 -> 1 -> 0
+    v = np.concatenate([a * shape for a in amplitudes] + [np.zeros(1)]) + v_min
+    return np.arange(v.size) / sample_rate, v
+
+
+def sinusoid_sequence(
+    amplitudes=PREISACH_AMPLITUDES,
+    *,
+    frequency: float = 1.0,
+    sample_rate: float = DEFAULT_SAMPLE_RATE,
+    v_min: float = 0.0,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Sinusoids ``v_min + A (1 - cos 2 pi f t) / 2``, one period per amplitude, then ``v_min``.
+
+    With the defaults this is the Preisach identification signal of Section III-A (i):
+    1 Hz sinusoids of amplitude 5, 10, ..., 120 V, each starting from ``v_min``, so that each
+    descent from ``v_min + A`` traces a first-order descending curve.
+
+    Returns
+    -------
+    t, v : ndarray
+        Time in s and voltage in V.
+    """
+    phase = _periods(
+        check_real(sample_rate, "sample_rate", "sinusoid_sequence", positive=True),
+        check_real(frequency, "frequency", "sinusoid_sequence", positive=True),
+    )
+    shape = 0.5 * (1.0 - np.cos(2.0 * np.pi * phase))
+    v = np.concatenate([a * shape for a in amplitudes] + [np.zeros(1)]) + v_min
+    return np.arange(v.size) / sample_rate, v
+
+
+def scaled_amplitudes(amplitudes, paper_range=(0.0, 120.0), voltage_range=(0.0, 120.0)):
+    """The paper's amplitudes rescaled from 0..120 V to another ``voltage_range``."""
+    lo, hi = check_range(voltage_range, "voltage_range", "scaled_amplitudes")
+    scale = (hi - lo) / (paper_range[1] - paper_range[0])
+    return tuple(a * scale for a in amplitudes)
