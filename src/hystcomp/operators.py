@@ -66,6 +66,16 @@ def deadzone_sum(z, r, w):
 
 
 @_kernel
+def deadzone_values(z, r, out):
+    """Each one-sided dead-zone of eq. (13) at ``z``: ``out[j] = s_{r_j}(z)``.
+
+    The per-operator regressors of the inverse saturation operator in eq. (19).
+    """
+    for j in range(r.size):
+        out[j] = max(z - r[j], 0.0) if r[j] > 0.0 else z
+
+
+@_kernel
 def chain_state_start(p):
     """Index of the first state slot of packed chain ``p``."""
     return HEADER + 2 * (int(p[N_PRE]) + int(p[N_PLAY]) + int(p[N_POST]))

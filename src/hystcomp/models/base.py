@@ -6,7 +6,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from hystcomp._validation import as_vector, check_range, check_real
+from hystcomp._validation import as_vector, check_int, check_range, check_real
 from hystcomp.errors import NotFittedError
 from hystcomp.models.compensator import ChainSystem
 
@@ -70,6 +70,12 @@ class HysteresisModel(ChainSystem):
             model.fit_report_ = dict(data["fit_report"])
         return model
 
+    def _adopt(self, fitted: HysteresisModel, fit_report: dict) -> None:
+        """Take the learned parameters of ``fitted`` (built by ``from_parameters``, so validated)."""
+        for name in self._learned:
+            setattr(self, name + "_", getattr(fitted, name + "_"))
+        self.fit_report_ = fit_report
+
     def __repr__(self) -> str:
         args = ", ".join(f"{k}={v!r}" for k, v in self.get_params().items())
         state = "" if hasattr(self, self._learned[0] + "_") else ", unfitted"
@@ -99,3 +105,18 @@ def slew_to_step(slew_rate, sample_rate, owner) -> float:
     slew_rate = check_real(slew_rate, "slew_rate", owner, positive=True)
     sample_rate = check_real(sample_rate, "sample_rate", owner, positive=True)
     return slew_rate / sample_rate
+
+
+def fit_voltage_range(voltage_range, v, owner) -> tuple[float, float]:
+    """The ``voltage_range`` hyperparameter, or the data's ``(min v, max v)`` if it is None."""
+    if voltage_range is None:
+        v = np.asarray(v, dtype=np.float64)
+        return float(v.min()), float(v.max())
+    return check_range(voltage_range, "voltage_range", owner)
+
+
+def check_fit_options(model, owner) -> None:
+    """Validate the identification hyperparameters ``transient`` and ``margin``."""
+    if model.transient is not None:
+        check_int(model.transient, "transient", owner, minimum=0)
+    check_real(model.margin, "margin", owner, positive=True)

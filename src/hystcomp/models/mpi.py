@@ -5,9 +5,13 @@ from __future__ import annotations
 import numpy as np
 
 from hystcomp import operators
-from hystcomp._validation import as_vector, check_thresholds
+from hystcomp._validation import as_vector, check_int, check_thresholds
+from hystcomp.identify.mpi import fit_mpi
+from hystcomp.identify.scoring import error_report
 from hystcomp.models.base import (
     HysteresisModel,
+    check_fit_options,
+    fit_voltage_range,
     initial_state_or_zero,
     set_common_parameters,
     slew_to_step,
@@ -34,6 +38,11 @@ class ModifiedPrandtlIshlinskii(HysteresisModel):
         Number of dead-zones in ``S`` (``m + 1``; the paper uses 16).
     voltage_range : (float, float) or None, default None
         The amplifier's range in V; ``None`` takes the range of the identification data.
+    transient : int or None, default None
+        Samples at the start of the record left out of the fit; ``None``: until the input
+        first reaches an end of its range (:func:`hystcomp.identify.scoring.transient_end`).
+    margin : float, default 1e-3
+        Invertibility margin of the fit (see :func:`hystcomp.identify.mpi.fit_mpi`).
 
     Attributes
     ----------
@@ -45,6 +54,8 @@ class ModifiedPrandtlIshlinskii(HysteresisModel):
         computed with eqs. (24)-(25) as the paper says after eq. 19.
     voltage_range_, input_offset_, output_offset_
         As in :class:`~hystcomp.models.pi.PrandtlIshlinskii`.
+    fit_report_ : dict
+        After :meth:`fit`: errors of the model on the record.
 
     Examples
     --------
@@ -60,7 +71,7 @@ class ModifiedPrandtlIshlinskii(HysteresisModel):
     """
 
     kind = "mpi"
-    _hyper = ("n_operators", "n_deadzones", "voltage_range")
+    _hyper = ("n_operators", "n_deadzones", "voltage_range", "transient", "margin")
     _learned = (
         "thresholds",
         "weights",
@@ -72,10 +83,54 @@ class ModifiedPrandtlIshlinskii(HysteresisModel):
         "output_offset",
     )
 
-    def __init__(self, *, n_operators=16, n_deadzones=16, voltage_range=None):
+    def __init__(
+        self, *, n_operators=16, n_deadzones=16, voltage_range=None, transient=None, margin=1e-3
+    ):
         self.n_operators = n_operators
         self.n_deadzones = n_deadzones
         self.voltage_range = voltage_range
+        self.transient = transient
+        self.margin = margin
+
+    def fit(self, v, x) -> ModifiedPrandtlIshlinskii:
+        """Identify the model from a measured record by eq. (19) (Section IV-A).
+
+        Delegates to :func:`hystcomp.identify.mpi.fit_mpi`, which finds the plays of ``H``
+        and the *inverse* dead-zones; the forward dead-zones ``deadzone_thresholds_``,
+        ``deadzone_weights_`` follow from eqs. (24)-(25) (:meth:`forward_deadzones`).
+
+        Parameters
+        ----------
+        v, x : array_like
+            Input voltage (V) and measured displacement (µm), one sample each per instant.
+
+        Returns
+        -------
+        ModifiedPrandtlIshlinskii
+            ``self``, fitted.
+        """
+        owner = type(self).__name__
+        n = check_int(self.n_operators, "n_operators", owner)
+        m = check_int(self.n_deadzones, "n_deadzones", owner)
+        check_fit_options(self, owner)
+        fit = fit_mpi(
+            v, x, n_operators=n, n_deadzones=m, transient=self.transient, margin=self.margin
+        )
+        rs, ws = self.forward_deadzones(
+            fit.inverse_deadzone_thresholds, fit.inverse_deadzone_weights
+        )
+        fitted = self.from_parameters(
+            thresholds=fit.thresholds,
+            weights=fit.weights,
+            initial_state=fit.initial_state,
+            deadzone_thresholds=rs,
+            deadzone_weights=ws,
+            voltage_range=fit_voltage_range(self.voltage_range, v, owner),
+            input_offset=fit.input_offset,
+            output_offset=fit.output_offset,
+        )
+        self._adopt(fitted, error_report(x, fitted.simulate(v), fit.first_sample))
+        return self
 
     @classmethod
     def from_parameters(

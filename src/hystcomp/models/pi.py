@@ -6,8 +6,12 @@ import numpy as np
 
 from hystcomp import operators
 from hystcomp._validation import as_vector, check_int, check_thresholds
+from hystcomp.identify.pi import fit_pi, paper_thresholds
+from hystcomp.identify.scoring import error_report
 from hystcomp.models.base import (
     HysteresisModel,
+    check_fit_options,
+    fit_voltage_range,
     initial_state_or_zero,
     set_common_parameters,
     slew_to_step,
@@ -18,6 +22,8 @@ from hystcomp.models.inversion import (
     inverse_initial_state,
     invert_superposition,
 )
+
+__all__ = ["PrandtlIshlinskii", "paper_thresholds"]
 
 
 class PrandtlIshlinskii(HysteresisModel):
@@ -34,6 +40,13 @@ class PrandtlIshlinskii(HysteresisModel):
     voltage_range : (float, float) or None, default None
         The amplifier's range in V, to which the compensator clamps its output. ``None``
         takes the range of the identification data.
+    transient : int or None, default None
+        Samples at the start of the record left out of the fit (a start-up transient).
+        ``None``: until the input first reaches an end of its range
+        (:func:`hystcomp.identify.scoring.transient_end`).
+    margin : float, default 1e-3
+        Invertibility margin of the fit: every partial sum of the weights is at least
+        ``margin`` times the record's mean slope (see :func:`hystcomp.identify.pi.fit_pi`).
 
     Attributes
     ----------
@@ -47,6 +60,9 @@ class PrandtlIshlinskii(HysteresisModel):
         Output clamp of the compensator, in V.
     input_offset_, output_offset_ : float
         ``v_0`` in V and ``x_0`` in µm.
+    fit_report_ : dict
+        After :meth:`fit`: errors of the model on the record
+        (:func:`hystcomp.identify.scoring.error_report`).
 
     Examples
     --------
@@ -59,7 +75,7 @@ class PrandtlIshlinskii(HysteresisModel):
     """
 
     kind = "pi"
-    _hyper = ("n_operators", "voltage_range")
+    _hyper = ("n_operators", "voltage_range", "transient", "margin")
     _learned = (
         "thresholds",
         "weights",
@@ -69,9 +85,43 @@ class PrandtlIshlinskii(HysteresisModel):
         "output_offset",
     )
 
-    def __init__(self, *, n_operators=16, voltage_range=None):
+    def __init__(self, *, n_operators=16, voltage_range=None, transient=None, margin=1e-3):
         self.n_operators = n_operators
         self.voltage_range = voltage_range
+        self.transient = transient
+        self.margin = margin
+
+    def fit(self, v, x) -> PrandtlIshlinskii:
+        """Identify the model from a measured record (Section IV-A, eqs. 12, 16, 18).
+
+        Delegates to :func:`hystcomp.identify.pi.fit_pi` (constrained least squares, with
+        the invertibility of eqs. 24-26 guaranteed), then sets the learned attributes and
+        ``fit_report_``.
+
+        Parameters
+        ----------
+        v, x : array_like
+            Input voltage (V) and measured displacement (µm), one sample each per instant.
+
+        Returns
+        -------
+        PrandtlIshlinskii
+            ``self``, fitted.
+        """
+        owner = type(self).__name__
+        n = check_int(self.n_operators, "n_operators", owner)
+        check_fit_options(self, owner)
+        fit = fit_pi(v, x, n_operators=n, transient=self.transient, margin=self.margin)
+        fitted = self.from_parameters(
+            thresholds=fit.thresholds,
+            weights=fit.weights,
+            initial_state=fit.initial_state,
+            voltage_range=fit_voltage_range(self.voltage_range, v, owner),
+            input_offset=fit.input_offset,
+            output_offset=fit.output_offset,
+        )
+        self._adopt(fitted, error_report(x, fitted.simulate(v), fit.first_sample))
+        return self
 
     @classmethod
     def from_parameters(
@@ -139,15 +189,3 @@ class PrandtlIshlinskii(HysteresisModel):
             max_step=max_step,
         )
         return Compensator(packed, kind=self.kind, voltage_range=self.voltage_range_)
-
-
-def paper_thresholds(n_operators: int, span: float) -> np.ndarray:
-    """Eq. (16)/(17): ``r_i = i / (n+1) * span`` for ``i = 0..n`` (``n_operators = n + 1``).
-
-    Examples
-    --------
-    >>> paper_thresholds(4, 120.0).tolist()
-    [0.0, 30.0, 60.0, 90.0]
-    """
-    n_operators = check_int(n_operators, "n_operators", "paper_thresholds")
-    return np.arange(n_operators) / n_operators * float(span)

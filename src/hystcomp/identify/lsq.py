@@ -1,0 +1,204 @@
+"""Least squares with the invertibility constraints of the PI-type models (eqs. 12, 19, 24-25).
+
+Both identification problems of the paper are linear in the weights:
+
+* PI, eq. (12): ``x[k] ~ c + sum_i w_i play_{r_i}(u)[k]``;
+* MPI, eq. (19): ``sum_i w_i play_{r_i}(u)[k] + b ~ sum_j w'_j s_{r'_j}(z)[k]`` with
+  ``w'_0 = 1`` (the normalisation, see :mod:`hystcomp.identify.mpi`), i.e.
+  ``z[k] ~ b + sum_i w_i play_{r_i}(u)[k] - sum_{j>=1} w'_j s_{r'_j}(z)[k]``.
+
+So one design serves both: the regressor row of sample ``k`` is ::
+
+    [ play_{r_0}(u)[k] ... play_{r_n}(u)[k] | -s_{r'_1}(z[k]) ... -s_{r'_m}(z[k]) | 1 ]
+
+with target ``z[k]`` (``m = 0`` for PI). :func:`normal_equations` accumulates the augmented
+Gram matrix ``[Phi | z]^T [Phi | z]`` in one pass over the record, block by block, without
+ever holding the ``N x p`` design matrix. :func:`constrained_lsq` then solves the small
+quadratic programme: weights whose every partial sum stays above a margin (eqs. 24-25 need
+``w_0 + ... + w_i > 0``; the same for the inverse dead-zones), solved with quadprog (the
+Goldfarb-Idnani dual active-set method, like the paper's Matlab ``quadprog``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numba
+import numpy as np
+import quadprog
+
+from hystcomp import operators
+from hystcomp.errors import IdentificationError
+
+_BLOCK = 1024  # rows per BLAS update of the Gram matrix
+
+
+@numba.njit(cache=True, nogil=True)
+def _accumulate_gram(u, r, y0, z, rs, start, gram):
+    """Add ``[Phi | z]^T [Phi | z]`` over samples ``start..`` to ``gram`` (layout above).
+
+    The plays run over every sample from ``y0`` (their state must be right at ``start``);
+    only samples ``k >= start`` enter the sums.
+    """
+    n = r.size
+    m = rs.size
+    p = n + m + 2
+    rows = np.empty((_BLOCK, p))
+    y = y0.copy()
+    fill = 0
+    for k in range(u.size):
+        operators.play_update(u[k], r, y)
+        if k < start:
+            continue
+        row = rows[fill]
+        row[:n] = y
+        operators.deadzone_values(z[k], rs, row[n : n + m])
+        row[n : n + m] *= -1.0
+        row[n + m] = 1.0
+        row[n + m + 1] = z[k]
+        fill += 1
+        if fill == _BLOCK:
+            gram += rows.T @ rows
+            fill = 0
+    if fill > 0:
+        part = rows[:fill]
+        gram += part.T @ part
+
+
+def normal_equations(u, thresholds, initial_state, z, deadzone_thresholds, start) -> np.ndarray:
+    """The augmented Gram matrix of the PI/MPI regressors over samples ``start..``.
+
+    Parameters
+    ----------
+    u : ndarray
+        Play input, ``v - v_0`` in V.
+    thresholds, initial_state : ndarray
+        Play thresholds and initial states, V.
+    z : ndarray
+        Target (and dead-zone input), displacement minus an offset, in µm.
+    deadzone_thresholds : ndarray
+        Positive thresholds ``r'_1..r'_m`` of the inverse dead-zones in µm (empty for PI).
+    start : int
+        First sample in the sums (the start-up transient before it is left out).
+
+    Returns
+    -------
+    ndarray, shape (p + 1, p + 1)
+        ``[Phi | z]^T [Phi | z]`` with ``p = n + m + 1`` regressors (plays, negated
+        dead-zones, constant) and the target last.
+    """
+    n, m = len(thresholds), len(deadzone_thresholds)
+    gram = np.zeros((n + m + 2, n + m + 2))
+    _accumulate_gram(
+        np.ascontiguousarray(u, dtype=np.float64),
+        np.ascontiguousarray(thresholds, dtype=np.float64),
+        np.array(initial_state, dtype=np.float64),
+        np.ascontiguousarray(z, dtype=np.float64),
+        np.ascontiguousarray(deadzone_thresholds, dtype=np.float64),
+        int(start),
+        gram,
+    )
+    return gram
+
+
+@dataclass(frozen=True)
+class LsqSolution:
+    """Result of :func:`constrained_lsq`.
+
+    Attributes
+    ----------
+    coef : ndarray
+        One coefficient per regressor, the constant last. Coefficients of regressors that do
+        not vary over the samples are 0 (see :func:`constrained_lsq`).
+    rss : float
+        Residual sum of squares of the fit, in the target's units squared.
+    varies : ndarray of bool
+        Which regressors vary over the samples (and so were fitted).
+    """
+
+    coef: np.ndarray
+    rss: float
+    varies: np.ndarray
+
+
+def constrained_lsq(gram, *, blocks, scales, flat_tol=1e-6, ridge=1e-10) -> LsqSolution:
+    """Least squares from normal equations, every partial sum in each block above a bound.
+
+    Minimises ``|Phi theta - z|^2`` subject to ``theta[a] + ... + theta[i] >= bound`` for
+    every block ``(a, b, bound)`` and every ``a <= i < b``. The last regressor is the
+    constant (an unconstrained offset): it is eliminated exactly first (the Schur complement,
+    i.e. the columns are centred), which also removes the large column means that would
+    otherwise spoil the conditioning.
+
+    A regressor whose standard deviation over the samples is below ``flat_tol`` times its
+    ``scale`` carries no information beyond the constant: its coefficient is fixed at 0.
+    This happens for plays with ``r >= (v_max - v_min) / 2`` once the input has visited both
+    ends of its range: such a play can never move again, so only the sum of its weight and
+    the offset is identifiable. The remaining columns are scaled to unit norm and a relative
+    ``ridge`` keeps the quadratic form positive definite when two of them are nearly equal.
+
+    Parameters
+    ----------
+    gram : ndarray, shape (p + 1, p + 1)
+        From :func:`normal_equations`: regressors, constant last, then the target.
+    blocks : sequence of (int, int, float)
+        ``(first, stop, bound)``: partial sums of ``theta[first:stop]`` must be ``>= bound``.
+        The first regressor of a block with ``bound > 0`` must vary over the samples.
+    scales : array_like, shape (p - 1,)
+        Typical size of each non-constant regressor (its range), in its own units.
+    flat_tol : float
+        Relative standard deviation under which a regressor counts as constant.
+    ridge : float
+        Added to the diagonal of the unit-scaled normal matrix.
+
+    Returns
+    -------
+    LsqSolution
+
+    Raises
+    ------
+    IdentificationError
+        If the constrained problem has no solution (it always has one when the first
+        regressor of each block varies; the message says what to check otherwise).
+    """
+    p = gram.shape[0] - 1
+    G, g, zz = gram[:p, :p], gram[:p, p], gram[p, p]
+    count = G[-1, -1]
+    mean = G[-1, :-1] / count
+    z_mean = g[-1] / count
+    g_c = g[:-1] - count * mean * z_mean
+    G_c = G[:-1, :-1] - count * np.outer(mean, mean)
+    spread = np.sqrt(np.maximum(np.diag(G_c), 0.0) / count)
+    varies = spread > flat_tol * np.asarray(scales, dtype=np.float64)
+    blocks = [(a, b, bound) for a, b, bound in blocks if b > a]
+    for first, _, bound in blocks:
+        if bound > 0 and not varies[first]:
+            raise IdentificationError(
+                f"Regressor {first} does not vary over the samples used, so the weights "
+                "cannot be identified: the input must vary after the start-up transient."
+            )
+    idx = np.flatnonzero(varies)
+    scale = 1.0 / np.sqrt(np.diag(G_c)[idx])
+    quad = G_c[np.ix_(idx, idx)] * np.outer(scale, scale)
+    quad[np.diag_indices_from(quad)] += ridge
+    lin = g_c[idx] * scale
+    rows, bounds = [], []
+    for first, stop, bound in blocks:
+        for i in range(first, stop):
+            if varies[i]:  # partial sums at a fixed (zero) coefficient repeat the one before
+                rows.append(np.where((idx >= first) & (idx <= i), scale, 0.0))
+                bounds.append(bound)
+    cons = np.array(rows, dtype=np.float64).reshape(len(rows), idx.size)
+    try:
+        solution = quadprog.solve_qp(quad, lin, cons.T.copy(), np.array(bounds, dtype=float))[0]
+    except ValueError as exc:
+        raise IdentificationError(
+            f"The constrained least-squares problem could not be solved ({exc}). Check that "
+            "the record is one experiment (input and displacement of the same samples) and "
+            "try fewer operators."
+        ) from None
+    coef = np.zeros(p)
+    coef[idx] = solution * scale
+    coef[-1] = z_mean - mean @ coef[:-1]
+    rss = float(zz - 2.0 * g @ coef + coef @ G @ coef)
+    return LsqSolution(coef=coef, rss=max(rss, 0.0), varies=varies)

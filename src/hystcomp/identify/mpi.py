@@ -1,0 +1,142 @@
+"""Identification of the Modified Prandtl-Ishlinskii model (Section IV-A, eqs. 15-19).
+
+Eq. (19) compares the two sides of the MPI model in the middle: the plays of ``H`` driven by
+the input, and the *inverse* saturation operator ``S^-1`` driven by the measured
+displacement. Both are linear in their weights, so the joint problem ::
+
+    minimise  sum_k ( H[v](k) + b - S^-1[x - x_0](k) )^2   over  w_H, b, w'_S
+
+is a least-squares problem (solved by :mod:`hystcomp.identify.lsq`), subject to both
+invertibility constraints (every partial sum of ``w_H`` and of ``w'_S`` above a margin).
+
+Normalisation. The error is homogeneous: ``(w_H, b, w'_S) -> c (w_H, b, w'_S)`` scales it
+by ``c``, so without a normalisation the minimum is the useless ``0``. We fix
+``w'_S0 = 1``. This loses nothing: every feasible solution has ``w'_S0 > 0`` (the first
+partial sum), and the MPI map itself is unchanged by the rescaling (``S`` with weights
+``c w'`` and ``H`` with weights ``c w_H`` compose to the same ``S[H[v]]``: the forward
+dead-zones of eqs. 24-25 take inputs scaled by ``c``). With ``w'_S0 = 1`` the cost is in µm
+at the lower end of the range, where ``S^-1`` has slope 1.
+
+Offsets. ``x_0`` is the smallest measured displacement after the transient, so that eq. (17)'s
+thresholds ``r'_j = j/(m+1) max{x - x_0}`` (the paper's ``max{x_p}``) span the measured
+range. The constant ``b`` on the ``H`` side absorbs the rest of the offset; because the play
+is shift-equivariant, ``play_r(u + c; y_0 + c) = play_r(u; y_0) + c``, a constant ``b`` equals
+``H`` with its input offset lowered and its initial states raised by ``c = b / sum(w_H)``
+(:func:`absorb_bias`), so the identified model has the form of eq. (15) exactly.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from hystcomp._validation import check_int
+from hystcomp.identify.lsq import constrained_lsq, normal_equations
+from hystcomp.identify.pi import DEFAULT_MARGIN, check_margin, paper_thresholds, prepare_record
+
+
+@dataclass(frozen=True)
+class MPIFit:
+    """Parameters of an MPI model identified by :func:`fit_mpi` (eqs. 15, 19).
+
+    Attributes
+    ----------
+    thresholds, weights, initial_state : ndarray
+        The plays of ``H``: V (eq. 16), µm/V, V.
+    inverse_deadzone_thresholds : ndarray
+        ``r'_S`` of eq. (17), in µm of ``x - x_0``.
+    inverse_deadzone_weights : ndarray
+        ``w'_S``, unitless, with ``w'_S0 = 1``.
+    input_offset, output_offset : float
+        ``v_0`` in V (with the bias absorbed, see :func:`absorb_bias`) and ``x_0`` in µm.
+    first_sample : int
+        First sample of the record in the cost.
+    """
+
+    thresholds: np.ndarray
+    weights: np.ndarray
+    initial_state: np.ndarray
+    inverse_deadzone_thresholds: np.ndarray
+    inverse_deadzone_weights: np.ndarray
+    input_offset: float
+    output_offset: float
+    first_sample: int
+
+
+def absorb_bias(weights, initial_state, input_offset: float, bias: float):
+    """Fold a constant ``b`` added to a play superposition into its offset and states.
+
+    ``b + sum_i w_i play_{r_i}(v - v_0; y_0)`` equals ``sum_i w_i play_{r_i}(v - v_0'; y_0')``
+    with ``c = b / sum(w)``, ``v_0' = v_0 - c`` and ``y_0' = y_0 + c`` (shift equivariance of
+    eq. 11). Needs ``sum(w) != 0`` (guaranteed by the invertibility constraint).
+
+    Returns
+    -------
+    initial_state, input_offset
+        The new initial states (V) and input offset (V).
+
+    Examples
+    --------
+    >>> absorb_bias(np.array([0.5, 0.5]), np.zeros(2), 10.0, 2.0)
+    (array([2., 2.]), 8.0)
+    """
+    shift = bias / float(np.sum(weights))
+    return np.asarray(initial_state, dtype=np.float64) + shift, input_offset - shift
+
+
+def fit_mpi(
+    v, x, *, n_operators=16, n_deadzones=16, transient=None, margin=DEFAULT_MARGIN
+) -> MPIFit:
+    """Identify an MPI model (eq. 15) from a measured record, by eq. (19) with constraints.
+
+    Parameters
+    ----------
+    v, x : array_like
+        Input voltage (V) and measured displacement (µm), at any sample rate.
+    n_operators : int, default 16
+        Number of plays ``n + 1`` in ``H`` (the paper uses 16).
+    n_deadzones : int, default 16
+        Number of dead-zones ``m + 1`` in ``S`` (the paper uses 16).
+    transient : int or None, default None
+        Samples at the start left out of the cost; ``None``: until the input first reaches
+        an end of its range (:func:`~hystcomp.identify.scoring.transient_end`).
+    margin : float, default 1e-3
+        Relative lower bound on the partial sums: ``margin`` times the record's mean slope
+        (µm/V) for ``w_H``, ``margin`` for ``w'_S`` (relative to ``w'_S0 = 1``).
+
+    Returns
+    -------
+    MPIFit
+        With the *inverse* dead-zones; the forward ones follow from eqs. (24)-(25)
+        (``ModifiedPrandtlIshlinskii.forward_deadzones``).
+    """
+    owner = "fit_mpi"
+    n = check_int(n_operators, "n_operators", owner)
+    m = check_int(n_deadzones, "n_deadzones", owner)
+    margin = check_margin(margin, owner)
+    rec = prepare_record(v, x, n_weights=n + m, transient=transient, owner=owner)
+    r = paper_thresholds(n, rec.input_span)
+    y0 = np.full(n, rec.u[0])
+    x0 = float(rec.x[rec.start :].min())
+    z = rec.x - x0
+    z_span = float(z[rec.start :].max())
+    rs = paper_thresholds(m, z_span)  # eq. (17)
+    gram = normal_equations(rec.u, r, y0, z, rs[1:], rec.start)
+    sol = constrained_lsq(
+        gram,
+        blocks=[(0, n, margin * rec.slope), (n, n + m - 1, margin - 1.0)],
+        scales=np.r_[np.full(n, rec.input_span), np.full(m - 1, z_span)],
+    )
+    weights = sol.coef[:n]
+    initial_state, input_offset = absorb_bias(weights, y0, rec.input_offset, sol.coef[-1])
+    return MPIFit(
+        thresholds=r,
+        weights=weights,
+        initial_state=initial_state,
+        inverse_deadzone_thresholds=rs,
+        inverse_deadzone_weights=np.r_[1.0, sol.coef[n : n + m - 1]],
+        input_offset=input_offset,
+        output_offset=x0,
+        first_sample=rec.start,
+    )

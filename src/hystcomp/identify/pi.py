@@ -1,0 +1,182 @@
+"""Identification of the classical Prandtl-Ishlinskii model (Section IV-A, eqs. 12, 16, 18).
+
+The paper fixes the thresholds (eq. 16) and the initial states (eq. 18) and fits the weights
+by quadratic programming. We do the same, with three generalisations for real records:
+
+* the plays act on ``u = v - v_0`` with ``v_0 = min(v)``, so that eq. (16)'s thresholds
+  ``r_i = i/(n+1) max{u}`` span the input range from its lower end (bipolar inputs too);
+* the initial states are ``u[0]`` (relaxed at the first sample), which is eq. (18)'s zero for
+  a record that starts at ``v_min`` like the paper's;
+* a displacement offset ``x_0`` is fitted as an unconstrained constant, and a start-up
+  transient can be left out of the cost (:func:`~hystcomp.identify.scoring.transient_end`).
+
+The weights are constrained so that every partial sum ``w_0 + ... + w_i`` stays above a
+small margin: then the inverse of eqs. (24)-(26) exists.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from hystcomp._validation import as_signal, check_int, check_real
+from hystcomp.errors import IdentificationError, InvalidSignalError
+from hystcomp.identify.lsq import constrained_lsq, normal_equations
+from hystcomp.identify.scoring import check_transient
+
+DEFAULT_MARGIN = 1e-3
+
+
+def paper_thresholds(n_operators: int, span: float) -> np.ndarray:
+    """Eq. (16)/(17): ``r_i = i / (n+1) * span`` for ``i = 0..n`` (``n_operators = n + 1``).
+
+    Examples
+    --------
+    >>> paper_thresholds(4, 120.0).tolist()
+    [0.0, 30.0, 60.0, 90.0]
+    """
+    n_operators = check_int(n_operators, "n_operators", "paper_thresholds")
+    return np.arange(n_operators) / n_operators * float(span)
+
+
+@dataclass(frozen=True)
+class PreparedRecord:
+    """A validated identification record, with the play input and the fit's first sample."""
+
+    v: np.ndarray
+    x: np.ndarray
+    input_offset: float  # v_0 = min(v), V
+    u: np.ndarray  # v - v_0, V
+    start: int  # first sample in the cost
+    input_span: float  # max(u), V
+    slope: float  # displacement range / input span over the fit samples, µm/V
+
+
+def prepare_record(v, x, *, n_weights: int, transient, owner: str) -> PreparedRecord:
+    """Validate ``(v, x)`` for identification and find the samples the fit uses."""
+    v = as_signal(v, "v", min_samples=2)
+    x = as_signal(x, "x", min_samples=2)
+    if v.size != x.size:
+        raise InvalidSignalError(
+            f"{owner}: 'v' and 'x' must have one sample each per instant. Got {v.size} "
+            f"voltage samples and {x.size} displacement samples."
+        )
+    v0 = float(v.min())
+    u = v - v0
+    span = float(u.max())
+    if span <= 0.0:
+        raise IdentificationError(
+            f"{owner}: the input 'v' is constant ({v0!r} V), so it shows no hysteresis to "
+            "identify. Record the response to an input that sweeps the actuator's range, "
+            "such as 'hystcomp excite pi'."
+        )
+    start = check_transient(transient, v, owner, min_used=2 * n_weights)
+    x_span = float(np.ptp(x[start:]))
+    if x_span <= 0.0:
+        raise IdentificationError(
+            f"{owner}: the displacement 'x' is constant after sample {start}; the sensor "
+            "recorded no motion. Check the displacement column."
+        )
+    if np.ptp(u[start:]) <= 0.0:
+        raise IdentificationError(
+            f"{owner}: the input 'v' is constant after the start-up transient (sample "
+            f"{start} on). Set a shorter transient."
+        )
+    return PreparedRecord(v, x, v0, u, start, span, x_span / span)
+
+
+def check_margin(margin, owner: str) -> float:
+    """The relative invertibility margin, a number in (0, 1)."""
+    margin = check_real(margin, "margin", owner, positive=True)
+    if margin >= 1.0:
+        raise IdentificationError(
+            f"The 'margin' parameter of {owner} must be below 1 (a small fraction such as "
+            f"{DEFAULT_MARGIN}). Got {margin!r} instead."
+        )
+    return margin
+
+
+@dataclass(frozen=True)
+class PIFit:
+    """Parameters of a PI model identified by :func:`fit_pi` (eq. 12).
+
+    Attributes
+    ----------
+    thresholds : ndarray
+        ``r_i`` in V (eq. 16).
+    weights : ndarray
+        ``w_i`` in µm/V; every partial sum is at least the margin.
+    initial_state : ndarray
+        Initial play states in V (``v[0] - v_0``).
+    input_offset : float
+        ``v_0 = min(v)`` in V.
+    output_offset : float
+        ``x_0`` in µm.
+    first_sample : int
+        First sample of the record in the cost (after the start-up transient).
+    """
+
+    thresholds: np.ndarray
+    weights: np.ndarray
+    initial_state: np.ndarray
+    input_offset: float
+    output_offset: float
+    first_sample: int
+
+
+def fit_pi(v, x, *, n_operators=16, transient=None, margin=DEFAULT_MARGIN) -> PIFit:
+    """Identify a classical PI model (eq. 12) from a measured record by constrained least squares.
+
+    Minimises ``sum_k (x_0 + sum_i w_i play_{r_i}(v - v_0)[k] - x[k])^2`` over the samples
+    after the start-up transient, subject to ``w_0 + ... + w_i >= margin * X / U`` for every
+    ``i`` (``X``: measured displacement range, ``U``: input span; so the smallest allowed
+    slope is ``margin`` times the mean slope of the record).
+
+    Parameters
+    ----------
+    v, x : array_like
+        Input voltage (V) and measured displacement (µm), one sample each per instant,
+        at any sample rate (the model is rate-independent).
+    n_operators : int, default 16
+        Number of plays ``n + 1`` (the paper uses 16).
+    transient : int or None, default None
+        Number of samples at the start left out of the cost (the model still runs over
+        them). ``None``: until the input first reaches an end of its range
+        (:func:`~hystcomp.identify.scoring.transient_end`).
+    margin : float, default 1e-3
+        Relative lower bound on the partial sums of the weights (invertibility).
+
+    Returns
+    -------
+    PIFit
+
+    Examples
+    --------
+    >>> v = np.concatenate([np.linspace(0, 10, 21), np.linspace(10, 0, 21)[1:]])
+    >>> x = 0.5 * v + 2.0
+    >>> fit = fit_pi(v, x, n_operators=2)
+    >>> fit.weights.round(6).tolist(), round(fit.output_offset, 6)
+    ([0.5, 0.0], 2.0)
+    """
+    owner = "fit_pi"
+    n = check_int(n_operators, "n_operators", owner)
+    margin = check_margin(margin, owner)
+    rec = prepare_record(v, x, n_weights=n + 1, transient=transient, owner=owner)
+    r = paper_thresholds(n, rec.input_span)
+    y0 = np.full(n, rec.u[0])
+    x_ref = float(rec.x[rec.start :].min())
+    gram = normal_equations(rec.u, r, y0, rec.x - x_ref, np.empty(0), rec.start)
+    sol = constrained_lsq(
+        gram,
+        blocks=[(0, n, margin * rec.slope)],
+        scales=np.full(n, rec.input_span),
+    )
+    return PIFit(
+        thresholds=r,
+        weights=sol.coef[:n],
+        initial_state=y0,
+        input_offset=rec.input_offset,
+        output_offset=x_ref + float(sol.coef[n]),
+        first_sample=rec.start,
+    )

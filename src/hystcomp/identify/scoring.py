@@ -1,0 +1,144 @@
+"""How well a fitted model describes a record: start-up transient, errors, hold-out test.
+
+Functions here work on arrays and on any object with ``simulate(v)``; they never import
+the model classes (the models import the identification layer, not the reverse).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from hystcomp._validation import as_signal, check_int
+from hystcomp.errors import IdentificationError
+
+#: How close (as a fraction of the input span) the input must come to an end of its range.
+END_TOLERANCE = 0.01
+
+
+def transient_end(v) -> int:
+    """Default start of the fit: the first sample at which the input reaches an end of its range.
+
+    A record may start anywhere, from a rest state the model does not know: the stage was
+    switched on, the command jumped to ``v[0]``, the sensor and the creep are settling
+    (the real record of the data folder starts mid-range, with the displacement 4 µm below
+    the loop). Reaching ``min(v)`` or ``max(v)`` (within 1 % of the span) ends that phase:
+    by then the plays with ``r <= |v_end - v[0]| / 2`` have forgotten their initial state
+    (wipe-out), the fast part of the transient is over, and from there on the record is
+    the periodic hysteresis loop the model describes. A record that starts at an end of its
+    range, like the paper's identification signal (eq. 18: relaxed at ``v_min``), loses no
+    sample.
+
+    Parameters
+    ----------
+    v : array_like
+        Input voltage in V.
+
+    Returns
+    -------
+    int
+        Index of the first sample to use.
+
+    Examples
+    --------
+    >>> transient_end([0.0, 1.0, 2.0, 1.0, 0.0])
+    0
+    >>> transient_end([1.0, 1.5, 2.0, 1.0, 0.0])
+    2
+    """
+    v = as_signal(v, "v", min_samples=1)
+    lo, hi = v.min(), v.max()
+    tol = END_TOLERANCE * (hi - lo)
+    return int(np.flatnonzero((v <= lo + tol) | (v >= hi - tol))[0])
+
+
+def check_transient(transient, v: np.ndarray, owner: str, *, min_used: int) -> int:
+    """The first sample of the fit: ``transient`` validated, or :func:`transient_end`."""
+    start = (
+        transient_end(v)
+        if transient is None
+        else check_int(transient, "transient", owner, minimum=0)
+    )
+    if v.size - start < min_used:
+        raise IdentificationError(
+            f"{owner}: only {v.size - start} of {v.size} samples remain after the start-up "
+            f"transient (first sample used: {start}), fewer than the {min_used} needed. "
+            "Record longer, use fewer operators, or set a shorter transient."
+        )
+    return start
+
+
+def error_report(x, x_model, start: int = 0) -> dict:
+    """Errors of a model output against the measured displacement over samples ``start..``.
+
+    Parameters
+    ----------
+    x, x_model : ndarray
+        Measured and modelled displacement in µm.
+    start : int
+        First sample scored.
+
+    Returns
+    -------
+    dict
+        ``rms_error_um``, ``max_error_um``, the same in percent of the measured displacement
+        range (``rms_error_percent``, ``max_error_percent``), ``displacement_range_um``,
+        ``n_samples`` (the record), ``n_used`` and ``first_used_sample``.
+    """
+    x = np.asarray(x, dtype=np.float64)[start:]
+    err = np.asarray(x_model, dtype=np.float64)[start:] - x
+    span = float(np.ptp(x))
+    rms = float(np.sqrt(np.mean(err**2)))
+    worst = float(np.abs(err).max())
+    return {
+        "rms_error_um": rms,
+        "max_error_um": worst,
+        "rms_error_percent": 100.0 * rms / span if span > 0 else float("nan"),
+        "max_error_percent": 100.0 * worst / span if span > 0 else float("nan"),
+        "displacement_range_um": span,
+        "n_samples": int(x.size + start),
+        "n_used": int(x.size),
+        "first_used_sample": int(start),
+    }
+
+
+def straight_line(v, x) -> tuple[float, float]:
+    """Least-squares line ``x = a v + b`` (a in µm/V, b in µm): the no-hysteresis baseline.
+
+    Examples
+    --------
+    >>> a, b = straight_line([0.0, 1.0, 2.0], [1.0, 3.0, 5.0])
+    >>> round(a, 9), round(b, 9)
+    (2.0, 1.0)
+    """
+    v = np.asarray(v, dtype=np.float64)
+    design = np.column_stack([v, np.ones_like(v)])
+    (a, b), *_ = np.linalg.lstsq(design, np.asarray(x, dtype=np.float64), rcond=None)
+    return float(a), float(b)
+
+
+def holdout_report(model, v, x, n_fit: int, start: int = 0) -> dict:
+    """Score a model fitted on ``v[:n_fit]`` on the rest of the record, against a line.
+
+    The model is run over the whole record (so that its state is right when the held-out
+    part begins) and scored on ``n_fit..`` only. The baseline is the straight line
+    :func:`straight_line` fitted on the same samples as the model (``start..n_fit``).
+
+    Returns
+    -------
+    dict
+        ``n_holdout``, ``model_rms_um``, ``line_rms_um`` and ``improvement`` (their ratio,
+        > 1 when the model predicts better than the line).
+    """
+    v = np.asarray(v, dtype=np.float64)
+    x = np.asarray(x, dtype=np.float64)
+    model_err = model.simulate(v)[n_fit:] - x[n_fit:]
+    a, b = straight_line(v[start:n_fit], x[start:n_fit])
+    line_err = a * v[n_fit:] + b - x[n_fit:]
+    model_rms = float(np.sqrt(np.mean(model_err**2)))
+    line_rms = float(np.sqrt(np.mean(line_err**2)))
+    return {
+        "n_holdout": int(v.size - n_fit),
+        "model_rms_um": model_rms,
+        "line_rms_um": line_rms,
+        "improvement": line_rms / model_rms if model_rms > 0 else float("inf"),
+    }
