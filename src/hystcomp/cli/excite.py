@@ -1,0 +1,69 @@
+"""``hystcomp excite``: the paper's identification signals (t, v)."""
+
+from __future__ import annotations
+
+import click
+
+from hystcomp.cli import main
+from hystcomp.cli._options import output_option
+from hystcomp.data import format_csv, write_table
+from hystcomp.identify.excitation import (
+    DEFAULT_SAMPLE_RATE,
+    PI_AMPLITUDES,
+    PREISACH_AMPLITUDES,
+    scaled_amplitudes,
+    sinusoid_sequence,
+    triangle_sequence,
+)
+
+#: Signal shape and paper amplitudes (on 0..120 V) for each model kind.
+SIGNALS = {
+    "pi": (triangle_sequence, PI_AMPLITUDES),
+    "mpi": (triangle_sequence, PI_AMPLITUDES),
+    "preisach": (sinusoid_sequence, PREISACH_AMPLITUDES),
+}
+
+
+@main.command("excite")
+@click.argument("model", type=click.Choice(sorted(SIGNALS)))
+@output_option(required=False, what="signal; CSV on standard output if omitted")
+@click.option(
+    "--fs",
+    "sample_rate",
+    type=float,
+    default=DEFAULT_SAMPLE_RATE,
+    show_default=True,
+    metavar="HZ",
+    help="Sample rate in Hz.",
+)
+@click.option(
+    "--voltage-range",
+    nargs=2,
+    type=float,
+    default=(0.0, 120.0),
+    show_default=True,
+    metavar="LO HI",
+    help="Amplifier range in V; the paper's amplitudes are scaled from 0..120 V to it.",
+)
+@click.option(
+    "--frequency", type=float, default=1.0, show_default=True, metavar="HZ", help="Period rate."
+)
+def excite(model, output, sample_rate, voltage_range, frequency):
+    """Write the identification input for MODEL (pi, mpi or preisach).
+
+    pi, mpi: triangles of 30, 60, 90, 120 V at 1 Hz (Section IV-A); preisach: sinusoids of
+    5, 10, ..., 120 V at 1 Hz (Section III-A). Each starts and ends at the lower end of the
+    range. Columns: t (s), v (V).
+    """
+    shape, amplitudes = SIGNALS[model]
+    t, v = shape(
+        scaled_amplitudes(amplitudes, voltage_range=voltage_range),
+        frequency=frequency,
+        sample_rate=sample_rate,
+        v_min=voltage_range[0],
+    )
+    if output is None:
+        click.echo(format_csv({"t": t, "v": v}), nl=False)
+    else:
+        write_table(output, {"t": t, "v": v})
+        click.echo(f"wrote {output}: {t.size} samples at {sample_rate:g} Hz ({t[-1]:g} s)")

@@ -1,0 +1,164 @@
+"""``hystcomp identify``: a model from a measured record, with an optional hold-out test."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import click
+import numpy as np
+
+from hystcomp.cli import main
+from hystcomp.cli._options import columns_option, fs_option, read_options
+from hystcomp.data import read_record
+from hystcomp.errors import IdentificationError
+from hystcomp.experiment.fig_identification import FORMATS, plot_identification
+from hystcomp.identify.scoring import error_report, holdout_report, straight_line, transient_end
+from hystcomp.io import MODEL_KINDS, save_model
+
+DEFAULT_OPERATORS = 16
+
+#: What each --model builds, and which size options it takes.
+LABELS = {"pi": "PI", "mpi": "MPI", "preisach": "Preisach"}
+SIZE_OPTIONS = {"pi": ("operators",), "mpi": ("operators", "deadzones"), "preisach": ()}
+
+
+def build_estimator(kind: str, *, operators, deadzones, voltage_range):
+    """An unfitted model of ``kind`` from the registry :data:`hystcomp.io.MODEL_KINDS`."""
+    cls = MODEL_KINDS.get(kind)
+    if cls is None:
+        raise IdentificationError(
+            f"The {LABELS[kind]} model is not available in this version of hystcomp; "
+            f"choose --model {' or '.join(k for k in LABELS if k in MODEL_KINDS)}."
+        )
+    given = {"operators": operators, "deadzones": deadzones}
+    for name, value in given.items():
+        if value is not None and name not in SIZE_OPTIONS[kind]:
+            raise click.UsageError(f"--{name} does not apply to --model {kind}.")
+    params = {"voltage_range": voltage_range}
+    if "operators" in SIZE_OPTIONS[kind]:
+        params["n_operators"] = DEFAULT_OPERATORS if operators is None else operators
+    if "deadzones" in SIZE_OPTIONS[kind]:
+        params["n_deadzones"] = DEFAULT_OPERATORS if deadzones is None else deadzones
+    return cls(**params)
+
+
+def _sizes(model) -> str:
+    parts = []
+    if hasattr(model, "n_operators"):
+        parts.append(f"{model.n_operators} plays")
+    if hasattr(model, "n_deadzones"):
+        parts.append(f"{model.n_deadzones} dead-zones")
+    return f" ({', '.join(parts)})" if parts else ""
+
+
+@main.command("identify")
+@click.argument("data", metavar="DATA")
+@click.option(
+    "--model", "kind", type=click.Choice(list(LABELS)), required=True, help="Model family."
+)
+@click.option("--operators", type=int, default=None, help="Number of plays n+1 [16].")
+@click.option("--deadzones", type=int, default=None, help="Number of dead-zones m+1, mpi [16].")
+@columns_option
+@fs_option
+@click.option(
+    "--transient",
+    type=float,
+    default=None,
+    metavar="SECONDS",
+    help="Start of the record left out of the fit [until the input first reaches an end "
+    "of its range].",
+)
+@click.option(
+    "--voltage-range",
+    nargs=2,
+    type=float,
+    default=None,
+    metavar="LO HI",
+    help="Amplifier range in V, the compensator's clamp [the record's range].",
+)
+@click.option(
+    "--holdout",
+    type=float,
+    default=None,
+    metavar="FRACTION",
+    help="Fit on the first part only and report how well the model predicts this last "
+    "fraction of the record, against a straight line.",
+)
+@click.option("--plot", default=None, metavar="FILE", help="Fig. 8-style figure (.png/.pdf/.svg).")
+@click.option("-o", "--output", required=True, metavar="MODEL.json", help="Model file to write.")
+def identify(
+    data,
+    kind,
+    operators,
+    deadzones,
+    columns,
+    sample_rate,
+    transient,
+    voltage_range,
+    holdout,
+    plot,
+    output,
+):
+    """Identify a hysteresis model from DATA (columns t, v, x) and write it as JSON.
+
+    PI and MPI: constrained least squares (eqs. 16-19) with invertible weights; the
+    start-up transient, the input range (bipolar too) and a displacement offset are handled.
+    """
+    if holdout is not None and not 0.0 < holdout < 1.0:
+        raise click.BadParameter(f"must be between 0 and 1; got {holdout}.", param_hint="--holdout")
+    if transient is not None and not transient >= 0.0:
+        raise click.BadParameter(f"must be >= 0 s; got {transient}.", param_hint="--transient")
+    if plot is not None and Path(plot).suffix.lower() not in FORMATS:
+        raise click.BadParameter(f"must end in {', '.join(FORMATS)}.", param_hint="--plot")
+    model = build_estimator(
+        kind, operators=operators, deadzones=deadzones, voltage_range=voltage_range
+    )
+    rec = read_record(data, **read_options(columns, sample_rate))
+    n = len(rec)
+    n_fit = n if holdout is None else n - round(holdout * n)
+    if holdout is not None and not 2 <= n_fit < n:
+        raise IdentificationError(
+            f"--holdout {holdout} leaves {n_fit} of {n} samples to fit on; choose a fraction "
+            "that keeps samples on both sides."
+        )
+    v, x = rec.v[:n_fit], rec.x[:n_fit]
+    if transient is None:
+        start = transient_end(v)
+    else:
+        start = int(np.searchsorted(rec.t - rec.t[0], transient, side="left"))
+    if "transient" in model.get_params():
+        if transient is not None:
+            model.transient = start
+        model.fit(v, x)
+    else:  # a model without its own transient option is fitted on the settled part only
+        model.fit(v[start:], x[start:])
+    x_model = model.simulate(v)
+    report = error_report(x, x_model, start)
+
+    label = LABELS[kind]
+    click.echo(f"{label} model{_sizes(model)} from {rec.source}")
+    click.echo(
+        f"  record:    {n} samples at {rec.sample_rate:.6g} Hz ({rec.t[-1] - rec.t[0]:.4g} s), "
+        f"v {rec.v.min():.4g} .. {rec.v.max():.4g} V, x {rec.x.min():.4g} .. {rec.x.max():.4g} µm"
+    )
+    skipped = f" (first {start} left out: start-up transient)" if start else ""
+    click.echo(f"  fitted on: samples {start + 1}..{n_fit}{skipped}")
+    click.echo(
+        f"  fit error: rms {report['rms_error_um']:.4g} µm "
+        f"({report['rms_error_percent']:.3g} % of {report['displacement_range_um']:.4g} µm), "
+        f"max {report['max_error_um']:.4g} µm ({report['max_error_percent']:.3g} %)"
+    )
+    if holdout is not None:
+        held = holdout_report(model, rec.v, rec.x, n_fit, start)
+        click.echo(
+            f"  hold-out:  last {held['n_holdout']} samples ({100 * holdout:g} %): model rms "
+            f"{held['model_rms_um']:.4g} µm, straight line rms {held['line_rms_um']:.4g} µm: "
+            f"{held['improvement']:.3g}x better"
+        )
+    if plot is not None:
+        a, b = straight_line(v[start:], x[start:])
+        line = a * v[start:] + b
+        plot_identification(v[start:], x[start:], line, x_model[start:], plot, model_name=label)
+        click.echo(f"  wrote {plot}")
+    save_model(model, output)
+    click.echo(f"  wrote {output}")

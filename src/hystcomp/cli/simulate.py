@@ -1,0 +1,36 @@
+"""``hystcomp simulate``: a model's displacement for a voltage input."""
+
+from __future__ import annotations
+
+import click
+
+from hystcomp.cli import main
+from hystcomp.cli._options import columns_option, fs_option, output_option, read_options
+from hystcomp.data import read_table, write_table
+from hystcomp.io import load_model
+
+
+@main.command("simulate")
+@click.argument("model_file", metavar="MODEL.json")
+@click.argument("input_file", metavar="INPUT")
+@output_option(what="result: t, v, x")
+@columns_option
+@fs_option
+def simulate(model_file, input_file, output, columns, sample_rate):
+    """Run the model in MODEL.json on the voltage in INPUT (columns t, v).
+
+    Writes t (s), v (V) and the modelled displacement x (µm).
+    """
+    model = load_model(model_file)
+    table = read_table(input_file, ("v",), **read_options(columns, sample_rate))
+    v = table["v"]
+    lo, hi = getattr(model, "voltage_range_", (-float("inf"), float("inf")))
+    if v.min() < lo or v.max() > hi:
+        click.echo(
+            f"hystcomp: warning: the input ({v.min():.4g} .. {v.max():.4g} V) leaves the "
+            f"model's voltage range ({lo:.4g} .. {hi:.4g} V); the model extrapolates there.",
+            err=True,
+        )
+    x = model.simulate(v)
+    write_table(output, {"t": table["t"], "v": v, "x": x})
+    click.echo(f"wrote {output}: {x.size} samples, x from {x.min():.4g} to {x.max():.4g} µm")
