@@ -49,3 +49,22 @@ def invert_monotone(f, y, lo, hi, iters=200):
         else:
             hi = mid
     return 0.5 * (lo + hi)
+
+
+def partial_sum_lsq(design, target, blocks):
+    """Least squares with every partial sum of each block ``(first, stop, bound)`` >= bound.
+
+    Written with scipy's bounded solver on the partial sums themselves (w = diff of s), not
+    with the normal equations: an independent route to the same optimum.
+    """
+    from scipy.optimize import lsq_linear
+
+    p = design.shape[1]
+    to_weights = np.eye(p)
+    lower = np.full(p, -np.inf)
+    for first, stop, bound in blocks:
+        for i in range(first + 1, stop):
+            to_weights[i, i - 1] = -1.0
+        lower[first:stop] = bound
+    result = lsq_linear(design @ to_weights, target, bounds=(lower, np.inf), method="bvls")
+    return to_weights @ result.x

@@ -226,22 +226,22 @@ def _pick(path: Path, names, arrays, positional, key: str, spec, required: bool)
 
 
 def _as_column(arr, path: Path, key: str, label: str) -> np.ndarray:
+    what = f"The {label} of {str(path)!r} ({key!r}, {MEANINGS[key]})"
     try:
         out = np.asarray(arr, dtype=np.float64)
     except (TypeError, ValueError):
-        raise DataFileError(f"{label} of {str(path)!r} ({key!r}) does not hold numbers.") from None
+        raise DataFileError(f"{what} does not hold numbers.") from None
     if out.ndim > 1 and sorted(out.shape)[-2] == 1:
         out = out.reshape(-1)
     if out.ndim != 1:
         raise DataFileError(
-            f"{label} of {str(path)!r} ({key!r}) has shape {out.shape}; expected one "
-            "value per sample (a vector)."
+            f"{what} has shape {out.shape}; expected one value per sample (a vector)."
         )
     bad = np.flatnonzero(~np.isfinite(out))
     if bad.size:
         raise DataFileError(
-            f"{label} of {str(path)!r} ({key!r}, {MEANINGS[key]}) has a non-finite value "
-            f"({out[bad[0]]!r}) in data row {bad[0] + 1}: remove or interpolate that row."
+            f"{what} has a non-finite value ({float(out[bad[0]])!r}) in data row "
+            f"{bad[0] + 1}: remove or interpolate that row."
         )
     return out
 
@@ -316,8 +316,9 @@ def _time(path: Path, t, n: int, sample_rate):
         k = int(bad[0]) + 1
         raise DataFileError(
             f"The time column 't' of {str(path)!r} is not strictly increasing: data row "
-            f"{k + 1} has t = {t[k]!r} s after t = {t[k - 1]!r} s. Sort the rows and remove "
-            "duplicates, or drop the time column and give the sample rate (--fs)."
+            f"{k + 1} has t = {float(t[k])!r} s after t = {float(t[k - 1])!r} s. Sort the "
+            "rows and remove duplicates, or drop the time column and give the sample rate "
+            "(--fs)."
         )
     if sample_rate is not None:
         rate = rate_of(t)
@@ -342,7 +343,7 @@ def read_record(path, *, columns=None, sample_rate=None) -> Record:
     v = table["v"]
     if np.ptp(v) <= 0:
         raise DataFileError(
-            f"The voltage column 'v' of {str(path)!r} is constant ({v[0]!r} V): an "
+            f"The voltage column 'v' of {str(path)!r} is constant ({float(v[0])!r} V): an "
             "identification record needs an input that sweeps the actuator's range "
             "(see 'hystcomp excite'). Check that the right column is named."
         )
@@ -375,6 +376,11 @@ def write_table(path, table: dict) -> None:
             f"Use a name ending in {', '.join(WRITABLE)}."
         )
     cols = {k: np.asarray(v, dtype=np.float64).reshape(-1) for k, v in table.items()}
+    lengths = {k: v.size for k, v in cols.items()}
+    if len(set(lengths.values())) != 1:
+        raise DataFileError(
+            f"Cannot write {str(path)!r}: the columns have different lengths ({lengths})."
+        )
     with atomic_path(path) as tmp:
         if suffix == ".csv":
             tmp.write_text(format_csv(cols), encoding="utf-8")

@@ -1,0 +1,94 @@
+"""The least-squares machinery of identification against slow, independent references."""
+
+import numpy as np
+import pytest
+
+from hystcomp import operators, presets
+from hystcomp.identify.excitation import triangle_sequence
+from hystcomp.identify.lsq import constrained_lsq, normal_equations
+from hystcomp.identify.pi import paper_thresholds
+from tests import naive
+from tests.conftest import random_walk
+
+
+def _design(u, r, y0, z, rs_tail):
+    """The regressors of identify.lsq written out with the naive operators."""
+    plays = [naive.play(u, ri, yi) for ri, yi in zip(r, y0, strict=True)]
+    deadzones = [-naive.deadzone(z, rj) for rj in rs_tail]
+    return np.column_stack([*plays, *deadzones, np.ones_like(u)])
+
+
+def test_deadzone_values_match_naive(rng):
+    r = np.array([0.0, 0.5, 2.0, 7.0])
+    out = np.empty(r.size)
+    for z in rng.uniform(-5, 12, 100):
+        operators.deadzone_values(z, r, out)
+        expected = [naive.deadzone(np.array([z]), rj)[0] for rj in r]
+        np.testing.assert_allclose(out, expected, rtol=0, atol=1e-15)
+
+
+def test_normal_equations_equal_the_explicit_design(rng):
+    # more samples than one block of the kernel, and a transient left out
+    u = random_walk(rng, 2500, 0.0, 10.0, 0.8)
+    z = 3.0 * u + rng.normal(size=u.size)
+    r, y0 = np.array([0.0, 1.0, 2.5, 6.0]), np.array([0.0, 0.5, 2.0, 5.0])
+    rs = np.array([4.0, 15.0])
+    start = 37
+    gram = normal_equations(u, r, y0, z, rs, start)
+    full = np.column_stack([_design(u, r, y0, z, rs), z])[start:]
+    np.testing.assert_allclose(gram, full.T @ full, rtol=1e-11, atol=1e-6)
+
+
+def test_constrained_lsq_matches_a_bounded_solver_when_constraints_bind(rng):
+    # a "true" superposition whose partial sums go negative: the unconstrained optimum is
+    # not invertible, so the constraint must bind and both routes must agree
+    u = triangle_sequence([4.0, 8.0, 12.0], sample_rate=300.0)[1]
+    r = paper_thresholds(5, 12.0)
+    y0 = np.zeros(5)
+    truth = np.array([1.0, -1.3, 0.6, 0.1, -0.2])
+    x = naive.pi_model(u, r, truth) + 2.0 + 0.01 * rng.standard_normal(u.size)
+    bound = 0.05
+    sol = constrained_lsq(
+        normal_equations(u, r, y0, x, np.empty(0), 0),
+        blocks=[(0, 5, bound)],
+        scales=np.full(5, 12.0),
+    )
+    expected = naive.partial_sum_lsq(_design(u, r, y0, x, []), x, [(0, 5, bound)])
+    assert np.cumsum(sol.coef[:5]).min() >= bound - 1e-9
+    assert np.cumsum(sol.coef[:5]).min() == pytest.approx(bound, abs=1e-9)  # it binds
+    np.testing.assert_allclose(sol.coef, expected, rtol=1e-6, atol=1e-7)
+
+
+def test_mpi_problem_matches_a_bounded_solver():
+    # eq. (19) on the paper's MPI with a small margin: same optimum by both routes
+    _, v = triangle_sequence(sample_rate=200.0)
+    model = presets.paper_mpi()
+    z = model.simulate(v)
+    r = paper_thresholds(16, 120.0)
+    rs = paper_thresholds(6, z.max())
+    blocks = [(0, 16, 0.02), (16, 21, -0.5)]
+    sol = constrained_lsq(
+        normal_equations(v, r, np.zeros(16), z, rs[1:], 0),
+        blocks=blocks,
+        scales=np.r_[np.full(16, 120.0), np.full(5, z.max())],
+    )
+    design = _design(v, r, np.zeros(16), z, rs[1:])
+    expected = naive.partial_sum_lsq(design, z, blocks)
+    np.testing.assert_allclose(design @ sol.coef, design @ expected, atol=1e-6)
+    assert sol.rss == pytest.approx(np.sum((design @ expected - z) ** 2), rel=1e-6)
+
+
+def test_regressors_that_never_move_are_fixed_at_zero():
+    # plays with r >= span/2 cannot move once both ends are reached: only the offset is seen
+    u = 1.8 + 1.8 * np.sin(np.linspace(0, 12 * np.pi, 1200))
+    r = paper_thresholds(8, 3.6)
+    x = naive.pi_model(u - u.min(), r[:4], [2.0, 1.0, 0.5, 0.3]) - 100.0
+    start = int(np.argmax(u))
+    sol = constrained_lsq(
+        normal_equations(u - u.min(), r, np.full(8, u[0]), x + 100.0, np.empty(0), start),
+        blocks=[(0, 8, 1e-3)],
+        scales=np.full(8, 3.6),
+    )
+    assert sol.varies.tolist() == [True] * 4 + [False] * 4
+    np.testing.assert_array_equal(sol.coef[4:8], 0.0)
+    np.testing.assert_allclose(sol.coef[:4], [2.0, 1.0, 0.5, 0.3], atol=1e-8)
