@@ -189,6 +189,10 @@ def test_fit_returns_self_and_keeps_hyperparameters():
     assert est.deadzone_thresholds_.size == 4
     assert est.voltage_range_ == (0.0, 120.0)
     assert set(est.fit_report_) >= {"rms_error_um", "max_error_percent", "n_used"}
+    # a given voltage range is the compensator's clamp, whatever the data
+    clamped = hystcomp.PrandtlIshlinskii(voltage_range=(-10.0, 100.0)).fit(v, 0.3 * v)
+    assert clamped.voltage_range_ == (-10.0, 100.0)
+    assert clamped.inverse().simulate([1e6]).item() == 100.0
 
 
 def test_fit_is_fast_enough_for_the_paper_signal_only_by_benchmark():

@@ -13,6 +13,7 @@ True
 """
 
 from hystcomp import errors, presets
+from hystcomp.data import Record, read_record
 from hystcomp.io import load_model, save_model
 from hystcomp.models.compensator import Compensator, Stepper
 from hystcomp.models.mpi import ModifiedPrandtlIshlinskii
@@ -24,10 +25,12 @@ __all__ = [
     "Compensator",
     "ModifiedPrandtlIshlinskii",
     "PrandtlIshlinskii",
+    "Record",
     "Stepper",
     "__version__",
     "errors",
     "load_model",
     "presets",
+    "read_record",
     "save_model",
 ]

@@ -30,12 +30,12 @@ import quadprog
 from hystcomp import operators
 from hystcomp.errors import IdentificationError
 
-_BLOCK = 1024  # rows per BLAS update of the Gram matrix
+_BLOCK = 256  # rows per BLAS update of the Gram matrix (larger blocks gain nothing)
 
 
 @numba.njit(cache=True, nogil=True)
 def _accumulate_gram(u, r, y0, z, rs, start, gram):
-    """Add ``[Phi | z]^T [Phi | z]`` over samples ``start..`` to ``gram`` (layout above).
+    """Add ``[Phi | z]^T [Phi | z]`` over samples ``start..`` to ``gram``, dead-zones positive.
 
     The plays run over every sample from ``y0`` (their state must be right at ``start``);
     only samples ``k >= start`` enter the sums.
@@ -52,8 +52,7 @@ def _accumulate_gram(u, r, y0, z, rs, start, gram):
             continue
         row = rows[fill]
         row[:n] = y
-        operators.deadzone_values(z[k], rs, row[n : n + m])
-        row[n : n + m] *= -1.0
+        operators.deadzone_values(z[k], rs, row[n : n + m])  # negated after the sums
         row[n + m] = 1.0
         row[n + m + 1] = z[k]
         fill += 1
@@ -98,7 +97,8 @@ def normal_equations(u, thresholds, initial_state, z, deadzone_thresholds, start
         int(start),
         gram,
     )
-    return gram
+    sign = np.r_[np.ones(n), -np.ones(m), 1.0, 1.0]  # the dead-zone regressors are negated
+    return gram * np.outer(sign, sign)
 
 
 @dataclass(frozen=True)

@@ -1,0 +1,98 @@
+"""Speed of identification: MPI 16+16 and PI 16 on the paper's 80,001-sample signal.
+
+Target: identifying MPI (16 plays, 16 dead-zones) on 80,000 samples in under 50 ms once
+compiled. The reference in the same run is NumPy's least squares on the same regressors
+(the design matrix already built, no constraints): the constrained fit, which also builds
+its regressors and scores the model, should not be slower than that alone.
+
+Run alone with ``python benchmarks/bench_identify.py``.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from hystcomp import ModifiedPrandtlIshlinskii, PrandtlIshlinskii, operators, presets
+from hystcomp.identify.excitation import triangle_sequence
+from hystcomp.identify.pi import paper_thresholds
+
+TARGET_MS = 50.0
+REPEATS = 7
+
+
+def _best_ms(func) -> float:
+    func()  # compile / warm caches
+    times = []
+    for _ in range(REPEATS):
+        start = time.perf_counter()
+        func()
+        times.append(time.perf_counter() - start)
+    return 1e3 * min(times)
+
+
+def _design(v, x, n_operators, n_deadzones):
+    """The MPI regressors of eq. (19) as a dense matrix, for the reference solver."""
+    plays = np.empty((v.size, n_operators))
+    r = paper_thresholds(n_operators, np.ptp(v))
+    operators.play_outputs(v - v.min(), r, np.zeros(n_operators), plays)
+    z = x - x.min()
+    rs = paper_thresholds(n_deadzones, z.max())[1:]
+    deadzones = np.maximum(z[:, None] - rs[None, :], 0.0)
+    return np.column_stack([plays, -deadzones, np.ones_like(v)]), z
+
+
+def run() -> list[dict]:
+    """Measure and return one row per figure: name, value, unit, target, ok."""
+    _, v = triangle_sequence()  # 80,001 samples at 20 kHz
+    x_mpi = presets.paper_mpi().simulate(v)
+    x_pi = presets.paper_pi().simulate(v)
+    mpi_ms = _best_ms(lambda: ModifiedPrandtlIshlinskii().fit(v, x_mpi))
+    pi_ms = _best_ms(lambda: PrandtlIshlinskii().fit(v, x_pi))
+    design, target = _design(v, x_mpi, 16, 16)
+    lstsq_ms = _best_ms(lambda: np.linalg.lstsq(design, target, rcond=None))
+    ratio = mpi_ms / lstsq_ms
+    n = f"{v.size:,} samples"
+    return [
+        {
+            "name": f"identify MPI 16+16, {n}",
+            "value": mpi_ms,
+            "unit": "ms",
+            "target": f"< {TARGET_MS:g} ms",
+            "ok": mpi_ms < TARGET_MS,
+        },
+        {
+            "name": f"identify PI 16, {n}",
+            "value": pi_ms,
+            "unit": "ms",
+            "target": f"< {TARGET_MS:g} ms",
+            "ok": pi_ms < TARGET_MS,
+        },
+        {
+            "name": "identify MPI vs numpy lstsq on the prebuilt design (same run)",
+            "value": ratio,
+            "unit": "x",
+            "target": "< 1",
+            "ok": ratio < 1.0,
+        },
+        {
+            "name": "numpy lstsq reference (unconstrained, design prebuilt)",
+            "value": lstsq_ms,
+            "unit": "ms",
+            "target": "reference",
+            "ok": True,
+        },
+    ]
+
+
+def main() -> None:
+    rows = run()
+    for row in rows:
+        flag = "ok " if row["ok"] else "SLOW"
+        print(f"{flag} {row['name']:<66} {row['value']:9.3f} {row['unit']:<3} ({row['target']})")
+    raise SystemExit(0 if all(row["ok"] for row in rows) else 1)
+
+
+if __name__ == "__main__":
+    main()

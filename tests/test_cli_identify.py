@@ -1,0 +1,188 @@
+"""The excite, identify, simulate and compensate commands, and their exit codes."""
+
+import os
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+import hystcomp
+from hystcomp import presets
+from hystcomp.cli import main
+from hystcomp.data import read_record, read_table, write_table
+from hystcomp.identify.scoring import holdout_report
+from hystcomp.io import MODEL_KINDS
+
+REAL_RECORD = (
+    Path(__file__).parents[2] / "shared" / "data" / "piezo-micromanipulator" / "Model_Vi_Do.dat"
+)
+
+
+def run(*args):
+    return CliRunner().invoke(main, [str(a) for a in args])
+
+
+def assert_one_line_error(result, code=2):
+    """Exit status ``code``, no traceback, one error line (click adds a usage hint above)."""
+    assert result.exit_code == code, result.output
+    assert "Traceback" not in result.output
+    errors = [
+        line
+        for line in result.output.splitlines()
+        if line.startswith(("Error:", "hystcomp: error:", "hystcomp: internal error:"))
+    ]
+    assert len(errors) == 1, result.output
+
+
+def test_excite_writes_the_paper_signals(tmp_path):
+    result = run("excite", "pi", "--fs", "4")
+    assert result.exit_code == 0
+    assert result.output.splitlines()[:4] == ["t,v", "0.0,0.0", "0.25,15.0", "0.5,30.0"]
+    out = tmp_path / "mpi.csv"
+    assert run("excite", "mpi", "-o", out, "--fs", "1000").exit_code == 0
+    table = read_table(out, ("v",))
+    assert table["v"].size == 4001
+    assert table["v"].max() == 120.0
+    result = run("excite", "preisach", "-o", tmp_path / "p.npz", "--voltage-range", "-150", "150")
+    assert result.exit_code == 0
+    v = read_table(tmp_path / "p.npz", ("v",))["v"]
+    assert (v.min(), v.max()) == (-150.0, 150.0)
+    assert v.size == 24 * 20_000 + 1  # 24 sinusoids of 1 s at 20 kHz
+
+
+@pytest.mark.parametrize(
+    ("kind", "operators", "tolerance"),
+    [("pi", 8, 0.05), ("mpi", 16, 1e-6)],  # a PI cannot follow the MPI's saturation
+)
+def test_identify_simulate_compensate_round_trip(tmp_path, kind, operators, tolerance):
+    true = presets.paper_mpi()
+    assert run("excite", kind, "-o", tmp_path / "v.csv", "--fs", "2000").exit_code == 0
+    t, v = (read_table(tmp_path / "v.csv", ("v",))[k] for k in "tv")
+    write_table(tmp_path / "rec.csv", {"t": t, "v": v, "x": true.simulate(v)})
+    args = ["identify", tmp_path / "rec.csv", "--model", kind, "--operators", operators]
+    result = run(*args, "-o", tmp_path / "m.json", "--plot", tmp_path / "fig.png")
+    assert result.exit_code == 0, result.output
+    assert "fit error: rms" in result.output
+    assert (tmp_path / "fig.png").stat().st_size > 10_000
+    model = hystcomp.load_model(tmp_path / "m.json")
+    assert model.kind == kind
+    assert model.thresholds_.size == operators
+    assert model.fit_report_["n_used"] == v.size
+
+    assert (
+        run("simulate", tmp_path / "m.json", tmp_path / "v.csv", "-o", tmp_path / "x.npz").exit_code
+        == 0
+    )
+    sim = read_table(tmp_path / "x.npz", ("v", "x"))
+    np.testing.assert_array_equal(sim["x"], model.simulate(v))
+
+    x_ref = 5.0 + 25.0 * (1.0 - np.abs(1.0 - 2.0 * (t % 1.0)))  # 1 Hz triangle, 5..30 µm
+    write_table(tmp_path / "ref.csv", {"t": t, "x": x_ref})
+    result = run("compensate", tmp_path / "m.json", tmp_path / "ref.csv", "-o", tmp_path / "v2.csv")
+    assert result.exit_code == 0
+    out = read_table(tmp_path / "v2.csv", ("v",))
+    tracking = np.abs(true.simulate(out["v"]) - x_ref).max()
+    assert tracking < tolerance * 25.0
+
+
+@pytest.mark.skipif(not REAL_RECORD.exists(), reason=f"real record not found at {REAL_RECORD}")
+@pytest.mark.parametrize("kind", ["pi", "mpi"])
+def test_real_record_in_one_command_beats_a_straight_line(tmp_path, kind):
+    out = tmp_path / "model.json"
+    result = run(
+        "identify", REAL_RECORD, "--model", kind, "--columns", "v=1,x=5", "--fs", 200,
+        "--holdout", 0.5, "-o", out,
+    )  # fmt: skip
+    assert result.exit_code == 0, result.output
+    assert "first 44 left out: start-up transient" in result.output
+    printed = float(re.search(r"([\d.]+)x better", result.output).group(1))
+    # the same figure, recomputed from the saved model
+    rec = read_record(REAL_RECORD, columns={"v": 1, "x": 5}, sample_rate=200.0)
+    model = hystcomp.load_model(out)
+    held = holdout_report(model, rec.v, rec.x, len(rec) - round(0.5 * len(rec)), 44)
+    assert held["improvement"] == pytest.approx(printed, rel=0.01)
+    assert held["improvement"] > 3.0
+    assert held["model_rms_um"] < 0.5  # of a 45 µm stroke
+    if kind == "mpi":  # x_0 is the smallest settled displacement: the sensor's offset
+        assert model.output_offset_ == pytest.approx(-119.45, abs=0.05)
+    model.inverse()  # invertible
+
+
+@pytest.mark.parametrize(
+    ("args", "match"),
+    [
+        (["identify", "missing.csv", "--model", "pi", "-o", "m.json"], "does not exist"),
+        (["identify", "rec.csv", "--model", "pi"], "Missing option '-o'"),
+        (
+            ["identify", "rec.csv", "--model", "bogus", "-o", "m.json"],
+            "Invalid value for '--model'",
+        ),
+        (["identify", "rec.csv", "--model", "pi", "--holdout", "1", "-o", "m.json"], "between 0"),
+        (
+            ["identify", "rec.csv", "--model", "pi", "--deadzones", "3", "-o", "m.json"],
+            "--deadzones",
+        ),
+        (["identify", "rec.csv", "--model", "pi", "--operators", "0", "-o", "m.json"], "int >= 1"),
+        (["identify", "rec.csv", "--model", "pi", "--plot", "f.jpg", "-o", "m.json"], "--plot"),
+        (["identify", "rec.csv", "--model", "pi", "--columns", "v=", "-o", "m.json"], "columns"),
+        (["identify", "flat.csv", "--model", "mpi", "-o", "m.json"], "is constant"),
+        (["simulate", "m.json", "rec.csv", "-o", "x.csv"], "Model file 'm.json' does not exist"),
+        (["excite", "pi", "--fs", "-5"], "sample_rate"),
+        (["compensate", "rec.csv", "rec.csv", "-o", "x.csv"], "not valid JSON"),
+    ],
+)
+def test_bad_usage_and_bad_input_exit_2_in_one_line(tmp_path, monkeypatch, args, match):
+    monkeypatch.chdir(tmp_path)
+    v = np.r_[np.linspace(0, 10, 50), np.linspace(10, 0, 50)]
+    write_table("rec.csv", {"t": np.arange(100) / 100, "v": v, "x": 2 * v})
+    write_table("flat.csv", {"t": np.arange(100) / 100, "v": np.ones(100), "x": v})
+    result = run(*args)
+    assert_one_line_error(result)
+    assert match in result.output
+
+
+def test_preisach_is_a_clean_error_until_registered(tmp_path):
+    if "preisach" in MODEL_KINDS:
+        pytest.skip("the Preisach model is registered in this build")
+    result = run("identify", "x.csv", "--model", "preisach", "-o", tmp_path / "m.json")
+    assert_one_line_error(result)
+    assert "Preisach model is not available" in result.output
+
+
+def test_failed_identify_keeps_the_existing_model_file(tmp_path):
+    out = tmp_path / "m.json"
+    out.write_text("precious")
+    write_table(tmp_path / "flat.csv", {"t": np.arange(3.0), "v": np.ones(3), "x": np.ones(3)})
+    assert run("identify", tmp_path / "flat.csv", "--model", "pi", "-o", out).exit_code == 2
+    assert out.read_text() == "precious"
+
+
+def test_internal_fault_exits_1(tmp_path, monkeypatch):
+    def broken(*args, **kwargs):
+        raise RuntimeError("boom")
+
+    monkeypatch.setattr("hystcomp.cli.identify.read_record", broken)
+    result = run("identify", "x.csv", "--model", "pi", "-o", tmp_path / "m.json")
+    assert_one_line_error(result, code=1)
+    assert "internal error: RuntimeError: boom" in result.output
+
+
+def test_python_dash_m_runs_the_command():
+    src = Path(hystcomp.__file__).parents[1]
+    env = {
+        **os.environ,
+        "PYTHONPATH": os.pathsep.join([str(src), os.environ.get("PYTHONPATH", "")]),
+    }
+    result = subprocess.run(
+        [sys.executable, "-m", "hystcomp", "excite", "--help"],
+        capture_output=True,
+        text=True,
+        env=env,
+        check=False,
+    )
+    assert result.returncode == 0, result.stderr
+    assert "identification input" in result.stdout
