@@ -42,6 +42,20 @@ def test_headerless_text_with_numbered_columns_and_sample_rate(tmp_path, record)
     np.testing.assert_allclose(rec.t, np.arange(500) / 200.0)
 
 
+def test_comma_separated_txt_with_byte_order_mark(tmp_path):
+    path = tmp_path / "export.txt"
+    path.write_text("\ufefft,v,x\n0,0,1\n1,2,5\n", encoding="utf-8")
+    assert read_record(path).v.tolist() == [0.0, 2.0]
+
+
+def test_bad_column_mappings_in_python(tmp_path, record):
+    path = tmp_path / "rec.csv"
+    write_table(path, record)
+    for bad in ({"v": 0}, {"y": 1}, {"v": True}, {"v": ""}):
+        with pytest.raises(InvalidParameterError, match=r"'columns' parameter of read_table"):
+            read_record(path, columns=bad)
+
+
 def test_csv_columns_by_name_extra_columns_ignored(tmp_path):
     path = tmp_path / "rec.csv"
     path.write_text("time,volts,disp,temperature\n0,0,1,20\n0.5,1,3,20\n1,2,5,21\n")

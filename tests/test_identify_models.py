@@ -217,6 +217,11 @@ def test_fit_is_fast_enough_for_the_paper_signal_only_by_benchmark():
             r"'x' is constant after sample 0",
         ),
         (
+            lambda: fit_mpi(np.arange(80.0), -np.arange(80.0)),
+            IdentificationError,
+            r"'x' falls as the voltage 'v' rises.*flip the sign",
+        ),
+        (
             lambda: fit_pi(np.arange(20.0), np.arange(20.0), n_operators=16),
             IdentificationError,
             r"only 20 of 20 samples remain .* fewer than the 34 needed",

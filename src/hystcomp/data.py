@@ -37,7 +37,7 @@ WRITABLE = (".csv", ".npz", ".mat")
 RATE_TOLERANCE = 0.01
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Record:
     """A measured record: time (s), input voltage (V) and displacement (µm).
 
@@ -108,6 +108,19 @@ def parse_columns(text: str | None) -> dict[str, int | str] | None:
     return mapping
 
 
+def _check_columns(columns) -> dict:
+    """A column mapping {key: 1-based number or name}, keys among t, v, x."""
+    columns = dict(columns or {})
+    for key, spec in columns.items():
+        number = isinstance(spec, int) and not isinstance(spec, bool) and spec >= 1
+        if key not in MEANINGS or not (number or (isinstance(spec, str) and spec)):
+            raise InvalidParameterError(
+                "The 'columns' parameter of read_table must map 't', 'v' or 'x' to a "
+                f"1-based column number or a column name. Got {key!r}: {spec!r}."
+            )
+    return columns
+
+
 def _is_header(tokens: list[str]) -> bool:
     try:
         [float(tok) for tok in tokens]
@@ -117,7 +130,7 @@ def _is_header(tokens: list[str]) -> bool:
 
 
 def _first_line(path: Path) -> str:
-    with path.open(encoding="utf-8") as f:
+    with path.open(encoding="utf-8-sig") as f:
         for line in f:
             if line.strip() and not line.lstrip().startswith("#"):
                 return line
@@ -125,8 +138,10 @@ def _first_line(path: Path) -> str:
 
 
 def _read_text(path: Path, delimiter: str | None):
-    """Header names (or None) and the columns of a text table."""
+    """Header names (or None) and the columns of a text table (``None``: by whitespace)."""
     first = _first_line(path)
+    if delimiter is None and "," in first:
+        delimiter = ","
     tokens = [tok.strip() for tok in (first.split(delimiter) if delimiter else first.split())]
     names = tokens if _is_header(tokens) else None
     try:
@@ -138,7 +153,7 @@ def _read_text(path: Path, delimiter: str | None):
                 skiprows=1 if names else 0,
                 comments="#",
                 ndmin=2,
-                encoding="utf-8",
+                encoding="utf-8-sig",
             )
     except ValueError as exc:
         raise DataFileError(
@@ -276,7 +291,7 @@ def read_table(path, keys=("v", "x"), *, columns=None, sample_rate=None, min_sam
         Naming the file, the column, the problem and the fix.
     """
     path = Path(os.fspath(path))
-    columns = dict(columns or {})
+    columns = _check_columns(columns)
     names, arrays, positional = _read_raw(path)
     out = {}
     for key in ("t", *keys):

@@ -78,10 +78,17 @@ def prepare_record(v, x, *, n_weights: int, transient, owner: str) -> PreparedRe
             f"{owner}: the displacement 'x' is constant after sample {start}; the sensor "
             "recorded no motion. Check the displacement column."
         )
-    if np.ptp(u[start:]) <= 0.0:
+    u_fit, x_fit = u[start:], x[start:]
+    if np.ptp(u_fit) <= 0.0:
         raise IdentificationError(
             f"{owner}: the input 'v' is constant after the start-up transient (sample "
             f"{start} on). Set a shorter transient."
+        )
+    if np.dot(u_fit - u_fit.mean(), x_fit - x_fit.mean()) <= 0.0:
+        raise IdentificationError(
+            f"{owner}: the displacement 'x' falls as the voltage 'v' rises. The models "
+            "describe an actuator whose displacement rises with its voltage: flip the sign "
+            "of the displacement (a negative sensor gain) or check the columns."
         )
     return PreparedRecord(v, x, v0, u, start, span, x_span / span)
 
