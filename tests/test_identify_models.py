@@ -228,8 +228,13 @@ def test_fit_is_fast_enough_for_the_paper_signal_only_by_benchmark():
         ),
         (
             lambda: fit_pi(np.arange(50.0), np.arange(50.0), margin=1.5),
-            IdentificationError,
+            InvalidParameterError,
             r"'margin' parameter of fit_pi must be below 1",
+        ),
+        (
+            lambda: hystcomp.ModifiedPrandtlIshlinskii(margin=2).fit([0, 1], [0, 1]),
+            InvalidParameterError,
+            r"'margin' parameter of ModifiedPrandtlIshlinskii must be below 1",
         ),
         (
             lambda: fit_mpi(np.arange(50.0), np.arange(50.0), n_deadzones=0),

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from hystcomp._validation import as_signal, check_int, check_real
-from hystcomp.errors import IdentificationError, InvalidSignalError
+from hystcomp.errors import IdentificationError, InvalidParameterError, InvalidSignalError
 from hystcomp.identify.lsq import constrained_lsq, normal_equations
 from hystcomp.identify.scoring import check_transient
 
@@ -97,7 +97,7 @@ def check_margin(margin, owner: str) -> float:
     """The relative invertibility margin, a number in (0, 1)."""
     margin = check_real(margin, "margin", owner, positive=True)
     if margin >= 1.0:
-        raise IdentificationError(
+        raise InvalidParameterError(
             f"The 'margin' parameter of {owner} must be below 1 (a small fraction such as "
             f"{DEFAULT_MARGIN}). Got {margin!r} instead."
         )

@@ -8,6 +8,7 @@ import numpy as np
 
 from hystcomp._validation import as_vector, check_int, check_range, check_real
 from hystcomp.errors import NotFittedError
+from hystcomp.identify.pi import check_margin
 from hystcomp.models.compensator import ChainSystem
 
 DEFAULT_VOLTAGE_RANGE = (0.0, 120.0)
@@ -119,4 +120,4 @@ def check_fit_options(model, owner) -> None:
     """Validate the identification hyperparameters ``transient`` and ``margin``."""
     if model.transient is not None:
         check_int(model.transient, "transient", owner, minimum=0)
-    check_real(model.margin, "margin", owner, positive=True)
+    check_margin(model.margin, owner)
