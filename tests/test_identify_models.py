@@ -54,8 +54,9 @@ def test_paper_models_are_recovered_from_the_excitation(kind, noise, rng):
     assert model.fit_report_["rms_error_um"] < max(1e-6, 1.05 * noise)
     assert model.fit_report_["n_used"] == v.size  # starts at v_min: nothing left out
     prediction, tracking = _check_identified(true, model, rng, 20_000.0)
-    assert prediction < (1e-5 if noise == 0 else 0.5)
-    assert tracking < (1e-5 if noise == 0 else 0.5)
+    # in % of the range; the requirement is 0.5 %, measured about 0.01 % with 5 nm noise
+    assert prediction < (1e-5 if noise == 0 else 0.05)
+    assert tracking < (1e-5 if noise == 0 else 0.05)
     if noise == 0:  # noise-free: the parameters themselves, MPI up to eq. (19)'s scale c
         c = 1.0 if kind == "pi" else 1.0 / presets.PAPER_MPI_INVERSE_DEADZONE_WEIGHTS[0]
         np.testing.assert_allclose(model.weights_, c * true.weights_, rtol=1e-6, atol=1e-7)
@@ -102,8 +103,8 @@ def test_other_ranges_rates_and_offsets_are_identified(kind, v_range, x_offset, 
     assert model.voltage_range_ == pytest.approx(v_range)
     assert model.fit_report_["rms_error_um"] < 1.1 * NOISE
     prediction, tracking = _check_identified(true, model, rng, fs)
-    assert prediction < 0.5
-    assert tracking < 0.5
+    assert prediction < 0.1  # % of the range (measured 0.002 to 0.03 %)
+    assert tracking < 0.1
 
 
 def test_bipolar_record_with_offset_gives_the_true_offset(rng):
