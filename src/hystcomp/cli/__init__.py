@@ -51,3 +51,7 @@ def main() -> None:
 
     Units: voltage in V, displacement in µm, time in s.
     """
+
+
+# Subcommands register themselves on `main` when imported.
+from hystcomp.cli import export_c  # noqa: F401
