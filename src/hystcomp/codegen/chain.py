@@ -103,7 +103,7 @@ def _kind_text(kind: str) -> str:
 
 def _summary(c, compensator) -> list[str]:
     lo, hi = compensator.voltage_range
-    lines = ["Parameters (identified values baked in below):"]
+    lines = ["Parameters (the identified values are tables in the .c file):"]
     if c.pre_r.size:
         lines.append(f"  {c.pre_r.size} inverse dead-zones (thresholds in um)")
     if c.play_r.size:
