@@ -53,3 +53,54 @@ def test_chain_holds_last_output_on_non_finite_input():
     operators.chain_run(p, u, out)
     assert out.tolist() == [1.0, 1.0, 1.0, 1.0, 3.0]
     assert p[operators.chain_state_start(p) + operators.STATE_NONFINITE] == 3.0
+
+
+def test_deadzone_block_gives_the_same_bits_for_any_block_length(rng):
+    x = rng.uniform(-5, 12, 1000)
+    r = np.array([0.0, 0.5, 2.0, 7.0, 9.5])
+    w = np.array([1.5, -0.4, 0.3, -0.2, 0.1])
+    whole = np.empty_like(x)
+    operators.deadzone_block(x, 1.25, r, w, whole)
+    one_by_one = np.empty_like(x)
+    for k in range(x.size):
+        operators.deadzone_block(x[k : k + 1], 1.25, r, w, one_by_one[k : k + 1])
+    np.testing.assert_allclose(whole, naive.saturation(x - 1.25, r, w), rtol=0, atol=1e-12)
+    assert np.array_equal(whole, one_by_one)
+
+
+def test_padding_plays_change_nothing_and_unpack_drops_them(rng):
+    r = np.array([0.0, 1.0, 2.5, 4.0, 6.0])
+    w = np.array([1.0, 0.3, -0.2, 0.25, 0.1])
+    y0 = np.array([0.5, 0.2, 0.0, -1.0, 0.0])
+    p = operators.pack_chain(plays=(r, w, y0), in_offset=2.0, out_offset=-1.0)
+    assert p[operators.N_PLAY] == operators.PLAY_MULTIPLE  # 5 plays padded to 8
+    u = random_walk(rng, 3 * operators.BLOCK + 17, -10, 10, 1.0)  # several blocks
+    out = np.empty_like(u)
+    operators.chain_run(p, u, out)
+    expected = naive.pi_model(u, r, w, y0, v0=2.0, x0=-1.0)
+    np.testing.assert_allclose(out, expected, rtol=0, atol=1e-12)
+    parts = operators.unpack_chain(p)
+    assert parts.play_r.tolist() == r.tolist()
+    assert parts.play_w.tolist() == w.tolist()
+    assert parts.plays.size == 5  # the states after the run, without padding
+    assert (parts.in_offset, parts.out_offset) == (2.0, -1.0)
+    assert not parts.play_w.flags.writeable
+
+
+def test_step_is_a_one_sample_run(rng):
+    pre = (np.array([0.0, 1.0, 3.0]), np.array([1.0, 0.5, -0.3]))
+    plays = (np.array([0.0, 0.7, 2.0]), np.array([0.8, 0.3, 0.2]), np.zeros(3))
+    post = (np.array([0.0, 2.0]), np.array([1.0, -0.4]))
+    packed = operators.pack_chain(pre=pre, plays=plays, post=post, low=-3.0, high=3.0)
+    u = random_walk(rng, 600, -6, 6, 0.8)
+    u[[10, 300]] = np.nan
+    batch = np.empty_like(u)
+    operators.chain_run(packed.copy(), u, batch)
+    p = packed.copy()
+    steps = [operators.chain_step(p, uk) for uk in u]
+    step = operators.chain_step_function()  # the compiled entry point the Stepper binds
+    q = packed.copy()
+    bound = [step(q, uk) for uk in u]
+    assert np.array_equal(steps, batch)
+    assert np.array_equal(bound, batch)
+    assert p[operators.chain_state_start(p) + operators.STATE_NONFINITE] == 2.0

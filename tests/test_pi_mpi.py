@@ -216,3 +216,14 @@ def test_unfitted_model_says_how_to_fit():
 def test_bad_parameters_get_clear_messages(kwargs, message):
     with pytest.raises(InvalidParameterError, match=message):
         hystcomp.PrandtlIshlinskii.from_parameters(**kwargs)
+
+
+def test_stepper_method_and_bound_step_agree(rng):
+    comp = hystcomp.presets.paper_mpi().inverse(slew_rate=2e5)
+    x = random_walk(rng, 300, 0.0, 35.0, 4.0)
+    a, b = comp.stepper(), comp.stepper()
+    assert [a.step(xk) for xk in x] == [hystcomp.Stepper.step(b, xk) for xk in x]
+    assert a.last_output == b.last_output
+    twin = a.copy()  # a copy binds its own state
+    assert twin.step(1.0) == a.step(1.0)
+    assert twin.step(30.0) == a.step(30.0)

@@ -12,19 +12,29 @@ Every Prandtl-Ishlinskii-type map in hystcomp, forward or inverse, is the same *
 with any stage possibly empty: the PI model (eq. 12) is the plays alone, the MPI model
 (eq. 15) is plays then dead-zones, the inverse MPI (eq. 23) is dead-zones then plays. A chain
 is *packed* into one float64 array (parameters, then state), so that a streaming step is one
-compiled call on one array, and batch runs, steppers, the C export and the benchmarks all use
-:func:`chain_step`: there is one play loop in the package.
+compiled call on one array. Batch runs and steppers both go through :func:`chain_blocks`
+(a step is a one-sample run), which uses the one play loop (:func:`play_step`) and the one
+dead-zone loop (:func:`deadzone_block`) of the package.
+
+Speed: a batch run takes the samples in blocks and the chain stage by stage. The dead-zones
+are stateless, so each is a pass over the block that vectorises over samples; the plays are
+the only recurrence and go sample by sample, vectorised over operators (their count is
+padded to :data:`PLAY_MULTIPLE` with operators of zero weight, so the vector loop has no
+scalar remainder). See ``benchmarks/bench_realtime.py`` for the figures.
 
 These functions trust their input; validation happens in the public classes above.
 """
 
 from __future__ import annotations
 
+import functools
+from collections import namedtuple
+
 import numba
 import numpy as np
 
 # Fast-math without 'nnan'/'ninf': reassociation lets the reductions vectorise, while the
-# stepper's finiteness test on the reference must survive compilation.
+# finiteness test on the input must survive compilation.
 FASTMATH = {"reassoc", "contract", "nsz", "arcp"}
 
 
@@ -32,16 +42,45 @@ def _kernel(func):
     return numba.njit(cache=True, fastmath=FASTMATH, nogil=True)(func)
 
 
+def _inline_kernel(func):
+    # Inlined into the calling kernel at numba-IR level: the stages of a chain then sit in
+    # one function that LLVM optimises as a whole (a call per stage and sample would cost
+    # more than the stage).
+    return numba.njit(cache=True, fastmath=FASTMATH, nogil=True, inline="always")(func)
+
+
+def _step_kernel(func):
+    # One sample per call, so the fixed cost of a call is what counts: keep the GIL
+    # (releasing and taking it back costs more than the sample) and compile without
+    # reference counting (the views of the packed array would otherwise cost an atomic
+    # increment and decrement each, a third of the call). Such a kernel must not allocate.
+    return numba.njit(cache=True, fastmath=FASTMATH, _nrt=False)(func)
+
+
 # Layout of a packed chain: header slots, then parameters, then state.
 N_PRE, N_PLAY, N_POST, IN_OFFSET, OUT_OFFSET, LOW, HIGH, MAX_STEP = range(8)
 HEADER = 8
-# State slots, from chain_state_start(p): last output, count of non-finite inputs, play states.
-STATE_LAST, STATE_NONFINITE, STATE_PLAYS = 0, 1, 2
+# State slots, from chain_state_start(p): last output, count of non-finite inputs, three
+# scratch slots for chain_step (its input, output and work sample), then the play states.
+STATE_LAST, STATE_NONFINITE, STATE_INPUT, STATE_OUTPUT, STATE_WORK, STATE_PLAYS = range(6)
+# Samples per stage pass in a batch run: the block and the parameters stay in L1 cache.
+BLOCK = 256
+# pack_chain pads the plays to a multiple of this count (the vector loop's step on AVX2).
+PLAY_MULTIPLE = 8
+
+ChainParts = namedtuple(
+    "ChainParts",
+    "in_offset out_offset low high max_step pre_r pre_w play_r play_w post_r post_w state plays",
+)
+ChainParts.__doc__ = """Views into a packed chain: its scalars, stage parameters and state."""
 
 
-@_kernel
-def play_update(v, r, y):
-    """Advance a bank of play operators by one sample, in place (eq. 11).
+@_inline_kernel
+def play_step(v, r, w, y):
+    """Advance a bank of play operators by one sample, in place, and weigh them.
+
+    The one play loop of the package: eq. (11) for every operator and, in the same pass,
+    the weighted sum of eq. (12) (a fused loop vectorises; two loops cost more).
 
     Parameters
     ----------
@@ -49,20 +88,56 @@ def play_update(v, r, y):
         The input sample.
     r : ndarray
         Thresholds ``r_i >= 0``.
+    w : ndarray
+        Weights ``w_i``, as long as ``r``.
     y : ndarray
         States ``y_i[k-1]`` on entry, ``y_i[k]`` on return.
+
+    Returns
+    -------
+    float
+        ``sum_i w_i y_i[k]``.
     """
+    acc = 0.0
     for i in range(r.size):
-        y[i] = max(v - r[i], min(v + r[i], y[i]))
+        yi = max(v - r[i], min(v + r[i], y[i]))
+        y[i] = yi
+        acc += w[i] * yi
+    return acc
+
+
+@_inline_kernel
+def play_update(v, r, y):
+    """Advance a bank of play operators by one sample, in place (eq. 11), without weights."""
+    play_step(v, r, r, y)  # the weighted sum is unused and compiled away
+
+
+@_inline_kernel
+def deadzone_block(x, shift, r, w, out):
+    """Weighted one-sided dead-zones (eqs. 13-14) of every sample of a block.
+
+    ``out[k] = sum_j w_j s_{r_j}(x[k] - shift)``, with ``s_0(z) = z`` (``r[0]`` must be 0)
+    and ``s_r(z) = max(z - r, 0)``. The one dead-zone loop of the package. Operators are the
+    outer loop and samples the inner one, so the inner loop vectorises over samples without
+    a reduction, and each sample's sum is formed in the same order whatever the block length
+    (a one-sample block gives the same bits as a long one). ``out`` must not overlap ``x``.
+    """
+    w0 = w[0]
+    for k in range(x.size):
+        out[k] = w0 * min(x[k] - shift, 0.0)  # with the j = 0 term below: w_0 * (x - shift)
+    for j in range(r.size):
+        rj = r[j] + shift
+        wj = w[j]
+        for k in range(x.size):
+            out[k] += wj * max(x[k] - rj, 0.0)
 
 
 @_kernel
 def deadzone_sum(z, r, w):
-    """Weighted superposition of one-sided dead-zones (eqs. 13-14); ``r[0]`` must be 0."""
-    acc = w[0] * z
-    for j in range(1, r.size):
-        acc += w[j] * max(z - r[j], 0.0)
-    return acc
+    """Weighted superposition of one-sided dead-zones (eqs. 13-14) at one point ``z``."""
+    out = np.empty(1)
+    deadzone_block(np.full(1, z), 0.0, r, w, out)
+    return out[0]
 
 
 @_kernel
@@ -75,56 +150,130 @@ def deadzone_values(z, r, out):
         out[j] = max(z - r[j], 0.0) if r[j] > 0.0 else z
 
 
-@_kernel
+@_inline_kernel
 def chain_state_start(p):
     """Index of the first state slot of packed chain ``p``."""
     return HEADER + 2 * (int(p[N_PRE]) + int(p[N_PLAY]) + int(p[N_POST]))
 
 
-@_kernel
-def chain_step(p, u):
-    """One sample through packed chain ``p``; updates the state in ``p`` and returns the output.
-
-    A non-finite ``u`` holds the last output and increments the non-finite counter.
-    """
+@_inline_kernel
+def chain_parts(p):
+    """The :data:`ChainParts` of packed chain ``p`` (views that share its memory)."""
     n_pre = int(p[N_PRE])
     n_play = int(p[N_PLAY])
     n_post = int(p[N_POST])
-    s = HEADER + 2 * (n_pre + n_play + n_post)
-    last = p[s + STATE_LAST]
-    if u - u != 0.0:  # NaN or +-inf
-        p[s + STATE_NONFINITE] += 1.0
-        return last
-    z = u - p[IN_OFFSET]
-    o = HEADER
-    if n_pre > 0:
-        z = deadzone_sum(z, p[o : o + n_pre], p[o + n_pre : o + 2 * n_pre])
-        o += 2 * n_pre
-    if n_play > 0:
-        r = p[o : o + n_play]
-        w = p[o + n_play : o + 2 * n_play]
-        y = p[s + STATE_PLAYS : s + STATE_PLAYS + n_play]
-        play_update(z, r, y)
-        acc = 0.0
-        for i in range(n_play):
-            acc += w[i] * y[i]
-        z = acc
-        o += 2 * n_play
-    if n_post > 0:
-        z = deadzone_sum(z, p[o : o + n_post], p[o + n_post : o + 2 * n_post])
-    out = z + p[OUT_OFFSET]
-    step = p[MAX_STEP]
-    out = min(max(out, last - step), last + step)
-    out = min(max(out, p[LOW]), p[HIGH])
-    p[s + STATE_LAST] = out
-    return out
+    o_play = HEADER + 2 * n_pre
+    o_post = o_play + 2 * n_play
+    s = o_post + 2 * n_post
+    return ChainParts(
+        p[IN_OFFSET],
+        p[OUT_OFFSET],
+        p[LOW],
+        p[HIGH],
+        p[MAX_STEP],
+        p[HEADER : o_play - n_pre],
+        p[o_play - n_pre : o_play],
+        p[o_play : o_post - n_play],
+        p[o_post - n_play : o_post],
+        p[o_post : s - n_post],
+        p[s - n_post : s],
+        p[s : s + STATE_PLAYS],
+        p[s + STATE_PLAYS : s + STATE_PLAYS + n_play],
+    )
+
+
+@_inline_kernel
+def chain_blocks(p, u, out, work):
+    """Run every sample of ``u`` through packed chain ``p`` into ``out``; state kept in ``p``.
+
+    A non-finite sample holds the last output and increments the non-finite counter.
+    Samples go through in blocks of :data:`BLOCK`, stage by stage: the stateless dead-zone
+    stages as passes over the block, the plays and the output limits sample by sample.
+    ``out`` is the work buffer of the stages before the plays and ``work`` (at least
+    ``min(BLOCK, u.size)`` long if the chain has dead-zones after the plays) that of the
+    stage after; none of the three may overlap another.
+    """
+    (
+        in_offset,
+        out_offset,
+        low,
+        high,
+        max_step,
+        pre_r,
+        pre_w,
+        play_r,
+        play_w,
+        post_r,
+        post_w,
+        state,
+        plays,
+    ) = chain_parts(p)
+    last = state[STATE_LAST]
+    held = state[STATE_NONFINITE]
+    slewing = max_step < np.inf  # a loop-invariant test: without a limit, no recurrence
+    for start in range(0, u.size, BLOCK):
+        ub = u[start : start + BLOCK]
+        z = out[start : start + BLOCK]
+        if pre_r.size > 0:
+            deadzone_block(ub, in_offset, pre_r, pre_w, z)
+        else:
+            for k in range(ub.size):
+                z[k] = ub[k] - in_offset
+        if play_r.size > 0:
+            for k in range(ub.size):
+                if ub[k] - ub[k] == 0.0:  # finite: the plays advance
+                    z[k] = play_step(z[k], play_r, play_w, plays)
+        zb = z
+        if post_r.size > 0:
+            zb = work[: ub.size]
+            deadzone_block(z, 0.0, post_r, post_w, zb)
+        for k in range(ub.size):
+            if ub[k] - ub[k] != 0.0:  # NaN or +-inf: hold the last output
+                held += 1.0
+            else:
+                zk = zb[k] + out_offset
+                if slewing:
+                    zk = min(max(zk, last - max_step), last + max_step)
+                last = min(max(zk, low), high)
+            z[k] = last
+    state[STATE_LAST] = last
+    state[STATE_NONFINITE] = held
+
+
+@_step_kernel
+def chain_step(p, u):
+    """One sample through packed chain ``p``; updates the state in ``p`` and returns the output.
+
+    A one-sample :func:`chain_blocks` run through the scratch slots of the state, so that
+    the streaming step and the batch run are the same code, bit for bit. A non-finite ``u``
+    holds the last output and increments the non-finite counter.
+    """
+    s = chain_state_start(p) + STATE_INPUT
+    p[s] = u
+    chain_blocks(p, p[s : s + 1], p[s + 1 : s + 2], p[s + 2 : s + 3])
+    return p[s + 1]
+
+
+@functools.cache
+def chain_step_function():
+    """:func:`chain_step` compiled for a float64 array and a float, as a plain ``f(p, u)``.
+
+    It skips numba's dispatch on argument types (a third of the cost of a call) and so
+    trusts its arguments more still: ``p`` must be a writable, C-contiguous float64 array.
+    The first call compiles the kernel or loads it from the on-disk cache.
+    """
+    return chain_step.compile((numba.types.float64[::1], numba.types.float64))
 
 
 @_kernel
 def chain_run(p, u, out):
-    """Run every sample of ``u`` through packed chain ``p`` into ``out`` (state kept in ``p``)."""
-    for k in range(u.size):
-        out[k] = chain_step(p, u[k])
+    """Run every sample of ``u`` through packed chain ``p`` into ``out`` (state kept in ``p``).
+
+    ``u`` and ``out`` must not overlap. A non-finite sample holds the last output and
+    increments the non-finite counter.
+    """
+    work = np.empty(min(BLOCK, u.size)) if p[N_POST] > 0 else out[:0]
+    chain_blocks(p, u, out, work)
 
 
 @_kernel
@@ -157,7 +306,9 @@ def pack_chain(
     pre, post : (thresholds, weights), optional
         Dead-zone superpositions before and after the plays.
     plays : (thresholds, weights, initial_states), optional
-        The play operators.
+        The play operators. They are padded to a multiple of :data:`PLAY_MULTIPLE` with
+        operators of threshold 0, weight 0 and state 0, which add nothing to the output
+        (:func:`unpack_chain` leaves them out).
     in_offset, out_offset : float
         Subtracted from the input, added to the output.
     low, high : float
@@ -174,8 +325,34 @@ def pack_chain(
     empty2 = (np.empty(0), np.empty(0))
     pre_r, pre_w = pre if pre is not None else empty2
     post_r, post_w = post if post is not None else empty2
-    play_r, play_w, play_y0 = plays if plays is not None else (*empty2, np.empty(0))
+    play_r, play_w, play_y0 = (*empty2, np.empty(0))
+    if plays is not None:
+        pad = np.zeros(-len(plays[0]) % PLAY_MULTIPLE)
+        play_r, play_w, play_y0 = (np.concatenate([np.asarray(a, np.float64), pad]) for a in plays)
     header = [len(pre_r), len(play_r), len(post_r), in_offset, out_offset, low, high, max_step]
-    state = [min(max(0.0, low), high), 0.0]
+    state = [min(max(0.0, low), high), 0.0, 0.0, 0.0, 0.0]
     parts = [header, pre_r, pre_w, play_r, play_w, post_r, post_w, state, play_y0]
     return np.concatenate([np.asarray(a, dtype=np.float64) for a in parts])
+
+
+def unpack_chain(p: np.ndarray) -> ChainParts:
+    """The parts of packed chain ``p`` as read-only copies, without the padding plays.
+
+    For code that reads a chain's parameters (the C export, tests); the kernels use
+    :func:`chain_parts`. The padding plays are those after the first with threshold 0
+    (real thresholds increase strictly from 0).
+    """
+    parts = chain_parts.py_func(np.asarray(p, dtype=np.float64))
+    n_play = parts.play_r.size
+    if n_play > 1:
+        zero = np.flatnonzero(parts.play_r[1:] == 0.0)
+        n_play = int(zero[0]) + 1 if zero.size else n_play
+    copies = {}
+    for name, value in parts._asdict().items():
+        if isinstance(value, np.ndarray):
+            value = value[:n_play].copy() if name in ("play_r", "play_w", "plays") else value.copy()
+            value.setflags(write=False)
+        else:
+            value = float(value)
+        copies[name] = value
+    return ChainParts(**copies)

@@ -1,0 +1,245 @@
+"""Real-time speed of the compensators (``python benchmarks/run.py realtime``).
+
+* Batch: the paper's inverse MPI (16 dead-zones, 16 plays; ``presets.paper_mpi().inverse()``)
+  over a million samples, against a plain C99 version of the same loop
+  (``benchmarks/c/inverse_mpi.c``, scalar code as an embedded engineer writes it) compiled
+  here with ``cc -O3``. Target: hystcomp at most half the C time.
+* The same compensator exported with ``hystcomp export-c`` and compiled with ``cc -O3``.
+* Streaming: the cost of one ``Stepper.step`` call from a Python loop (target < 300 ns) and
+  of ``step_block`` per sample.
+* First use: the cost of the first call in a fresh process, with an empty and with a warm
+  on-disk kernel cache.
+
+Times are the best of several runs; ratios come from the same run.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+import hystcomp
+from hystcomp import operators
+from hystcomp.codegen import export_c
+
+HERE = Path(__file__).resolve().parent
+N_SAMPLES = 1_000_000
+REPEAT = 11
+CC = shutil.which("cc")
+
+
+def run() -> list[dict]:
+    model = hystcomp.presets.paper_mpi()
+    comp = model.inverse()
+    x = reference(model, N_SAMPLES)
+    with tempfile.TemporaryDirectory() as tmp:
+        rows = batch_rows(comp, x, Path(tmp))
+        rows += first_call_rows(Path(tmp))
+    rows += stepper_rows(comp, x)
+    return rows
+
+
+def reference(model, n: int) -> np.ndarray:
+    """A seeded random-walk reference in µm, a little beyond the reachable range."""
+    x_max = float(model.simulate([0.0, model.voltage_range_[1]])[-1])
+    rng = np.random.default_rng(20_000)
+    walk = np.cumsum(rng.normal(scale=0.01 * x_max, size=n)) + 0.5 * x_max
+    return np.clip(walk, -0.05 * x_max, 1.05 * x_max)
+
+
+def best_of(funcs: dict, repeat: int = REPEAT) -> dict:
+    """The shortest time in s of each of ``funcs`` (name -> callable), over ``repeat`` rounds.
+
+    The rounds interleave the callables, so that a slow spell of a shared machine hits all
+    of them alike and the ratios stay fair.
+    """
+    best = dict.fromkeys(funcs, np.inf)
+    for _ in range(repeat):
+        for name, func in funcs.items():
+            start = time.perf_counter()
+            func()
+            best[name] = min(best[name], time.perf_counter() - start)
+    return best
+
+
+def row(name, value, unit, target=None, ok=None) -> dict:
+    return {"name": name, "value": float(value), "unit": unit, "target": target, "ok": ok}
+
+
+# ----------------------------------------------------------------------------- batch
+
+
+def batch_rows(comp, x: np.ndarray, tmp: Path) -> list[dict]:
+    outputs = {}
+
+    def timed(name, run):
+        out = outputs.setdefault(name, np.empty_like(x))
+        return lambda: run(x, out)
+
+    funcs = {
+        "numba": timed("numba", lambda u, out: operators.chain_run(comp.packed.copy(), u, out)),
+        "simulate": lambda: comp.simulate(x),
+    }
+    funcs["numba"]()  # compile, or load from the cache
+    comp.simulate(x[:10])
+    if CC is not None:
+        funcs["c"] = timed("c", PlainC(comp, tmp, ["-O3"]).run)
+        funcs["native"] = timed("native", PlainC(comp, tmp, ["-O3", "-march=native"]).run)
+        funcs["export"] = timed("export", ExportedC(comp, tmp).run)
+    t = best_of(funcs)
+    ns = {name: seconds * 1e9 / x.size for name, seconds in t.items()}
+    rows = [
+        row("inverse MPI batch, chain_run (numba)", ns["numba"], "ns/sample"),
+        row("inverse MPI batch, Compensator.simulate", ns["simulate"], "ns/sample"),
+    ]
+    if CC is None:
+        return [*rows, row("plain C reference: skipped, no C compiler 'cc'", np.nan, "")]
+    dv_c = float(np.abs(outputs["numba"] - outputs["c"]).max())
+    dv_export = float(np.abs(outputs["numba"] - outputs["export"]).max())
+    ratio, ratio_simulate = t["numba"] / t["c"], t["simulate"] / t["c"]
+    return [
+        row("inverse MPI batch, plain C99 cc -O3 (reference)", ns["c"], "ns/sample"),
+        *rows,
+        row("chain_run time / plain C time", ratio, "x", "<= 0.5", ratio <= 0.5),
+        row("simulate time / plain C time", ratio_simulate, "x", "<= 0.5", ratio_simulate <= 0.5),
+        row("plain C99, cc -O3 -march=native", ns["native"], "ns/sample"),
+        row("exported C (hystcomp export-c), cc -O3", ns["export"], "ns/sample"),
+        row("max |v| difference, chain_run vs plain C", dv_c, "V", "<= 1e-9", dv_c <= 1e-9),
+        row(
+            "max |v| difference, chain_run vs export", dv_export, "V", "<= 1e-9", dv_export <= 1e-9
+        ),
+    ]
+
+
+def build(sources: list[Path], lib: Path, flags: list[str]) -> ctypes.CDLL:
+    cmd = [CC, "-std=c99", *flags, "-shared", "-fPIC", "-o", str(lib), *map(str, sources)]
+    subprocess.run(cmd, check=True, capture_output=True, text=True)
+    return ctypes.CDLL(str(lib))
+
+
+class PlainC:
+    """``benchmarks/c/inverse_mpi.c`` loaded with the compensator's parameters."""
+
+    N_DEADZONES = N_PLAYS = 16
+
+    def __init__(self, comp, tmp: Path, flags: list[str]):
+        c = operators.unpack_chain(comp.packed)
+        if (c.pre_r.size, c.play_r.size, c.post_r.size) != (self.N_DEADZONES, self.N_PLAYS, 0):
+            raise ValueError("the C reference is written for 16 dead-zones then 16 plays")
+        lib = build([HERE / "c" / "inverse_mpi.c"], tmp / f"ref{len(flags)}.so", flags)
+        self._run = lib.ref_run
+        self._run.argtypes = [ctypes.c_void_p] * 3 + [ctypes.c_long]
+        doubles = ctypes.c_double * 16
+        fields = [(name, doubles) for name in ("dz_r", "dz_w", "play_r", "play_w")]
+        scalars = ("in_offset", "out_offset", "low", "high", "max_step")
+        fields += [(name, ctypes.c_double) for name in scalars]
+        fields += [("y", doubles), ("last", ctypes.c_double)]
+        state_type = type("ref_compensator", (ctypes.Structure,), {"_fields_": fields})
+        self._initial = state_type(
+            doubles(*c.pre_r),
+            doubles(*c.pre_w),
+            doubles(*c.play_r),
+            doubles(*c.play_w),
+            *(getattr(c, name) for name in scalars),
+            doubles(*c.plays),
+            c.state[operators.STATE_LAST],
+        )
+        self._state = state_type()
+
+    def run(self, x: np.ndarray, out: np.ndarray) -> None:
+        ctypes.pointer(self._state)[0] = self._initial
+        self._run(ctypes.byref(self._state), x.ctypes.data, out.ctypes.data, x.size)
+
+
+class ExportedC:
+    """The compensator as ``hystcomp export-c`` writes it, with a loop around its step."""
+
+    DRIVER = """#include "bench_comp.h"
+void bench_run(const double *x_ref, double *v, long n)
+{
+    bench_comp_state s;
+    long k;
+    bench_comp_init(&s);
+    for (k = 0; k < n; k++) {
+        v[k] = bench_comp_step(&s, x_ref[k]);
+    }
+}
+"""
+
+    def __init__(self, comp, tmp: Path):
+        _, source = export_c(comp, tmp / "export", prefix="bench_comp")
+        driver = tmp / "export" / "driver.c"
+        driver.write_text(self.DRIVER)
+        self._run = build([source, driver], tmp / "export.so", ["-O3"]).bench_run
+        self._run.argtypes = [ctypes.c_void_p] * 2 + [ctypes.c_long]
+
+    def run(self, x: np.ndarray, out: np.ndarray) -> None:
+        self._run(x.ctypes.data, out.ctypes.data, x.size)
+
+
+# ----------------------------------------------------------------------------- streaming
+
+
+def stepper_rows(comp, x: np.ndarray) -> list[dict]:
+    samples = x[:20_000].tolist()
+    blocks = x[:20_000].reshape(-1, 20)  # 1 ms of a 20 kHz loop per block
+    stepper = comp.stepper()
+    stepper.step(samples[0])
+    stepper.step_block(blocks[0])
+
+    def step_loop():
+        for xk in samples:
+            stepper.step(xk)
+
+    def block_loop():
+        for block in blocks:
+            stepper.step_block(block)
+
+    t = best_of({"step": step_loop, "block": block_loop}, 3 * REPEAT)
+    per_call = t["step"] / len(samples) * 1e9
+    return [
+        row("Stepper.step, one call in a Python loop", per_call, "ns", "< 300", per_call < 300),
+        row("Stepper.step_block, blocks of 20, per sample", t["block"] / blocks.size * 1e9, "ns"),
+    ]
+
+
+# ----------------------------------------------------------------------------- first use
+
+FIRST_CALL = """
+import json, time
+start = time.perf_counter()
+import hystcomp
+imported = time.perf_counter()
+comp = hystcomp.presets.paper_mpi().inverse()
+comp.simulate([0.0, 1.0])
+comp.stepper().step(1.0)
+print(json.dumps({"import": imported - start, "first": time.perf_counter() - imported}))
+"""
+
+
+def first_call_rows(tmp: Path) -> list[dict]:
+    """Import and first-call times in fresh processes sharing an initially empty cache."""
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp / "numba-cache"))
+    src = str(Path(hystcomp.__file__).resolve().parents[1])  # the hystcomp measured here
+    env["PYTHONPATH"] = os.pathsep.join([src, env.get("PYTHONPATH", "")])
+    times = []
+    for _ in range(2):  # cold, then warm
+        done = subprocess.run(
+            [sys.executable, "-c", FIRST_CALL], env=env, capture_output=True, text=True, check=True
+        )
+        times.append(json.loads(done.stdout))
+    cold, warm = times
+    return [
+        row("import hystcomp, fresh process", warm["import"], "s"),
+        row("first simulate + step, empty kernel cache", cold["first"], "s"),
+        row("first simulate + step, warm kernel cache", warm["first"], "s"),
+    ]

@@ -1,0 +1,62 @@
+"""``hystcomp export-c``: a model file's compensator as C99 code for an embedded controller."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import click
+
+from hystcomp.cli import main
+from hystcomp.codegen import DEFAULT_PREFIX, export_c
+from hystcomp.io import load_model
+
+
+@main.command("export-c")
+@click.argument("model_file", type=click.Path(path_type=Path))
+@click.option(
+    "-o",
+    "--output",
+    "directory",
+    required=True,
+    type=click.Path(path_type=Path),
+    help="Folder for NAME.h and NAME.c (made if its parent exists).",
+)
+@click.option(
+    "--prefix",
+    default=DEFAULT_PREFIX,
+    show_default=True,
+    help="NAME: names the files, the state type NAME_state and the functions (a C identifier).",
+)
+@click.option(
+    "--slew-rate",
+    type=float,
+    default=None,
+    metavar="V_PER_S",
+    help="Largest output slew rate in V/s, baked into the code (none by default).",
+)
+@click.option(
+    "--fs",
+    "sample_rate",
+    type=float,
+    default=20_000.0,
+    show_default=True,
+    metavar="HZ",
+    help="Sample rate at which NAME_step is called; sets the slew step per sample.",
+)
+def export_c_command(model_file, directory, prefix, slew_rate, sample_rate):
+    """Write MODEL_FILE's compensator as C99 code: NAME.h and NAME.c in folder -o.
+
+    The code has the identified parameters baked in, clamps its output to the model's
+    voltage range and holds the last output when the reference is not finite:
+
+    \b
+      void   NAME_init(NAME_state *s);
+      void   NAME_reset(NAME_state *s);
+      double NAME_step(NAME_state *s, double x_ref);   /* um in, V out */
+    """
+    model = load_model(model_file)
+    compensator = model.inverse(slew_rate=slew_rate, sample_rate=sample_rate)
+    header, source = export_c(
+        compensator, directory, prefix=prefix, source=str(model_file), sample_rate=sample_rate
+    )
+    click.echo(f"wrote {header} and {source}")

@@ -1,0 +1,124 @@
+"""C99 export of compensators: a state struct and ``init`` / ``reset`` / ``step`` functions.
+
+>>> import hystcomp
+>>> from hystcomp.codegen import generate_c
+>>> header, source = generate_c(hystcomp.presets.paper_pi().inverse(), prefix="stage_x")
+>>> "double stage_x_step(stage_x_state *s, double x_ref);" in header
+True
+
+A template per kind of compensator (:data:`TEMPLATES`) describes its state, tables and step
+(:class:`~hystcomp.codegen.c99.CTemplate`); :func:`~hystcomp.codegen.c99.render` writes
+the same files for all of them. PI and MPI compensators share the chain template.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+from collections.abc import Callable
+from pathlib import Path
+
+from hystcomp.codegen.c99 import CTemplate, check_prefix, render
+from hystcomp.codegen.chain import chain_template
+from hystcomp.errors import InvalidParameterError, InvalidTypeError
+from hystcomp.io import atomic_path
+
+DEFAULT_PREFIX = "hystcomp_compensator"
+
+#: Templates by the ``kind`` of the compensator.
+TEMPLATES: dict[str, Callable[..., CTemplate]] = {
+    "pi": chain_template,
+    "mpi": chain_template,
+}
+
+__all__ = ["DEFAULT_PREFIX", "TEMPLATES", "CTemplate", "check_prefix", "export_c", "generate_c"]
+
+
+def generate_c(
+    compensator,
+    *,
+    prefix: str = DEFAULT_PREFIX,
+    source: str | None = None,
+    sample_rate: float = 20_000.0,
+) -> tuple[str, str]:
+    """The C99 header and source of ``compensator`` (see :func:`export_c`).
+
+    Returns
+    -------
+    (str, str)
+        The texts of ``PREFIX.h`` and ``PREFIX.c``.
+    """
+    kind = getattr(compensator, "kind", None)
+    if not hasattr(compensator, "voltage_range") or not isinstance(kind, str):
+        raise InvalidTypeError(
+            "'compensator' must be a hystcomp compensator, as returned by model.inverse(). "
+            f"Got {type(compensator).__name__}."
+        )
+    if kind not in TEMPLATES:
+        raise InvalidParameterError(
+            f"C export supports compensators of kinds {sorted(TEMPLATES)}. "
+            f"Got a compensator of kind {kind!r}."
+        )
+    check_prefix(prefix)
+    template = TEMPLATES[kind](compensator)
+    return render(template, prefix, source=source, sample_rate=sample_rate)
+
+
+def export_c(
+    compensator,
+    directory: str | os.PathLike,
+    *,
+    prefix: str = DEFAULT_PREFIX,
+    source: str | None = None,
+    sample_rate: float = 20_000.0,
+) -> tuple[Path, Path]:
+    """Write ``PREFIX.h`` and ``PREFIX.c``, a C99 version of ``compensator``, into ``directory``.
+
+    The identified parameters are baked in; the code clamps its output to the compensator's
+    voltage range, applies its slew-rate limit if it has one, and holds the last output on a
+    non-finite reference, sample for sample as :meth:`Compensator.stepper` does.
+
+    Parameters
+    ----------
+    compensator : Compensator
+        From ``model.inverse(...)`` of a PI or MPI model.
+    directory : path
+        Output folder; created if its parent exists.
+    prefix : str, default "hystcomp_compensator"
+        Names the files, the state type ``PREFIX_state`` and the functions; a C identifier.
+    source : str, optional
+        The model file, named in the header comment.
+    sample_rate : float, default 20000
+        Hz at which the code is meant to be called, for the header comment.
+
+    Returns
+    -------
+    (Path, Path)
+        The header and source written. Nothing is written if anything fails, and existing
+        files are replaced only once both new files are complete.
+    """
+    header, source_text = generate_c(
+        compensator, prefix=prefix, source=source, sample_rate=sample_rate
+    )
+    directory = Path(directory)
+    if not directory.is_dir():
+        if directory.exists() or not directory.parent.is_dir():
+            raise InvalidParameterError(
+                f"Cannot write the C files into {str(directory)!r}: it is not a folder and "
+                f"cannot be made (its parent {str(directory.parent)!r} must be an existing "
+                "folder). Create it first or choose another output folder."
+            )
+        directory.mkdir()
+    paths = (directory / f"{prefix}.h", directory / f"{prefix}.c")
+    try:
+        # both files renamed into place only once both are written (the .c first)
+        with contextlib.ExitStack() as stack:
+            tmp_h, tmp_c = (stack.enter_context(atomic_path(path)) for path in paths)
+            tmp_h.write_text(header, encoding="ascii")
+            tmp_c.write_text(source_text, encoding="ascii")
+    except OSError as exc:
+        raise InvalidParameterError(
+            f"Cannot write the C files into {str(directory)!r}: {exc.strerror} "
+            f"({exc.filename}). Check that NAME.h and NAME.c can be written there."
+        ) from None
+    return paths

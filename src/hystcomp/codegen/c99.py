@@ -1,0 +1,255 @@
+"""The C99 file pair that every compensator template fills in.
+
+A template (see :mod:`hystcomp.codegen.chain`) describes one compensator as a
+:class:`CTemplate`: the fields of its state, its constant tables, the body of ``reset`` and
+the body of ``step``. :func:`render` wraps them in the same files for every template::
+
+    NAME.h   the state struct NAME_state and the three functions
+    NAME.c   the constant tables and the functions
+
+    void   NAME_init(NAME_state *s);               before the first step
+    void   NAME_reset(NAME_state *s);              back to the initial state
+    double NAME_step(NAME_state *s, double x_ref); one sample: reference (um) -> voltage (V)
+
+The generated code is C99 with nothing beyond ``<math.h>`` (only its ``isfinite``), no
+allocation, no global state, and its numbers written with 17 significant digits so that a
+double holds exactly the value the Python compensator uses.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from hystcomp.errors import InvalidParameterError
+
+# A C identifier that does not start with '_' (reserved at file scope, C99 7.1.3).
+_PREFIX = re.compile(r"[A-Za-z][A-Za-z0-9_]*\Z")
+
+
+@dataclass
+class CTemplate:
+    """What a compensator template contributes to the generated files.
+
+    Strings are C99 lines in which ``{p}`` stands for the prefix. ``state_fields`` are
+    declarations inside the state struct (``last`` and ``nonfinite_count`` are always
+    there); ``tables`` the ``static const`` tables of NAME.c; ``locals`` the declarations
+    at the top of ``NAME_step``; ``reset_body`` the statements of ``NAME_reset``.
+    ``step_body`` runs for a finite ``x_ref`` and assigns the voltage to ``v``; the common
+    part then applies the slew-rate limit (``max_step`` V per sample, if finite) and the
+    clamp to ``[low, high]`` V, and ``after_body`` runs last, with the final ``v`` (for
+    state that follows the applied voltage).
+    """
+
+    kind: str
+    summary: list[str]
+    low: float
+    high: float
+    max_step: float = np.inf
+    initial_output: float = 0.0
+    state_fields: list[str] = field(default_factory=list)
+    tables: list[str] = field(default_factory=list)
+    locals: list[str] = field(default_factory=list)
+    reset_body: list[str] = field(default_factory=list)
+    step_body: list[str] = field(default_factory=list)
+    after_body: list[str] = field(default_factory=list)
+
+
+def check_prefix(prefix: str) -> str:
+    """Return ``prefix`` if it can start C identifiers, else raise :class:`InvalidParameterError`.
+
+    Examples
+    --------
+    >>> check_prefix("stage_x")
+    'stage_x'
+    >>> check_prefix("2axis")
+    Traceback (most recent call last):
+    ...
+    hystcomp.errors.InvalidParameterError: The prefix must be a C identifier ...
+    """
+    if not isinstance(prefix, str) or not _PREFIX.match(prefix):
+        raise InvalidParameterError(
+            "The prefix must be a C identifier that starts with a letter (then letters, digits "
+            f"or '_'), as it names the C files, type and functions. Got {prefix!r}; "
+            "for example 'stage_x' or 'piezo_comp'."
+        )
+    return prefix
+
+
+def c_double(value: float) -> str:
+    """A C double literal that reads back exactly (17 significant digits).
+
+    Examples
+    --------
+    >>> c_double(0.1), c_double(3.0), c_double(-1e-20)
+    ('0.10000000000000001', '3.0', '-9.9999999999999995e-21')
+    """
+    value = float(value)
+    if not np.isfinite(value):
+        raise ValueError(f"C99 has no literal for {value!r}")  # templates never ask for one
+    text = f"{value:.17g}"
+    return text if any(c in text for c in ".e") else text + ".0"
+
+
+def c_table(name: str, values, comment: str) -> str:
+    """A ``static const double`` table, four numbers to a line, with a comment above."""
+    values = [c_double(v) for v in values]
+    rows = [", ".join(values[i : i + 4]) for i in range(0, len(values), 4)]
+    body = ",\n    ".join(rows)
+    return f"/* {comment} */\nstatic const double {name}[{len(values)}] = {{\n    {body}\n}};"
+
+
+def render(
+    template: CTemplate, prefix: str, *, source: str | None = None, sample_rate: float = 20_000.0
+) -> tuple[str, str]:
+    """The texts of ``NAME.h`` and ``NAME.c`` for ``template``.
+
+    ``source`` (the model file) and ``sample_rate`` (Hz, at which ``NAME_step`` is called)
+    only go into the comments.
+    """
+    p = check_prefix(prefix)
+    guard = f"{p.upper()}_H"
+    comment = _header_comment(template, p, source, sample_rate)
+    fields = [
+        "double last; /* last output, V (held while x_ref is not finite) */",
+        "unsigned long nonfinite_count; /* non-finite x_ref samples since the last reset */",
+        *template.state_fields,
+    ]
+    header = "\n".join(
+        [
+            comment,
+            f"#ifndef {guard}",
+            f"#define {guard}",
+            "",
+            "#ifdef __cplusplus",
+            'extern "C" {',
+            "#endif",
+            "",
+            "typedef struct {",
+            *(f"    {line}" for line in fields),
+            f"}} {p}_state;",
+            "",
+            "/* Prepare a state before its first step (the same as a reset). */",
+            f"void {p}_init({p}_state *s);",
+            "",
+            "/* Return to the initial state: the output the amplifier holds at rest and the",
+            "   operator states the model starts from. */",
+            f"void {p}_reset({p}_state *s);",
+            "",
+            "/* One sample: reference x_ref in um -> piezo voltage in V, always inside the",
+            "   voltage range. A non-finite x_ref (NaN, +-inf) holds the last output. */",
+            f"double {p}_step({p}_state *s, double x_ref);",
+            "",
+            "#ifdef __cplusplus",
+            "}",
+            "#endif",
+            "",
+            f"#endif /* {guard} */",
+            "",
+        ]
+    )
+    local_lines = [f"    {line}" for line in template.locals]
+    source_text = "\n".join(
+        [
+            comment,
+            f'#include "{p}.h"',
+            "",
+            "#include <math.h>",
+            "",
+            *(f"{t}\n" for t in template.tables),
+            f"void {p}_reset({p}_state *s)",
+            "{",
+            *(f"    {line}" for line in template.reset_body),
+            f"    s->last = {c_double(template.initial_output)};",
+            "    s->nonfinite_count = 0;",
+            "}",
+            "",
+            f"void {p}_init({p}_state *s)",
+            "{",
+            f"    {p}_reset(s);",
+            "}",
+            "",
+            f"double {p}_step({p}_state *s, double x_ref)",
+            "{",
+            *local_lines,
+            "    double v;",
+            "",
+            "    if (!isfinite(x_ref)) { /* a broken sensor or reference: hold the output */",
+            "        s->nonfinite_count++;",
+            "        return s->last;",
+            "    }",
+            *(f"    {line}" if line else "" for line in template.step_body),
+            *(f"    {line}" if line else "" for line in _limits(template)),
+            *(f"    {line}" if line else "" for line in template.after_body),
+            "    s->last = v;",
+            "    return v;",
+            "}",
+            "",
+        ]
+    )
+    return header.replace("{p}", p), source_text.replace("{p}", p)
+
+
+def _limits(template: CTemplate) -> list[str]:
+    """Slew-rate limit, then clamp: the order of the Python compensators."""
+    lines = [""]
+    if np.isfinite(template.max_step):
+        step = c_double(template.max_step)
+        lines += [
+            f"/* slew-rate limit: at most {step} V per sample */",
+            f"if (v < s->last - {step}) {{",
+            f"    v = s->last - {step};",
+            "}",
+            f"if (v > s->last + {step}) {{",
+            f"    v = s->last + {step};",
+            "}",
+        ]
+    lo, hi = c_double(template.low), c_double(template.high)
+    return [
+        *lines,
+        "/* the amplifier's range: never drive the piezo outside it */",
+        f"if (v < {lo}) {{",
+        f"    v = {lo};",
+        "}",
+        f"if (v > {hi}) {{",
+        f"    v = {hi};",
+        "}",
+    ]
+
+
+def _header_comment(template: CTemplate, p: str, source: str | None, sample_rate: float) -> str:
+    if np.isfinite(template.max_step):
+        slew = (
+            f"  slew-rate limit {template.max_step:.9g} V per sample "
+            f"({template.max_step * sample_rate:.9g} V/s at {sample_rate:.9g} Hz)"
+        )
+    else:
+        slew = "  no slew-rate limit"
+    period_us = 1e6 / sample_rate
+    lines = [
+        f"{p}: hysteresis compensator generated by hystcomp (do not edit; re-export instead).",
+        "",
+        f"Model: {template.kind}" + (f", from {source}" if source else ""),
+        *template.summary,
+        slew,
+        "",
+        "Units: x_ref in um (micrometres), output in V (piezo voltage).",
+        "Build: any C99 compiler, e.g. cc -std=c99 -O2 -c " + f"{p}.c; no allocation, no",
+        "libraries beyond <math.h>. Do not build with -ffast-math or -ffinite-math-only:",
+        "they remove the isfinite() test that holds the output on a non-finite x_ref.",
+        "",
+        f"Use, for example from a {sample_rate / 1000:.6g} kHz timer interrupt:",
+        "",
+        f"    static {p}_state comp;",
+        f"    void controller_init(void) {{ {p}_init(&comp); }}",
+        f"    void timer_isr(void)   // every {period_us:.6g} us",
+        "    {",
+        "        double x_ref = next_reference_um();      // your reference, um",
+        f"        double v = {p}_step(&comp, x_ref);",
+        "        dac_write_volts(v);                      // your DAC, V",
+        "    }",
+    ]
+    body = "\n".join(f" * {line}".rstrip() for line in lines)
+    return f"/*\n{body}\n */"
