@@ -13,12 +13,24 @@ Columns can be named explicitly: ``{"v": 1, "x": 5}`` (1-based column numbers, f
 files) or ``{"v": "volts", "x": "disp"}`` (header names or keys); on the command line
 ``--columns v=1,x=5``. A file without a time column needs the sample rate. Writes go through
 :func:`hystcomp.io.atomic_path`: a failing write never truncates an existing file.
+
+Files are untrusted input: every problem (not a regular file, not text, a corrupt archive,
+text or complex numbers in a column, NaN or inf, a value beyond
+:data:`~hystcomp._validation.MAX_MAGNITUDE`, a time column that does not increase) is a
+:class:`~hystcomp.errors.DataFileError` naming the file, the column and the fix. NPZ files
+are read without pickle. MAT files are parsed in a separate process, because scipy's MAT
+reader is not hardened against corrupt files (it can crash the interpreter); a crash there
+is reported as a corrupt file.
 """
 
 from __future__ import annotations
 
 import io as _io
+import json
 import os
+import subprocess
+import sys
+import tempfile
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
@@ -26,8 +38,8 @@ from pathlib import Path
 import numpy as np
 import scipy.io
 
-from hystcomp._validation import check_real
-from hystcomp.errors import DataFileError, InvalidParameterError
+from hystcomp._validation import MAX_MAGNITUDE, as_signal, check_int, check_real
+from hystcomp.errors import DataFileError, InvalidParameterError, InvalidSignalError
 from hystcomp.io import atomic_path
 
 #: What each column holds, for messages.
@@ -35,6 +47,8 @@ MEANINGS = {"t": "time in s", "v": "voltage in V", "x": "displacement in µm"}
 WRITABLE = (".csv", ".npz", ".mat")
 #: Largest relative disagreement between a time column and a given sample rate.
 RATE_TOLERANCE = 0.01
+#: Longest time a MAT file may take to parse (s).
+MAT_TIMEOUT = 120.0
 
 
 @dataclass(frozen=True, eq=False)
@@ -60,6 +74,26 @@ class Record:
     x: np.ndarray
     source: str = "record"
 
+    def __post_init__(self):
+        arrays = {}
+        for key in ("t", "v", "x"):
+            try:
+                arr = as_signal(getattr(self, key), key, min_samples=1)
+            except InvalidSignalError as exc:
+                raise InvalidSignalError(f"Record {key!r}: {exc}") from None
+            arr = np.array(arr)  # an own, read-only copy
+            arr.setflags(write=False)
+            arrays[key] = arr
+        if len({arr.size for arr in arrays.values()}) > 1:
+            raise InvalidSignalError(
+                "Record: 't', 'v' and 'x' must have one sample each per instant. Got "
+                f"{', '.join(f'{k}: {a.size}' for k, a in arrays.items())} samples."
+            )
+        if not np.all(np.diff(arrays["t"]) > 0):
+            raise InvalidSignalError("Record: the time 't' must be strictly increasing.")
+        for key, arr in arrays.items():
+            object.__setattr__(self, key, arr)
+
     def __len__(self) -> int:
         return int(self.t.size)
 
@@ -71,7 +105,8 @@ class Record:
 
 def rate_of(t) -> float:
     """Sample rate in Hz of strictly increasing times ``t`` (s), from the median step."""
-    return float(1.0 / np.median(np.diff(t)))
+    with np.errstate(over="ignore", divide="ignore"):
+        return float(1.0 / np.median(np.diff(t)))
 
 
 def parse_columns(text: str | None) -> dict[str, int | str] | None:
@@ -88,6 +123,10 @@ def parse_columns(text: str | None) -> dict[str, int | str] | None:
     """
     if text is None:
         return None
+    if not isinstance(text, str):
+        raise InvalidParameterError(
+            f"The 'columns' option must be text such as v=1,x=5. Got {type(text).__name__}."
+        )
     mapping: dict[str, int | str] = {}
     for item in text.split(","):
         key, sep, value = (part.strip() for part in item.partition("="))
@@ -97,7 +136,7 @@ def parse_columns(text: str | None) -> dict[str, int | str] | None:
                 "v=volts,x=disp (header names), each of t, v, x at most once. "
                 f"Got {text!r} instead."
             )
-        if value.isdigit():
+        if value.isascii() and value.isdigit():
             if int(value) < 1:
                 raise InvalidParameterError(
                     f"Column numbers in 'columns' start at 1. Got {key}={value} in {text!r}."
@@ -155,10 +194,10 @@ def _read_text(path: Path, delimiter: str | None):
                 ndmin=2,
                 encoding="utf-8-sig",
             )
-    except ValueError as exc:
+    except (ValueError, IndexError, OverflowError) as exc:
         raise DataFileError(
-            f"Data file {str(path)!r} is not a table of numbers ({exc}). Every row after the "
-            "header must hold the same number of numeric columns."
+            f"Data file {str(path)!r} is not a table of numbers ({_reason(exc)}). Every row "
+            "after the header must hold the same number of numeric columns."
         ) from None
     if table.shape[0] == 0:
         raise DataFileError(f"Data file {str(path)!r} has a header but no data rows.")
@@ -170,25 +209,97 @@ def _read_text(path: Path, delimiter: str | None):
     return names, list(table.T)
 
 
-def _read_arrays(path: Path, suffix: str):
-    """Names and arrays of an NPZ or MAT file."""
+def _read_npz(path: Path):
+    """Names and arrays of an NPZ file (never unpickling)."""
     try:
-        if suffix == ".npz":
-            with np.load(path, allow_pickle=False) as npz:
-                arrays = {name: npz[name] for name in npz.files}
-        else:
-            arrays = {k: v for k, v in scipy.io.loadmat(path).items() if not k.startswith("__")}
-    except NotImplementedError:
+        loaded = np.load(path, allow_pickle=False)
+        if not isinstance(loaded, np.lib.npyio.NpzFile):
+            raise TypeError("it holds a single .npy array, not named arrays")
+        with loaded as npz:
+            arrays = {name: npz[name] for name in npz.files}
+    except MemoryError:
+        raise
+    except Exception as exc:  # noqa: BLE001 - any failure to parse foreign bytes
         raise DataFileError(
-            f"Data file {str(path)!r} is a MATLAB v7.3 (HDF5) file, which scipy cannot read. "
-            "Save it from MATLAB with save(..., '-v7')."
-        ) from None
-    except (ValueError, OSError, TypeError) as exc:
-        kind = "NumPy .npz" if suffix == ".npz" else "MATLAB .mat"
-        raise DataFileError(
-            f"Data file {str(path)!r} is not a readable {kind} file ({exc})."
+            f"Data file {str(path)!r} is not a readable NumPy .npz file ({_reason(exc)}). "
+            "Write it with numpy.savez (named arrays t, v, x)."
         ) from None
     return list(arrays), list(arrays.values())
+
+
+_MAT_CHILD = """
+import json, sys
+import numpy as np
+import scipy.io
+try:
+    variables = scipy.io.loadmat(sys.argv[1])
+except NotImplementedError:
+    sys.exit(4)
+except Exception as exc:
+    sys.stderr.write(f"{type(exc).__name__}: {exc}"[:300])
+    sys.exit(3)
+numeric, other = {}, []
+for name, value in variables.items():
+    if name.startswith("__"):
+        continue
+    if isinstance(value, np.ndarray) and value.dtype.kind in "iufc":
+        numeric[name] = value
+    else:
+        other.append(name)
+np.savez(sys.argv[2], **numeric)
+sys.stdout.write(json.dumps(other))
+"""
+
+
+def _read_mat(path: Path):
+    """Names and arrays of a MAT file, parsed by scipy in a child process.
+
+    The child writes the numeric variables to an NPZ file, read here without pickle; the
+    names of other variables (text, cells, structs) are kept, with a value that is refused
+    as "does not hold numbers".
+    """
+    where = f"Data file {str(path)!r}"
+    with tempfile.TemporaryDirectory(prefix="hystcomp-mat-") as folder:
+        out = Path(folder) / "variables.npz"
+        try:
+            child = subprocess.run(
+                [sys.executable, "-I", "-c", _MAT_CHILD, str(path.resolve()), str(out)],
+                capture_output=True,
+                text=True,
+                timeout=MAT_TIMEOUT,
+                check=False,
+            )
+        except subprocess.TimeoutExpired:
+            raise DataFileError(
+                f"{where} took more than {MAT_TIMEOUT:g} s to read as a MATLAB .mat file; it "
+                "is corrupt or too large. Save the columns as .csv or .npz instead."
+            ) from None
+        if child.returncode == 4:
+            raise DataFileError(
+                f"{where} is a MATLAB v7.3 (HDF5) file, which scipy cannot read. "
+                "Save it from MATLAB with save(..., '-v7')."
+            )
+        if child.returncode != 0:
+            reason = (
+                child.stderr.strip().splitlines()[-1][:200]
+                if child.returncode == 3 and child.stderr.strip()
+                else f"the reader stopped with status {child.returncode}"
+            )
+            raise DataFileError(
+                f"{where} is not a readable MATLAB .mat file ({reason}); the file is corrupt. "
+                "Save it again from MATLAB (save(..., '-v7')) or as .csv."
+            )
+        names, arrays = _read_npz(out)
+        try:
+            other = [str(name) for name in json.loads(child.stdout)]
+        except (ValueError, TypeError):
+            other = []
+    return [*names, *other], [*arrays, *([np.array(["(not numbers)"])] * len(other))]
+
+
+def _reason(exc: Exception) -> str:
+    text = str(exc).strip().splitlines()[0][:160] if str(exc).strip() else ""
+    return f"{type(exc).__name__}: {text}" if text else type(exc).__name__
 
 
 def _read_raw(path: Path):
@@ -196,14 +307,29 @@ def _read_raw(path: Path):
         raise DataFileError(f"Data file {str(path)!r} does not exist; check the path.")
     if path.is_dir():
         raise DataFileError(f"{str(path)!r} is a folder, not a data file.")
+    if not path.is_file():
+        raise DataFileError(
+            f"{str(path)!r} is not a regular file (a device or a pipe?); save the data to a "
+            "file first."
+        )
     suffix = path.suffix.lower()
     try:
-        if suffix in (".npz", ".mat"):
-            return (*_read_arrays(path, suffix), False)
+        if suffix == ".npz":
+            return (*_read_npz(path), False)
+        if suffix == ".mat":
+            return (*_read_mat(path), False)
         return (*_read_text(path, "," if suffix == ".csv" else None), True)
     except UnicodeDecodeError:
         raise DataFileError(
             f"Data file {str(path)!r} is not text; use .csv, .npz, .mat or a text table."
+        ) from None
+    except MemoryError:
+        raise DataFileError(
+            f"Data file {str(path)!r} is too large for this computer's memory (or corrupt)."
+        ) from None
+    except OSError as exc:
+        raise DataFileError(
+            f"Cannot read data file {str(path)!r}: {exc.strerror or exc}."
         ) from None
 
 
@@ -213,8 +339,9 @@ def _pick(path: Path, names, arrays, positional, key: str, spec, required: bool)
     if isinstance(spec, int):
         if not positional:
             raise DataFileError(
-                f"{where} has named arrays ({', '.join(names)}), not numbered columns: "
-                f"name the array for {key!r} instead of {spec} (for example {key}={names[0]})."
+                f"{where} has named arrays ({', '.join(names) or 'none'}), not numbered "
+                f"columns: name the array for {key!r} instead of {spec} (for example "
+                f"{key}={names[0] if names else 'NAME'})."
             )
         if spec > len(arrays):
             raise DataFileError(
@@ -242,10 +369,12 @@ def _pick(path: Path, names, arrays, positional, key: str, spec, required: bool)
 
 def _as_column(arr, path: Path, key: str, label: str) -> np.ndarray:
     what = f"The {label} of {str(path)!r} ({key!r}, {MEANINGS[key]})"
-    try:
-        out = np.asarray(arr, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise DataFileError(f"{what} does not hold numbers.") from None
+    arr = np.asarray(arr)
+    if arr.dtype.kind == "c":
+        raise DataFileError(f"{what} holds complex numbers; save the real part only.")
+    if arr.dtype.kind not in "iuf":
+        raise DataFileError(f"{what} does not hold numbers (it holds {arr.dtype} values).")
+    out = np.asarray(arr, dtype=np.float64)
     if out.ndim > 1 and sorted(out.shape)[-2] == 1:
         out = out.reshape(-1)
     if out.ndim != 1:
@@ -258,6 +387,13 @@ def _as_column(arr, path: Path, key: str, label: str) -> np.ndarray:
             f"{what} has a non-finite value ({float(out[bad[0]])!r}) in data row "
             f"{bad[0] + 1}: remove or interpolate that row."
         )
+    if key != "t":
+        big = np.flatnonzero(np.abs(out) > MAX_MAGNITUDE)
+        if big.size:
+            raise DataFileError(
+                f"{what} has the value {float(out[big[0]])!r} in data row {big[0] + 1}, "
+                f"beyond {MAX_MAGNITUDE:g}: check the units and the column."
+            )
     return out
 
 
@@ -290,8 +426,17 @@ def read_table(path, keys=("v", "x"), *, columns=None, sample_rate=None, min_sam
     DataFileError
         Naming the file, the column, the problem and the fix.
     """
-    path = Path(os.fspath(path))
+    path = _data_path(path)
+    keys = tuple(keys) if not isinstance(keys, str) else (keys,)
+    if not keys or any(key not in ("v", "x") for key in keys) or len(set(keys)) < len(keys):
+        raise InvalidParameterError(
+            f"The 'keys' parameter of read_table must name 'v' and/or 'x' once each. "
+            f"Got {keys!r} instead."
+        )
+    min_samples = check_int(min_samples, "min_samples", "read_table", minimum=1)
     columns = _check_columns(columns)
+    if sample_rate is not None:
+        sample_rate = check_real(sample_rate, "sample_rate", "read_table", positive=True)
     names, arrays, positional = _read_raw(path)
     out = {}
     for key in ("t", *keys):
@@ -309,8 +454,6 @@ def read_table(path, keys=("v", "x"), *, columns=None, sample_rate=None, min_sam
         raise DataFileError(
             f"Data file {str(path)!r} has {n} samples; at least {min_samples} are needed."
         )
-    if sample_rate is not None:
-        sample_rate = check_real(sample_rate, "sample_rate", "read_table", positive=True)
     out["t"] = _time(path, out.get("t"), n, sample_rate)
     for arr in out.values():
         arr.setflags(write=False)
@@ -325,7 +468,9 @@ def _time(path: Path, t, n: int, sample_rate):
                 "--fs HZ on the command line (sample_rate=HZ in Python)."
             )
         return np.arange(n) / sample_rate
-    steps = np.diff(t)
+    with np.errstate(over="ignore", invalid="ignore"):
+        steps = np.diff(t)
+        span = t[-1] - t[0]
     bad = np.flatnonzero(~(steps > 0))
     if bad.size:
         k = int(bad[0]) + 1
@@ -335,13 +480,18 @@ def _time(path: Path, t, n: int, sample_rate):
             "rows and remove duplicates, or drop the time column and give the sample rate "
             "(--fs)."
         )
-    if sample_rate is not None:
-        rate = rate_of(t)
-        if abs(rate - sample_rate) > RATE_TOLERANCE * sample_rate:
-            raise DataFileError(
-                f"The time column 't' of {str(path)!r} says {rate:.6g} Hz but the sample rate "
-                f"given is {sample_rate:.6g} Hz. Give one of them, not both."
-            )
+    rate = rate_of(t)
+    if not (np.isfinite(span) and 0.0 < rate < np.inf):
+        raise DataFileError(
+            f"The time column 't' of {str(path)!r} spans {float(t[0])!r} to {float(t[-1])!r} s, "
+            "which gives no usable sample rate. Check the units of the time column, or drop "
+            "it and give the sample rate (--fs)."
+        )
+    if sample_rate is not None and abs(rate - sample_rate) > RATE_TOLERANCE * sample_rate:
+        raise DataFileError(
+            f"The time column 't' of {str(path)!r} says {rate:.6g} Hz but the sample rate "
+            f"given is {sample_rate:.6g} Hz. Give one of them, not both."
+        )
     return t
 
 
@@ -373,6 +523,33 @@ def format_csv(table: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
+def check_writable(path) -> Path:
+    """``path`` as a Path if :func:`write_table` can write its format, else raise.
+
+    Raises
+    ------
+    DataFileError
+        If the suffix is not one of ``.csv``, ``.npz``, ``.mat``.
+    """
+    path = Path(os.fspath(path))
+    suffix = path.suffix.lower()
+    if suffix not in WRITABLE:
+        raise DataFileError(
+            f"Cannot write {str(path)!r}: unknown format {suffix or '(no suffix)'!r}. "
+            f"Use a name ending in {', '.join(WRITABLE)}."
+        )
+    return path
+
+
+def _data_path(path) -> Path:
+    try:
+        return Path(os.fspath(path))
+    except TypeError:
+        raise InvalidParameterError(
+            f"The 'path' parameter must be a file name. Got {type(path).__name__}."
+        ) from None
+
+
 def write_table(path, table: dict) -> None:
     """Write equally long columns to ``path`` as CSV, NPZ or MAT (by suffix), atomically.
 
@@ -383,14 +560,26 @@ def write_table(path, table: dict) -> None:
     table : dict of str to array_like
         Column name to values, e.g. ``{"t": t, "v": v, "x": x}``.
     """
-    path = Path(os.fspath(path))
+    path = check_writable(path)
     suffix = path.suffix.lower()
-    if suffix not in WRITABLE:
-        raise DataFileError(
-            f"Cannot write {str(path)!r}: unknown format {suffix or '(no suffix)'!r}. "
-            f"Use a name ending in {', '.join(WRITABLE)}."
+    if not isinstance(table, dict) or not table:
+        raise InvalidParameterError(
+            "The 'table' parameter of write_table must be a non-empty dict of column name to "
+            f"values. Got {type(table).__name__}."
         )
-    cols = {k: np.asarray(v, dtype=np.float64).reshape(-1) for k, v in table.items()}
+    cols = {}
+    for name, values in table.items():
+        if not (isinstance(name, str) and name.isidentifier() and name.isascii()):
+            raise InvalidParameterError(
+                f"Column names of write_table must be ASCII identifiers such as 'x_ref'. "
+                f"Got {name!r}."
+            )
+        try:
+            cols[name] = np.asarray(values, dtype=np.float64).reshape(-1)
+        except (TypeError, ValueError, OverflowError):
+            raise InvalidParameterError(
+                f"Column {name!r} of write_table does not hold numbers."
+            ) from None
     lengths = {k: v.size for k, v in cols.items()}
     if len(set(lengths.values())) != 1:
         raise DataFileError(
