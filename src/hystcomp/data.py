@@ -391,7 +391,7 @@ def _as_column(arr, path: Path, key: str, label: str) -> np.ndarray:
         big = np.flatnonzero(np.abs(out) > MAX_MAGNITUDE)
         if big.size:
             raise DataFileError(
-                f"{what} has the value {float(out[big[0]])!r} in data row {big[0] + 1}, "
+                f"{what} has the value {float(out[big[0]]):.6g} in data row {big[0] + 1}, "
                 f"beyond {MAX_MAGNITUDE:g}: check the units and the column."
             )
     return out

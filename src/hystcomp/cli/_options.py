@@ -21,7 +21,10 @@ MAX_OPERATORS = 1000
 
 def _finite(value: float, param) -> float:
     if not (math.isfinite(value) and abs(value) <= MAX_MAGNITUDE):
-        raise click.BadParameter(f"must be a finite number; got {value!r}.", param=param)
+        raise click.BadParameter(
+            f"must be a finite number of size at most {MAX_MAGNITUDE:g}; got {value!r}.",
+            param=param,
+        )
     return value
 
 
@@ -127,5 +130,5 @@ def read_options(columns: dict | None, sample_rate: float | None) -> dict:
 
 def check_data_output(path, *, inputs=(), what: str = "output"):
     """Refuse, before any work, a data output that cannot be written or would overwrite an input."""
-    check_writable(path)
-    return check_output_path(path, inputs=inputs, what=what)
+    check_output_path(path, inputs=inputs, what=what)
+    return check_writable(path)
