@@ -149,7 +149,7 @@ def as_signal(value, name: str, *, min_samples: int = 1) -> np.ndarray:
         if np.isfinite(value):
             raise InvalidSignalError(
                 f"{name!r} must hold samples of magnitude at most {MAX_MAGNITUDE:g}. Sample "
-                f"{bad} is {value!r}; check the units."
+                f"{bad} is {value:.6g}; check the units."
             )
         raise InvalidSignalError(
             f"{name!r} must be finite. Sample {bad} is {value!r}; "

@@ -212,11 +212,12 @@ def _read_text(path: Path, delimiter: str | None):
 def _read_npz(path: Path):
     """Names and arrays of an NPZ file (never unpickling)."""
     try:
-        loaded = np.load(path, allow_pickle=False)
-        if not isinstance(loaded, np.lib.npyio.NpzFile):
-            raise TypeError("it holds a single .npy array, not named arrays")
-        with loaded as npz:
-            arrays = {name: npz[name] for name in npz.files}
+        with path.open("rb") as file:  # our handle: closed whatever numpy does
+            loaded = np.load(file, allow_pickle=False)
+            if not isinstance(loaded, np.lib.npyio.NpzFile):
+                raise TypeError("it holds a single .npy array, not named arrays")
+            with loaded as npz:
+                arrays = {name: npz[name] for name in npz.files}
     except MemoryError:
         raise
     except Exception as exc:  # noqa: BLE001 - any failure to parse foreign bytes

@@ -111,13 +111,15 @@ def atomic_paths(*paths: str | os.PathLike):
                 )
                 os.close(fd)
                 tmps.append(Path(tmp))
+            current = None  # the caller writes any of them
             yield list(tmps)
             for tmp, current in zip(tmps, paths, strict=True):
                 os.replace(tmp, current)
         except OSError as exc:
+            names = ", ".join(repr(str(p)) for p in ([current] if current else paths))
             raise OutputPathError(
-                f"Cannot write {str(current)!r}: {exc.strerror or exc}. Check the permissions "
-                "and the free space of its folder."
+                f"Cannot write {names}: {exc.strerror or exc}. Check the permissions and the "
+                "free space of the folder."
             ) from None
     finally:
         for tmp in tmps:
@@ -168,7 +170,7 @@ def _check_value(value: Any, where: str, source: str, *, depth: int = 0) -> None
     """A parameter value: a JSON number, null, or an array (of arrays) of them."""
     if value is None or (isinstance(value, int | float) and not isinstance(value, bool)):
         return
-    if isinstance(value, list) and depth < 2:
+    if isinstance(value, list | tuple) and depth < 2:
         for i, item in enumerate(value):
             _check_value(item, f"{where}[{i}]", source, depth=depth + 1)
         return
@@ -176,7 +178,7 @@ def _check_value(value: Any, where: str, source: str, *, depth: int = 0) -> None
         found = f"the boolean {json.dumps(value)}"
     elif isinstance(value, str):
         found = f"the text {value[:40]!r}"
-    elif isinstance(value, list):
+    elif isinstance(value, list | tuple):
         found = "an array nested too deep"
     else:
         found = "an object"
@@ -234,8 +236,8 @@ def _check_document(doc: Any, source: str) -> type[HysteresisModel]:
                 f'{source} has a "{key}" that is not an object; the file is corrupt.'
             )
     for name, value in doc.get("hyperparameters", {}).items():
-        if isinstance(value, dict | list) and not (
-            isinstance(value, list) and all(isinstance(v, int | float) for v in value)
+        if isinstance(value, dict | list | tuple) and not (
+            isinstance(value, list | tuple) and all(isinstance(v, int | float) for v in value)
         ):
             raise ModelFileError(
                 f'{source} has an invalid hyperparameter "{name}" ({json.dumps(value)[:60]}); '

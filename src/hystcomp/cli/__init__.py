@@ -7,6 +7,7 @@ traceback), 1 on an internal fault.
 
 from __future__ import annotations
 
+import contextlib
 import os
 import sys
 
@@ -50,7 +51,8 @@ class _Group(click.Group):
             )
             sys.exit(EXIT_BAD_INPUT)
         except BrokenPipeError:  # the reader of standard output went away (e.g. | head)
-            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+            with contextlib.suppress(OSError, ValueError):  # no flush error at exit either
+                os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
             sys.exit(EXIT_BROKEN_PIPE)
         except KeyboardInterrupt:
             click.echo("hystcomp: interrupted", err=True)
