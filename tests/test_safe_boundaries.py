@@ -204,7 +204,7 @@ def test_read_table_checks_its_own_arguments(tmp_path):
         read_table(path, ("y",))
     with pytest.raises(InvalidParameterError, match=r"'min_samples'"):
         read_table(path, min_samples=0)
-    with pytest.raises(InvalidParameterError, match=r"'path' parameter"):
+    with pytest.raises(InvalidTypeError, match=r"'path' parameter of read_table"):
         read_table(3.5)
     np.savez(tmp_path / "c.npz", t=np.arange(2.0), v=np.ones(2) * 1j, x=np.ones(2))
     with pytest.raises(DataFileError, match=r"'v'.*holds complex numbers"):
@@ -235,3 +235,48 @@ def test_no_pickle_anywhere_in_the_package():
             if isinstance(node, ast.keyword) and node.arg == "allow_pickle":
                 assert isinstance(node.value, ast.Constant), path
                 assert node.value.value is False, path
+
+
+GARBAGE = [None, "abc", [], [[1.0, 2.0]], float("nan"), -1, 10**400, object(), [1.0, np.nan]]
+PUBLIC = {
+    "simulate": lambda a: presets.paper_pi().simulate(a),
+    "inverse simulate": lambda a: presets.paper_mpi().inverse().simulate(a),
+    "inverse options": lambda a: presets.paper_mpi().inverse(slew_rate=a, sample_rate=a),
+    "inverse voltage_range": lambda a: presets.paper_mpi().inverse(voltage_range=a),
+    "fit": lambda a: hystcomp.PrandtlIshlinskii(n_operators=2).fit(a, a),
+    "fit hyperparameters": lambda a: hystcomp.ModifiedPrandtlIshlinskii(
+        n_operators=a, n_deadzones=a, transient=a, margin=a
+    ).fit(np.r_[0:10, 10:0:-1.0], np.r_[0:10, 10:0:-1.0]),
+    "from_parameters": lambda a: hystcomp.PrandtlIshlinskii.from_parameters(
+        thresholds=a, weights=a
+    ),
+    "from_dict": lambda a: hystcomp.PrandtlIshlinskii.from_dict(a),
+    "model_from_dict": lambda a: model_io.model_from_dict(a),
+    "load_model": lambda a: hystcomp.load_model(a),
+    "save_model": lambda a: hystcomp.save_model(a, a),
+    "read_table": lambda a: read_table(a),
+    "read_table columns": lambda a: read_table(SRC / "py.typed", columns=a, sample_rate=a),
+    "write_table": lambda a: hystcomp.data.write_table(a, {"t": a}),
+    "format_csv": lambda a: hystcomp.data.format_csv(a),
+    "rate_of": lambda a: hystcomp.data.rate_of(a),
+    "Record": lambda a: Record(a, a, a),
+    "parse_columns": lambda a: parse_columns(a),
+    "triangle_sequence": lambda a: triangle_sequence(a, sample_rate=a, frequency=a),
+    "fit_pi": lambda a: hystcomp.identify.pi.fit_pi(a, a),
+    "paper_thresholds": lambda a: hystcomp.identify.pi.paper_thresholds(a, a),
+    "error_report": lambda a: hystcomp.identify.scoring.error_report(a, a),
+    "straight_line": lambda a: hystcomp.identify.scoring.straight_line(a, a),
+    "absorb_bias": lambda a: hystcomp.identify.mpi.absorb_bias(a, a, a, a),
+}
+
+
+@pytest.mark.parametrize("name", sorted(PUBLIC))
+def test_public_functions_refuse_garbage_with_package_errors(name):
+    """Each value is accepted or refused with a hystcomp error, never another exception."""
+    refused = 0
+    for value in GARBAGE:
+        try:
+            PUBLIC[name](value)
+        except hystcomp.errors.HystcompError:
+            refused += 1
+    assert refused >= 4

@@ -7,7 +7,9 @@ Messages follow one pattern: what the argument must be, what was found, and the 
 from __future__ import annotations
 
 import numbers
+import os
 import warnings
+from pathlib import Path
 
 import numpy as np
 
@@ -121,6 +123,20 @@ def check_thresholds(value, name: str, owner: str) -> np.ndarray:
             f"Entry {bad} ({float(r[bad])!r}) is not above entry {bad - 1} ({float(r[bad - 1])!r})."
         )
     return r
+
+
+def as_path(value, name: str, owner: str) -> Path:
+    """Return ``value`` (a str or path-like) as a Path, or raise a message that names it."""
+    try:
+        path = Path(os.fspath(value))
+    except TypeError:
+        raise InvalidTypeError(
+            f"The {name!r} parameter of {owner} must be a file name (str or path-like). "
+            f"Got {type(value).__name__}."
+        ) from None
+    if not str(value):
+        raise InvalidParameterError(f"The {name!r} parameter of {owner} is an empty file name.")
+    return path
 
 
 def as_signal(value, name: str, *, min_samples: int = 1) -> np.ndarray:

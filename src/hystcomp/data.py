@@ -27,7 +27,6 @@ from __future__ import annotations
 
 import io as _io
 import json
-import os
 import subprocess
 import sys
 import tempfile
@@ -38,7 +37,7 @@ from pathlib import Path
 import numpy as np
 import scipy.io
 
-from hystcomp._validation import MAX_MAGNITUDE, as_signal, check_int, check_real
+from hystcomp._validation import MAX_MAGNITUDE, as_path, as_signal, check_int, check_real
 from hystcomp.errors import DataFileError, InvalidParameterError, InvalidSignalError
 from hystcomp.io import atomic_path
 
@@ -105,6 +104,7 @@ class Record:
 
 def rate_of(t) -> float:
     """Sample rate in Hz of strictly increasing times ``t`` (s), from the median step."""
+    t = as_signal(t, "t", min_samples=2)
     with np.errstate(over="ignore", divide="ignore"):
         return float(1.0 / np.median(np.diff(t)))
 
@@ -149,6 +149,11 @@ def parse_columns(text: str | None) -> dict[str, int | str] | None:
 
 def _check_columns(columns) -> dict:
     """A column mapping {key: 1-based number or name}, keys among t, v, x."""
+    if columns is not None and not isinstance(columns, dict):
+        raise InvalidParameterError(
+            "The 'columns' parameter of read_table must be a dict such as {'v': 1, 'x': 5}. "
+            f"Got {type(columns).__name__}."
+        )
     columns = dict(columns or {})
     for key, spec in columns.items():
         number = isinstance(spec, int) and not isinstance(spec, bool) and spec >= 1
@@ -427,7 +432,7 @@ def read_table(path, keys=("v", "x"), *, columns=None, sample_rate=None, min_sam
     DataFileError
         Naming the file, the column, the problem and the fix.
     """
-    path = _data_path(path)
+    path = as_path(path, "path", "read_table")
     keys = tuple(keys) if not isinstance(keys, str) else (keys,)
     if not keys or any(key not in ("v", "x") for key in keys) or len(set(keys)) < len(keys):
         raise InvalidParameterError(
@@ -516,10 +521,35 @@ def read_record(path, *, columns=None, sample_rate=None) -> Record:
     return Record(table["t"], v, table["x"], source=str(path))
 
 
+def _columns(table, owner: str) -> dict[str, np.ndarray]:
+    """Column name (an ASCII identifier) to a 1-D float64 array, validated."""
+    if not isinstance(table, dict) or not table:
+        raise InvalidParameterError(
+            f"The 'table' parameter of {owner} must be a non-empty dict of column name to "
+            f"values. Got {type(table).__name__}."
+        )
+    cols = {}
+    for name, values in table.items():
+        if not (isinstance(name, str) and name.isidentifier() and name.isascii()):
+            raise InvalidParameterError(
+                f"Column names of {owner} must be ASCII identifiers such as 'x_ref'. Got {name!r}."
+            )
+        try:
+            cols[name] = np.asarray(values, dtype=np.float64).reshape(-1)
+        except (TypeError, ValueError, OverflowError):
+            raise InvalidParameterError(
+                f"Column {name!r} of {owner} does not hold numbers."
+            ) from None
+    return cols
+
+
 def format_csv(table: dict) -> str:
     """A table of equally long columns as CSV text with a header row (shortest round-trip)."""
-    keys = list(table)
-    rows = np.column_stack([np.asarray(table[k], dtype=np.float64) for k in keys]).tolist()
+    cols = _columns(table, "format_csv")
+    if len({c.size for c in cols.values()}) != 1:
+        raise InvalidParameterError("The columns given to format_csv have different lengths.")
+    keys = list(cols)
+    rows = np.column_stack([cols[k] for k in keys]).tolist()
     lines = [",".join(keys), *(",".join(map(repr, row)) for row in rows)]
     return "\n".join(lines) + "\n"
 
@@ -532,7 +562,7 @@ def check_writable(path) -> Path:
     DataFileError
         If the suffix is not one of ``.csv``, ``.npz``, ``.mat``.
     """
-    path = Path(os.fspath(path))
+    path = as_path(path, "path", "write_table")
     suffix = path.suffix.lower()
     if suffix not in WRITABLE:
         raise DataFileError(
@@ -540,15 +570,6 @@ def check_writable(path) -> Path:
             f"Use a name ending in {', '.join(WRITABLE)}."
         )
     return path
-
-
-def _data_path(path) -> Path:
-    try:
-        return Path(os.fspath(path))
-    except TypeError:
-        raise InvalidParameterError(
-            f"The 'path' parameter must be a file name. Got {type(path).__name__}."
-        ) from None
 
 
 def write_table(path, table: dict) -> None:
@@ -563,24 +584,7 @@ def write_table(path, table: dict) -> None:
     """
     path = check_writable(path)
     suffix = path.suffix.lower()
-    if not isinstance(table, dict) or not table:
-        raise InvalidParameterError(
-            "The 'table' parameter of write_table must be a non-empty dict of column name to "
-            f"values. Got {type(table).__name__}."
-        )
-    cols = {}
-    for name, values in table.items():
-        if not (isinstance(name, str) and name.isidentifier() and name.isascii()):
-            raise InvalidParameterError(
-                f"Column names of write_table must be ASCII identifiers such as 'x_ref'. "
-                f"Got {name!r}."
-            )
-        try:
-            cols[name] = np.asarray(values, dtype=np.float64).reshape(-1)
-        except (TypeError, ValueError, OverflowError):
-            raise InvalidParameterError(
-                f"Column {name!r} of write_table does not hold numbers."
-            ) from None
+    cols = _columns(table, "write_table")
     lengths = {k: v.size for k, v in cols.items()}
     if len(set(lengths.values())) != 1:
         raise DataFileError(

@@ -21,6 +21,7 @@ import tempfile
 from pathlib import Path
 from typing import Any
 
+from hystcomp._validation import as_path
 from hystcomp.errors import HystcompError, InvalidTypeError, ModelFileError, OutputPathError
 from hystcomp.models.base import HysteresisModel
 from hystcomp.models.mpi import ModifiedPrandtlIshlinskii
@@ -59,7 +60,7 @@ def check_output_path(path: str | os.PathLike, *, inputs=(), what: str = "output
     OutputPathError
         If the folder does not exist, ``path`` is a folder, or ``path`` is one of ``inputs``.
     """
-    path = Path(os.fspath(path))
+    path = as_path(path, "path", "check_output_path")
     if path.is_dir():
         raise OutputPathError(
             f"Cannot write the {what} {str(path)!r}: it is a folder. Give a file name, "
@@ -71,7 +72,7 @@ def check_output_path(path: str | os.PathLike, *, inputs=(), what: str = "output
             "exist. Create it first or choose another output path."
         )
     for source in inputs:
-        if source is not None and _same_file(path, Path(os.fspath(source))):
+        if source is not None and _same_file(path, as_path(source, "inputs", "check_output_path")):
             raise OutputPathError(
                 f"Cannot write the {what} {str(path)!r}: it is the input file "
                 f"{str(source)!r}, which would be overwritten. Choose another output path."
@@ -284,7 +285,7 @@ def load_model(path: str | os.PathLike) -> HysteresisModel:
         If the file is missing, not a regular file, too large, not JSON, holds NaN or
         Infinity, or is not a valid model of a known kind and supported version.
     """
-    path = Path(os.fspath(path))
+    path = as_path(path, "path", "load_model")
     name = repr(str(path))
     try:
         if path.is_dir():

@@ -36,8 +36,9 @@ def paper_thresholds(n_operators: int, span: float) -> np.ndarray:
     >>> paper_thresholds(4, 120.0).tolist()
     [0.0, 30.0, 60.0, 90.0]
     """
-    n_operators = check_int(n_operators, "n_operators", "paper_thresholds")
-    return np.arange(n_operators) / n_operators * float(span)
+    n_operators = check_int(n_operators, "n_operators", "paper_thresholds", maximum=10**6)
+    span = check_real(span, "span", "paper_thresholds", positive=True)
+    return np.arange(n_operators) / n_operators * span
 
 
 @dataclass(frozen=True)

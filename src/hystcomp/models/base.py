@@ -62,7 +62,15 @@ class HysteresisModel(ChainSystem):
 
     @classmethod
     def from_dict(cls, data: dict[str, Any]):
-        """Inverse of :meth:`to_dict` (validates everything through ``from_parameters``)."""
+        """Inverse of :meth:`to_dict` (validates everything through ``from_parameters``).
+
+        :func:`hystcomp.io.model_from_dict` checks a whole document (keys, JSON types) first.
+        """
+        if not (isinstance(data, dict) and isinstance(data.get("parameters"), dict)):
+            raise InvalidParameterError(
+                f"{cls.__name__}.from_dict needs a dict with a 'parameters' dict (as written "
+                f"by to_dict). Got {type(data).__name__}."
+            )
         model = cls.from_parameters(**data["parameters"])
         for name, value in data.get("hyperparameters", {}).items():
             if name in cls._hyper:
