@@ -157,6 +157,20 @@ def test_a_failed_rename_or_write_leaves_every_file_as_it_was(tmp_path, monkeypa
     assert sorted(p.name for p in tmp_path.iterdir()) == ["a.csv", "b.csv"]
 
 
+def test_outputs_get_ordinary_permissions(tmp_path):
+    """Not the private mode of a temporary file: the umask's, or the replaced file's."""
+    umask = os.umask(0o022)
+    try:
+        write_table(tmp_path / "new.csv", {"t": [0.0, 1.0]})
+        (tmp_path / "old.csv").write_text("old")
+        (tmp_path / "old.csv").chmod(0o640)
+        write_table(tmp_path / "old.csv", {"t": [0.0, 1.0]})
+    finally:
+        os.umask(umask)
+    assert (tmp_path / "new.csv").stat().st_mode & 0o777 == 0o644
+    assert (tmp_path / "old.csv").stat().st_mode & 0o777 == 0o640
+
+
 def test_output_path_errors_are_their_own_class(tmp_path):
     with pytest.raises(OutputPathError, match=r"folder '.*nowhere' does not exist") as err:
         write_table(tmp_path / "nowhere" / "x.csv", {"t": [0.0, 1.0]})

@@ -87,6 +87,15 @@ def _same_file(a: Path, b: Path) -> bool:
     return os.path.abspath(a) == os.path.abspath(b)
 
 
+def _mode_for(path: Path) -> int:
+    """Permissions for a new ``path``: those of the file it replaces, else the umask's."""
+    with contextlib.suppress(OSError):
+        return path.stat().st_mode & 0o7777
+    umask = os.umask(0)
+    os.umask(umask)
+    return 0o666 & ~umask
+
+
 @contextlib.contextmanager
 def atomic_paths(*paths: str | os.PathLike):
     """Yield a list of temporary paths beside ``paths``; on success rename each onto its path.
@@ -112,6 +121,7 @@ def atomic_paths(*paths: str | os.PathLike):
                 )
                 os.close(fd)
                 tmps.append(Path(tmp))
+                os.chmod(tmp, _mode_for(current))
             current = None  # the caller writes any of them
             yield list(tmps)
             for tmp, current in zip(tmps, paths, strict=True):
