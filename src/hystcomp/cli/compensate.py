@@ -33,6 +33,14 @@ def inverse_options(model, table, *, slew_rate, narrow_range) -> dict:
         shortest = float(np.min(np.diff(table["t"])))
         options.update(slew_rate=slew_rate, sample_rate=1.0 / shortest)
     if narrow_range is not None:
+        (lo, hi), (low, high) = model.voltage_range_, narrow_range
+        if low < lo or high > hi:
+            raise click.BadParameter(
+                f"may only narrow the model's voltage range {lo:g} .. {hi:g} V: the model was "
+                f"identified inside it and would command voltages it never saw. Got {low:g} "
+                f"{high:g}; choose limits within it, or identify over a wider range.",
+                param_hint="'--voltage-range'",
+            )
         if "voltage_range" not in inspect.signature(model.inverse).parameters:
             raise InvalidParameterError(
                 f"--voltage-range is not available for {model.kind!r} models; their "

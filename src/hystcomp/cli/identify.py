@@ -128,7 +128,9 @@ def identify(
         raise click.BadParameter(f"must end in {', '.join(FIGURE_FORMATS)}.", param_hint="--plot")
     check_output_path(output, inputs=(data,), what="model file")
     if plot is not None:
-        check_output_path(plot, inputs=(data, output), what="figure")
+        check_output_path(plot, inputs=(data,), what="figure")
+        if Path(plot).resolve() == Path(output).resolve():
+            raise click.BadParameter("names the same file as -o.", param_hint="--plot")
     model = build_estimator(
         kind, operators=operators, deadzones=deadzones, voltage_range=voltage_range
     )
