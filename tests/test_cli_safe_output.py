@@ -210,3 +210,13 @@ def test_closed_standard_output_is_not_an_internal_error(monkeypatch):
     result = run("excite", "pi", "--fs", "10")
     assert result.exit_code == 141
     assert "internal error" not in result.output
+
+
+@pytest.mark.parametrize("make", [presets.paper_pi, presets.paper_mpi])
+def test_stepper_never_commands_nan_for_huge_finite_references(make):
+    """A garbage float from a sensor (1e308) overflows inside the chain: the output holds."""
+    stepper = make().inverse().stepper()
+    outputs = [stepper.step(x) for x in (10.0, 1e308, -1e308, 1e300, 20.0)]
+    assert all(0.0 <= v <= 120.0 for v in outputs), outputs
+    assert outputs[1] == outputs[0]  # held, like a non-finite reference
+    assert stepper.nonfinite_count >= 1

@@ -128,12 +128,20 @@ def _read_mat(path: Path):
         out = Path(folder) / "variables.npz"
         try:
             child = subprocess.run(
-                [sys.executable, "-I", "-c", _MAT_CHILD, str(path.resolve()), str(out)],
+                # -P: the working folder is not on the child's path (no module of it shadows
+                # numpy or scipy), while PYTHONPATH still applies
+                [sys.executable, "-P", "-c", _MAT_CHILD, str(path.resolve()), str(out)],
                 capture_output=True,
                 text=True,
                 timeout=MAT_TIMEOUT,
                 check=False,
             )
+        except OSError as exc:
+            raise DataFileError(
+                f"{where} is a MATLAB .mat file, which is read by a Python child process, and "
+                f"{sys.executable!r} could not be started ({exc.strerror or exc}). Save the "
+                "columns as .csv or .npz instead."
+            ) from None
         except subprocess.TimeoutExpired:
             raise DataFileError(
                 f"{where} took more than {MAT_TIMEOUT:g} s to read as a MATLAB .mat file; it "

@@ -85,7 +85,8 @@ def chain_state_start(p):
 def chain_step(p, u):
     """One sample through packed chain ``p``; updates the state in ``p`` and returns the output.
 
-    A non-finite ``u`` holds the last output and increments the non-finite counter.
+    A non-finite ``u``, or a result that overflows to NaN (a ``u`` near the float range),
+    holds the last output and increments the non-finite counter.
     """
     n_pre = int(p[N_PRE])
     n_play = int(p[N_PLAY])
@@ -113,6 +114,11 @@ def chain_step(p, u):
     if n_post > 0:
         z = deadzone_sum(z, p[o : o + n_post], p[o + n_post : o + 2 * n_post])
     out = z + p[OUT_OFFSET]
+    # NaN from an overflow (u finite but near the float range): hold, as for a non-finite u.
+    # Written as a comparison: fast-math folds the `out - out` test away here.
+    if not abs(out) <= np.inf:
+        p[s + STATE_NONFINITE] += 1.0
+        return last
     step = p[MAX_STEP]
     out = min(max(out, last - step), last + step)
     out = min(max(out, p[LOW]), p[HIGH])
