@@ -22,8 +22,6 @@ from hystcomp.errors import IdentificationError
 from hystcomp.identify.scoring import error_report, holdout_report, straight_line, transient_end
 from hystcomp.io import MODEL_KINDS, atomic_paths, check_output_path, model_text
 
-FIGURE_FORMATS = (".png", ".pdf", ".svg")  # those of plot_identification
-
 DEFAULT_OPERATORS = 16
 
 #: What each --model builds, and which size options it takes.
@@ -124,10 +122,12 @@ def identify(
     PI and MPI: constrained least squares (eqs. 16-19) with invertible weights; the
     start-up transient, the input range (bipolar too) and a displacement offset are handled.
     """
-    if plot is not None and Path(plot).suffix.lower() not in FIGURE_FORMATS:
-        raise click.BadParameter(f"must end in {', '.join(FIGURE_FORMATS)}.", param_hint="--plot")
     check_output_path(output, inputs=(data,), what="model file")
-    if plot is not None:
+    if plot is not None:  # matplotlib is imported only when a figure is asked for
+        from hystcomp.experiment.fig_identification import FORMATS, plot_identification
+
+        if Path(plot).suffix.lower() not in FORMATS:
+            raise click.BadParameter(f"must end in {', '.join(FORMATS)}.", param_hint="--plot")
         check_output_path(plot, inputs=(data,), what="figure")
         if Path(plot).resolve() == Path(output).resolve():
             raise click.BadParameter("names the same file as -o.", param_hint="--plot")
@@ -182,8 +182,6 @@ def identify(
     with atomic_paths(*outputs) as (tmp_model, *tmp_plot):
         tmp_model.write_text(text, encoding="utf-8")
         if plot is not None:
-            from hystcomp.experiment.fig_identification import plot_identification
-
             a, b = straight_line(v[start:], x[start:])
             line = a * v[start:] + b
             plot_identification(
