@@ -39,8 +39,10 @@ def check_int(value, name: str, owner: str, *, minimum: int = 1, maximum: int | 
     return int(value)
 
 
-def check_real(value, name: str, owner: str, *, positive: bool = False) -> float:
-    """Return ``value`` as a finite float (``> 0`` if ``positive``) or raise."""
+def check_real(
+    value, name: str, owner: str, *, positive: bool = False, bound: float = MAX_MAGNITUDE
+) -> float:
+    """Return ``value`` as a finite float of size at most ``bound`` (``> 0`` if ``positive``)."""
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
         raise InvalidTypeError(
             f"The {name!r} parameter of {owner} must be a real number. "
@@ -50,11 +52,11 @@ def check_real(value, name: str, owner: str, *, positive: bool = False) -> float
         value = float(value)
     except OverflowError:
         value = float("inf")
-    if not abs(value) <= MAX_MAGNITUDE or (positive and value <= 0):
+    if not (np.isfinite(value) and abs(value) <= bound) or (positive and value <= 0):
         need = "a finite number > 0" if positive else "a finite number"
+        size = f" of magnitude at most {bound:g}" if np.isfinite(bound) else ""
         raise InvalidParameterError(
-            f"The {name!r} parameter of {owner} must be {need} of magnitude at most "
-            f"{MAX_MAGNITUDE:g}. Got {value!r} instead."
+            f"The {name!r} parameter of {owner} must be {need}{size}. Got {value!r} instead."
         )
     return value
 
