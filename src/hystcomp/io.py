@@ -22,7 +22,13 @@ from pathlib import Path
 from typing import Any
 
 from hystcomp._validation import as_path
-from hystcomp.errors import HystcompError, InvalidTypeError, ModelFileError, OutputPathError
+from hystcomp.errors import (
+    HystcompError,
+    InvalidParameterError,
+    InvalidTypeError,
+    ModelFileError,
+    OutputPathError,
+)
 from hystcomp.models.base import HysteresisModel
 from hystcomp.models.mpi import ModifiedPrandtlIshlinskii
 from hystcomp.models.pi import PrandtlIshlinskii
@@ -90,7 +96,7 @@ def _same_file(a: Path, b: Path) -> bool:
 def _mode_for(path: Path) -> int:
     """Permissions for a new ``path``: those of the file it replaces, else the umask's."""
     with contextlib.suppress(OSError):
-        return path.stat().st_mode & 0o7777
+        return path.stat().st_mode & 0o777
     umask = os.umask(0)
     os.umask(umask)
     return 0o666 & ~umask
@@ -110,6 +116,8 @@ def atomic_paths(*paths: str | os.PathLike):
         If a path cannot be written (see :func:`check_output_path`), or the write fails
         (permissions, a full disk).
     """
+    if not paths:
+        raise InvalidParameterError("atomic_paths needs at least one path to write.")
     paths = [check_output_path(p) for p in paths]
     tmps: list[Path] = []
     current = paths[0]

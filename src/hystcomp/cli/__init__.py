@@ -1,8 +1,9 @@
 """The ``hystcomp`` command.
 
 Each subcommand lives in its own module of this package and registers itself on
-:data:`main`. Exit status: 0 on success, 2 on bad usage or bad input (one line, no
-traceback), 1 on an internal fault.
+:data:`main`. Exit status: 0 on success, 2 on bad usage or bad input (one line on
+standard error that names the problem and the fix, no traceback), 1 on an internal fault,
+141 when standard output is closed early (``| head``).
 """
 
 from __future__ import annotations
