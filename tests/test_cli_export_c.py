@@ -106,6 +106,7 @@ def test_write_failure_exits_2_and_leaves_the_other_file(model_file, tmp_path):
     (tmp_path / "hystcomp_compensator.c").mkdir()  # in the way: the .c cannot be written
     result = _export(model_file, "-o", tmp_path)
     assert result.exit_code == 2
-    assert "Cannot write the C files" in result.output
+    assert "Cannot write the output" in result.output
+    assert "hystcomp_compensator.c" in result.output
     assert (tmp_path / "hystcomp_compensator.h").read_text() == "precious"
     assert not [p for p in tmp_path.iterdir() if p.name.endswith(".tmp")]

@@ -66,14 +66,14 @@ def test_failed_save_leaves_existing_file(tmp_path):
         ),
         (
             '{"format": "hystcomp-model", "version": 1, "kind": "pi", "parameters": {}}',
-            r"invalid parameters",
+            r'no "thresholds" in its parameters',
         ),
         (
             (
                 '{"format": "hystcomp-model", "version": 1, "kind": "pi", '
                 '"parameters": {"thresholds": [0, 1], "weights": [1, "x"]}}'
             ),
-            r"invalid parameters",
+            r"the text 'x' at parameters\[\"weights\"\]\[1\]",
         ),
     ],
 )

@@ -7,14 +7,22 @@ Messages follow one pattern: what the argument must be, what was found, and the 
 from __future__ import annotations
 
 import numbers
+import os
+import warnings
+from pathlib import Path
 
 import numpy as np
 
 from hystcomp.errors import InvalidParameterError, InvalidSignalError, InvalidTypeError
 
+#: Largest magnitude accepted for a signal sample or a model parameter (V, µm, µm/V, ...).
+#: Far beyond any actuator, and small enough that no sum or product of such numbers in the
+#: models overflows to inf (which could turn into a NaN output).
+MAX_MAGNITUDE = 1e12
 
-def check_int(value, name: str, owner: str, *, minimum: int = 1) -> int:
-    """Return ``value`` as an int ``>= minimum`` or raise a message that names it."""
+
+def check_int(value, name: str, owner: str, *, minimum: int = 1, maximum: int | None = None) -> int:
+    """Return ``value`` as an int ``>= minimum`` (and ``<= maximum``) or raise a message."""
     if isinstance(value, bool) or not isinstance(value, numbers.Integral):
         raise InvalidTypeError(
             f"The {name!r} parameter of {owner} must be an int >= {minimum}. "
@@ -24,21 +32,31 @@ def check_int(value, name: str, owner: str, *, minimum: int = 1) -> int:
         raise InvalidParameterError(
             f"The {name!r} parameter of {owner} must be an int >= {minimum}. Got {value!r} instead."
         )
+    if maximum is not None and value > maximum:
+        raise InvalidParameterError(
+            f"The {name!r} parameter of {owner} must be an int <= {maximum}. Got {value!r} instead."
+        )
     return int(value)
 
 
-def check_real(value, name: str, owner: str, *, positive: bool = False) -> float:
-    """Return ``value`` as a finite float (``> 0`` if ``positive``) or raise."""
+def check_real(
+    value, name: str, owner: str, *, positive: bool = False, bound: float = MAX_MAGNITUDE
+) -> float:
+    """Return ``value`` as a finite float of size at most ``bound`` (``> 0`` if ``positive``)."""
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
         raise InvalidTypeError(
             f"The {name!r} parameter of {owner} must be a real number. "
             f"Got {value!r} of type {type(value).__name__} instead."
         )
-    value = float(value)
-    if not np.isfinite(value) or (positive and value <= 0):
+    try:
+        value = float(value)
+    except OverflowError:
+        value = float("inf")
+    if not (np.isfinite(value) and abs(value) <= bound) or (positive and value <= 0):
         need = "a finite number > 0" if positive else "a finite number"
+        size = f" of magnitude at most {bound:g}" if np.isfinite(bound) else ""
         raise InvalidParameterError(
-            f"The {name!r} parameter of {owner} must be {need}. Got {value!r} instead."
+            f"The {name!r} parameter of {owner} must be {need}{size}. Got {value!r} instead."
         )
     return value
 
@@ -47,15 +65,16 @@ def check_range(value, name: str, owner: str) -> tuple[float, float]:
     """Return ``(low, high)`` with finite ``low < high`` or raise."""
     try:
         low, high = (float(v) for v in value)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         raise InvalidParameterError(
             f"The {name!r} parameter of {owner} must be a pair (low, high) of numbers. "
             f"Got {value!r} instead."
         ) from None
-    if not (np.isfinite(low) and np.isfinite(high) and low < high):
+    if not (abs(low) <= MAX_MAGNITUDE and abs(high) <= MAX_MAGNITUDE and low < high):
         raise InvalidParameterError(
             f"The {name!r} parameter of {owner} must be a pair (low, high) of finite numbers "
-            f"with low < high. Got ({low!r}, {high!r}) instead."
+            f"with low < high (magnitude at most {MAX_MAGNITUDE:g}). "
+            f"Got ({low!r}, {high!r}) instead."
         )
     return low, high
 
@@ -63,10 +82,10 @@ def check_range(value, name: str, owner: str) -> tuple[float, float]:
 def as_vector(value, name: str, owner: str, *, length: int | None = None) -> np.ndarray:
     """Return a read-only 1-D finite float64 copy of ``value`` or raise."""
     try:
-        arr = np.array(value, dtype=np.float64)
-    except (TypeError, ValueError):
+        arr = _real_array(value, copy=True)
+    except (TypeError, ValueError, OverflowError):
         raise InvalidTypeError(
-            f"The {name!r} parameter of {owner} must be a 1-D array of numbers. "
+            f"The {name!r} parameter of {owner} must be a 1-D array of real numbers. "
             f"Got a {type(value).__name__} that does not convert to numbers."
         ) from None
     if arr.ndim != 1 or arr.size == 0:
@@ -79,10 +98,13 @@ def as_vector(value, name: str, owner: str, *, length: int | None = None) -> np.
             f"The {name!r} parameter of {owner} must have {length} entries, one per operator. "
             f"Got {arr.size} instead."
         )
-    if not np.all(np.isfinite(arr)):
-        bad = int(np.flatnonzero(~np.isfinite(arr))[0])
+    bad = _first_out_of_bounds(arr)
+    if bad is not None:
+        value = float(arr[bad])
+        need = f"be at most {MAX_MAGNITUDE:g} in size" if np.isfinite(value) else "be finite"
         raise InvalidParameterError(
-            f"The {name!r} parameter of {owner} must be finite. Entry {bad} is {float(arr[bad])!r}."
+            f"The {name!r} parameter of {owner} must {need}. Entry {bad} is {value!r}"
+            + ("; check the units." if np.isfinite(value) else ".")
         )
     arr.setflags(write=False)
     return arr
@@ -105,13 +127,27 @@ def check_thresholds(value, name: str, owner: str) -> np.ndarray:
     return r
 
 
+def as_path(value, name: str, owner: str) -> Path:
+    """Return ``value`` (a str or path-like) as a Path, or raise a message that names it."""
+    try:
+        path = Path(os.fspath(value))
+    except TypeError:
+        raise InvalidTypeError(
+            f"The {name!r} parameter of {owner} must be a file name (str or path-like). "
+            f"Got {type(value).__name__}."
+        ) from None
+    if not str(value):
+        raise InvalidParameterError(f"The {name!r} parameter of {owner} is an empty file name.")
+    return path
+
+
 def as_signal(value, name: str, *, min_samples: int = 1) -> np.ndarray:
     """Return a 1-D finite float64 array of samples (a copy if conversion is needed)."""
     try:
-        arr = np.asarray(value, dtype=np.float64)
-    except (TypeError, ValueError):
+        arr = _real_array(value, copy=False)
+    except (TypeError, ValueError, OverflowError):
         raise InvalidTypeError(
-            f"{name!r} must be a 1-D array of numbers (samples). "
+            f"{name!r} must be a 1-D array of real numbers (samples). "
             f"Got a {type(value).__name__} that does not convert to numbers."
         ) from None
     if arr.ndim == 0:
@@ -125,11 +161,43 @@ def as_signal(value, name: str, *, min_samples: int = 1) -> np.ndarray:
         raise InvalidSignalError(
             f"{name!r} must have at least {min_samples} samples. Got {arr.size}."
         )
-    finite = np.isfinite(arr)
-    if not finite.all():
-        bad = int(np.flatnonzero(~finite)[0])
+    bad = _first_out_of_bounds(arr)
+    if bad is not None:
+        value = float(arr[bad])
+        if np.isfinite(value):
+            raise InvalidSignalError(
+                f"{name!r} must hold samples of magnitude at most {MAX_MAGNITUDE:g}. Sample "
+                f"{bad} is {value:.6g}; check the units."
+            )
         raise InvalidSignalError(
-            f"{name!r} must be finite. Sample {bad} is {float(arr[bad])!r}; "
+            f"{name!r} must be finite. Sample {bad} is {value!r}; "
             "remove or interpolate non-finite samples first."
         )
     return np.ascontiguousarray(arr)
+
+
+def _real_array(value, *, copy: bool) -> np.ndarray:
+    """``value`` as a float64 array; anything but real numbers raises TypeError.
+
+    Text, booleans, dates and complex numbers are refused rather than converted (``"1.5"``
+    or ``True`` are not samples), and so is any conversion that warns.
+    """
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # e.g. a ComplexWarning from an object array
+        try:
+            probe = np.asarray(value)
+            if probe.dtype.kind not in "iufO":
+                raise TypeError(f"values of dtype {probe.dtype}")
+            if copy:
+                return np.array(probe, dtype=np.float64)
+            return np.asarray(probe, dtype=np.float64)
+        except Warning as exc:
+            raise TypeError(str(exc)) from None
+
+
+def _first_out_of_bounds(arr: np.ndarray) -> int | None:
+    """Index of the first entry that is not finite or exceeds :data:`MAX_MAGNITUDE`."""
+    ok = np.abs(arr) <= MAX_MAGNITUDE  # False for NaN
+    if ok.all():
+        return None
+    return int(np.flatnonzero(~ok.reshape(-1))[0])

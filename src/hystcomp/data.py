@@ -13,21 +13,28 @@ Columns can be named explicitly: ``{"v": 1, "x": 5}`` (1-based column numbers, f
 files) or ``{"v": "volts", "x": "disp"}`` (header names or keys); on the command line
 ``--columns v=1,x=5``. A file without a time column needs the sample rate. Writes go through
 :func:`hystcomp.io.atomic_path`: a failing write never truncates an existing file.
+
+Files are untrusted input: every problem (not a regular file, not text, a corrupt archive,
+text or complex numbers in a column, NaN or inf, a value beyond
+:data:`~hystcomp._validation.MAX_MAGNITUDE`, a time column that does not increase) is a
+:class:`~hystcomp.errors.DataFileError` naming the file, the column and the fix. NPZ files
+are read without pickle. MAT files are parsed in a separate process, because scipy's MAT
+reader is not hardened against corrupt files (it can crash the interpreter); a crash there
+is reported as a corrupt file.
 """
 
 from __future__ import annotations
 
 import io as _io
-import os
-import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import scipy.io
 
-from hystcomp._validation import check_real
-from hystcomp.errors import DataFileError, InvalidParameterError
+from hystcomp._formats import read_raw
+from hystcomp._validation import MAX_MAGNITUDE, as_path, as_signal, check_int, check_real
+from hystcomp.errors import DataFileError, InvalidParameterError, InvalidSignalError
 from hystcomp.io import atomic_path
 
 #: What each column holds, for messages.
@@ -60,6 +67,26 @@ class Record:
     x: np.ndarray
     source: str = "record"
 
+    def __post_init__(self):
+        arrays = {}
+        for key in ("t", "v", "x"):
+            try:
+                arr = as_signal(getattr(self, key), key, min_samples=1)
+            except InvalidSignalError as exc:
+                raise InvalidSignalError(f"Record {key!r}: {exc}") from None
+            arr = np.array(arr)  # an own, read-only copy
+            arr.setflags(write=False)
+            arrays[key] = arr
+        if len({arr.size for arr in arrays.values()}) > 1:
+            raise InvalidSignalError(
+                "Record: 't', 'v' and 'x' must have one sample each per instant. Got "
+                f"{', '.join(f'{k}: {a.size}' for k, a in arrays.items())} samples."
+            )
+        if not np.all(np.diff(arrays["t"]) > 0):
+            raise InvalidSignalError("Record: the time 't' must be strictly increasing.")
+        for key, arr in arrays.items():
+            object.__setattr__(self, key, arr)
+
     def __len__(self) -> int:
         return int(self.t.size)
 
@@ -71,7 +98,9 @@ class Record:
 
 def rate_of(t) -> float:
     """Sample rate in Hz of strictly increasing times ``t`` (s), from the median step."""
-    return float(1.0 / np.median(np.diff(t)))
+    t = as_signal(t, "t", min_samples=2)
+    with np.errstate(over="ignore", divide="ignore"):
+        return float(1.0 / np.median(np.diff(t)))
 
 
 def parse_columns(text: str | None) -> dict[str, int | str] | None:
@@ -88,6 +117,10 @@ def parse_columns(text: str | None) -> dict[str, int | str] | None:
     """
     if text is None:
         return None
+    if not isinstance(text, str):
+        raise InvalidParameterError(
+            f"The 'columns' option must be text such as v=1,x=5. Got {type(text).__name__}."
+        )
     mapping: dict[str, int | str] = {}
     for item in text.split(","):
         key, sep, value = (part.strip() for part in item.partition("="))
@@ -97,7 +130,7 @@ def parse_columns(text: str | None) -> dict[str, int | str] | None:
                 "v=volts,x=disp (header names), each of t, v, x at most once. "
                 f"Got {text!r} instead."
             )
-        if value.isdigit():
+        if value.isascii() and value.isdigit():
             if int(value) < 1:
                 raise InvalidParameterError(
                     f"Column numbers in 'columns' start at 1. Got {key}={value} in {text!r}."
@@ -110,6 +143,11 @@ def parse_columns(text: str | None) -> dict[str, int | str] | None:
 
 def _check_columns(columns) -> dict:
     """A column mapping {key: 1-based number or name}, keys among t, v, x."""
+    if columns is not None and not isinstance(columns, dict):
+        raise InvalidParameterError(
+            "The 'columns' parameter of read_table must be a dict such as {'v': 1, 'x': 5}. "
+            f"Got {type(columns).__name__}."
+        )
     columns = dict(columns or {})
     for key, spec in columns.items():
         number = isinstance(spec, int) and not isinstance(spec, bool) and spec >= 1
@@ -121,100 +159,15 @@ def _check_columns(columns) -> dict:
     return columns
 
 
-def _is_header(tokens: list[str]) -> bool:
-    try:
-        [float(tok) for tok in tokens]
-    except ValueError:
-        return True
-    return False
-
-
-def _first_line(path: Path) -> str:
-    with path.open(encoding="utf-8-sig") as f:
-        for line in f:
-            if line.strip() and not line.lstrip().startswith("#"):
-                return line
-    raise DataFileError(f"Data file {str(path)!r} is empty: it has no data rows.")
-
-
-def _read_text(path: Path, delimiter: str | None):
-    """Header names (or None) and the columns of a text table (``None``: by whitespace)."""
-    first = _first_line(path)
-    if delimiter is None and "," in first:
-        delimiter = ","
-    tokens = [tok.strip() for tok in (first.split(delimiter) if delimiter else first.split())]
-    names = tokens if _is_header(tokens) else None
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", UserWarning)  # "input contained no data"
-            table = np.loadtxt(
-                path,
-                delimiter=delimiter,
-                skiprows=1 if names else 0,
-                comments="#",
-                ndmin=2,
-                encoding="utf-8-sig",
-            )
-    except ValueError as exc:
-        raise DataFileError(
-            f"Data file {str(path)!r} is not a table of numbers ({exc}). Every row after the "
-            "header must hold the same number of numeric columns."
-        ) from None
-    if table.shape[0] == 0:
-        raise DataFileError(f"Data file {str(path)!r} has a header but no data rows.")
-    if names is not None and len(names) != table.shape[1]:
-        raise DataFileError(
-            f"Data file {str(path)!r} has {len(names)} names in its header row but "
-            f"{table.shape[1]} columns of data. Make them agree."
-        )
-    return names, list(table.T)
-
-
-def _read_arrays(path: Path, suffix: str):
-    """Names and arrays of an NPZ or MAT file."""
-    try:
-        if suffix == ".npz":
-            with np.load(path, allow_pickle=False) as npz:
-                arrays = {name: npz[name] for name in npz.files}
-        else:
-            arrays = {k: v for k, v in scipy.io.loadmat(path).items() if not k.startswith("__")}
-    except NotImplementedError:
-        raise DataFileError(
-            f"Data file {str(path)!r} is a MATLAB v7.3 (HDF5) file, which scipy cannot read. "
-            "Save it from MATLAB with save(..., '-v7')."
-        ) from None
-    except (ValueError, OSError, TypeError) as exc:
-        kind = "NumPy .npz" if suffix == ".npz" else "MATLAB .mat"
-        raise DataFileError(
-            f"Data file {str(path)!r} is not a readable {kind} file ({exc})."
-        ) from None
-    return list(arrays), list(arrays.values())
-
-
-def _read_raw(path: Path):
-    if not path.exists():
-        raise DataFileError(f"Data file {str(path)!r} does not exist; check the path.")
-    if path.is_dir():
-        raise DataFileError(f"{str(path)!r} is a folder, not a data file.")
-    suffix = path.suffix.lower()
-    try:
-        if suffix in (".npz", ".mat"):
-            return (*_read_arrays(path, suffix), False)
-        return (*_read_text(path, "," if suffix == ".csv" else None), True)
-    except UnicodeDecodeError:
-        raise DataFileError(
-            f"Data file {str(path)!r} is not text; use .csv, .npz, .mat or a text table."
-        ) from None
-
-
 def _pick(path: Path, names, arrays, positional, key: str, spec, required: bool):
     """The column for ``key`` (``None`` if absent and not required)."""
     where = f"Data file {str(path)!r}"
     if isinstance(spec, int):
         if not positional:
             raise DataFileError(
-                f"{where} has named arrays ({', '.join(names)}), not numbered columns: "
-                f"name the array for {key!r} instead of {spec} (for example {key}={names[0]})."
+                f"{where} has named arrays ({', '.join(names) or 'none'}), not numbered "
+                f"columns: name the array for {key!r} instead of {spec} (for example "
+                f"{key}={names[0] if names else 'NAME'})."
             )
         if spec > len(arrays):
             raise DataFileError(
@@ -242,10 +195,12 @@ def _pick(path: Path, names, arrays, positional, key: str, spec, required: bool)
 
 def _as_column(arr, path: Path, key: str, label: str) -> np.ndarray:
     what = f"The {label} of {str(path)!r} ({key!r}, {MEANINGS[key]})"
-    try:
-        out = np.asarray(arr, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise DataFileError(f"{what} does not hold numbers.") from None
+    arr = np.asarray(arr)
+    if arr.dtype.kind == "c":
+        raise DataFileError(f"{what} holds complex numbers; save the real part only.")
+    if arr.dtype.kind not in "iuf":
+        raise DataFileError(f"{what} does not hold numbers (it holds {arr.dtype} values).")
+    out = np.asarray(arr, dtype=np.float64)
     if out.ndim > 1 and sorted(out.shape)[-2] == 1:
         out = out.reshape(-1)
     if out.ndim != 1:
@@ -258,6 +213,13 @@ def _as_column(arr, path: Path, key: str, label: str) -> np.ndarray:
             f"{what} has a non-finite value ({float(out[bad[0]])!r}) in data row "
             f"{bad[0] + 1}: remove or interpolate that row."
         )
+    if key != "t":
+        big = np.flatnonzero(np.abs(out) > MAX_MAGNITUDE)
+        if big.size:
+            raise DataFileError(
+                f"{what} has the value {float(out[big[0]]):.6g} in data row {big[0] + 1}, "
+                f"beyond {MAX_MAGNITUDE:g}: check the units and the column."
+            )
     return out
 
 
@@ -290,9 +252,18 @@ def read_table(path, keys=("v", "x"), *, columns=None, sample_rate=None, min_sam
     DataFileError
         Naming the file, the column, the problem and the fix.
     """
-    path = Path(os.fspath(path))
+    path = as_path(path, "path", "read_table")
+    keys = tuple(keys) if not isinstance(keys, str) else (keys,)
+    if not keys or any(key not in ("v", "x") for key in keys) or len(set(keys)) < len(keys):
+        raise InvalidParameterError(
+            f"The 'keys' parameter of read_table must name 'v' and/or 'x' once each. "
+            f"Got {keys!r} instead."
+        )
+    min_samples = check_int(min_samples, "min_samples", "read_table", minimum=1)
     columns = _check_columns(columns)
-    names, arrays, positional = _read_raw(path)
+    if sample_rate is not None:
+        sample_rate = check_real(sample_rate, "sample_rate", "read_table", positive=True)
+    names, arrays, positional = read_raw(path)
     out = {}
     for key in ("t", *keys):
         arr, label = _pick(path, names, arrays, positional, key, columns.get(key), key != "t")
@@ -309,8 +280,6 @@ def read_table(path, keys=("v", "x"), *, columns=None, sample_rate=None, min_sam
         raise DataFileError(
             f"Data file {str(path)!r} has {n} samples; at least {min_samples} are needed."
         )
-    if sample_rate is not None:
-        sample_rate = check_real(sample_rate, "sample_rate", "read_table", positive=True)
     out["t"] = _time(path, out.get("t"), n, sample_rate)
     for arr in out.values():
         arr.setflags(write=False)
@@ -325,7 +294,9 @@ def _time(path: Path, t, n: int, sample_rate):
                 "--fs HZ on the command line (sample_rate=HZ in Python)."
             )
         return np.arange(n) / sample_rate
-    steps = np.diff(t)
+    with np.errstate(over="ignore", invalid="ignore"):
+        steps = np.diff(t)
+        span = t[-1] - t[0]
     bad = np.flatnonzero(~(steps > 0))
     if bad.size:
         k = int(bad[0]) + 1
@@ -335,13 +306,18 @@ def _time(path: Path, t, n: int, sample_rate):
             "rows and remove duplicates, or drop the time column and give the sample rate "
             "(--fs)."
         )
-    if sample_rate is not None:
-        rate = rate_of(t)
-        if abs(rate - sample_rate) > RATE_TOLERANCE * sample_rate:
-            raise DataFileError(
-                f"The time column 't' of {str(path)!r} says {rate:.6g} Hz but the sample rate "
-                f"given is {sample_rate:.6g} Hz. Give one of them, not both."
-            )
+    rate = rate_of(t)
+    if not (np.isfinite(span) and 0.0 < rate < np.inf):
+        raise DataFileError(
+            f"The time column 't' of {str(path)!r} spans {float(t[0])!r} to {float(t[-1])!r} s, "
+            "which gives no usable sample rate. Check the units of the time column, or drop "
+            "it and give the sample rate (--fs)."
+        )
+    if sample_rate is not None and abs(rate - sample_rate) > RATE_TOLERANCE * sample_rate:
+        raise DataFileError(
+            f"The time column 't' of {str(path)!r} says {rate:.6g} Hz but the sample rate "
+            f"given is {sample_rate:.6g} Hz. Give one of them, not both."
+        )
     return t
 
 
@@ -365,12 +341,55 @@ def read_record(path, *, columns=None, sample_rate=None) -> Record:
     return Record(table["t"], v, table["x"], source=str(path))
 
 
+def _columns(table, owner: str) -> dict[str, np.ndarray]:
+    """Column name (an ASCII identifier) to a 1-D float64 array, validated."""
+    if not isinstance(table, dict) or not table:
+        raise InvalidParameterError(
+            f"The 'table' parameter of {owner} must be a non-empty dict of column name to "
+            f"values. Got {type(table).__name__}."
+        )
+    cols = {}
+    for name, values in table.items():
+        if not (isinstance(name, str) and name.isidentifier() and name.isascii()):
+            raise InvalidParameterError(
+                f"Column names of {owner} must be ASCII identifiers such as 'x_ref'. Got {name!r}."
+            )
+        try:
+            cols[name] = np.asarray(values, dtype=np.float64).reshape(-1)
+        except (TypeError, ValueError, OverflowError):
+            raise InvalidParameterError(
+                f"Column {name!r} of {owner} does not hold numbers."
+            ) from None
+    return cols
+
+
 def format_csv(table: dict) -> str:
     """A table of equally long columns as CSV text with a header row (shortest round-trip)."""
-    keys = list(table)
-    rows = np.column_stack([np.asarray(table[k], dtype=np.float64) for k in keys]).tolist()
+    cols = _columns(table, "format_csv")
+    if len({c.size for c in cols.values()}) != 1:
+        raise InvalidParameterError("The columns given to format_csv have different lengths.")
+    keys = list(cols)
+    rows = np.column_stack([cols[k] for k in keys]).tolist()
     lines = [",".join(keys), *(",".join(map(repr, row)) for row in rows)]
     return "\n".join(lines) + "\n"
+
+
+def check_writable(path) -> Path:
+    """``path`` as a Path if :func:`write_table` can write its format, else raise.
+
+    Raises
+    ------
+    DataFileError
+        If the suffix is not one of ``.csv``, ``.npz``, ``.mat``.
+    """
+    path = as_path(path, "path", "write_table")
+    suffix = path.suffix.lower()
+    if suffix not in WRITABLE:
+        raise DataFileError(
+            f"Cannot write {str(path)!r}: unknown format {suffix or '(no suffix)'!r}. "
+            f"Use a name ending in {', '.join(WRITABLE)}."
+        )
+    return path
 
 
 def write_table(path, table: dict) -> None:
@@ -383,14 +402,9 @@ def write_table(path, table: dict) -> None:
     table : dict of str to array_like
         Column name to values, e.g. ``{"t": t, "v": v, "x": x}``.
     """
-    path = Path(os.fspath(path))
+    path = check_writable(path)
     suffix = path.suffix.lower()
-    if suffix not in WRITABLE:
-        raise DataFileError(
-            f"Cannot write {str(path)!r}: unknown format {suffix or '(no suffix)'!r}. "
-            f"Use a name ending in {', '.join(WRITABLE)}."
-        )
-    cols = {k: np.asarray(v, dtype=np.float64).reshape(-1) for k, v in table.items()}
+    cols = _columns(table, "write_table")
     lengths = {k: v.size for k, v in cols.items()}
     if len(set(lengths.values())) != 1:
         raise DataFileError(

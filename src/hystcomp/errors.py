@@ -52,3 +52,12 @@ class DataFileError(HystcompError, ValueError):
 
 class ModelFileError(HystcompError, ValueError):
     """A model file is missing, corrupt, foreign, or of an unsupported version."""
+
+
+class OutputPathError(HystcompError, ValueError):
+    """An output cannot be written where asked.
+
+    The folder does not exist, the path is a folder, the path is one of the command's own
+    input files, or the write itself failed (permissions, a full disk). Nothing is left
+    half-written: the existing file, if any, is unchanged.
+    """

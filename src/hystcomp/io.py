@@ -5,25 +5,38 @@ A model file is JSON::
     {"format": "hystcomp-model", "version": 1, "kind": "pi" | "mpi" | ...,
      "hyperparameters": {...}, "parameters": {...}, "fit_report": {...}}
 
-Never pickle: a model file is data, readable by any program and safe to open.
+Never pickle: a model file is data, readable by any program and safe to open. Reading one
+checks its shape before any model is built (:func:`model_from_dict`): the keys a kind's
+``from_parameters`` takes, JSON numbers (never NaN/Infinity, never text or booleans) or
+arrays of them, a bounded size; every value is then validated by ``from_parameters``.
 """
 
 from __future__ import annotations
 
 import contextlib
+import inspect
 import json
 import os
 import tempfile
 from pathlib import Path
 from typing import Any
 
-from hystcomp.errors import HystcompError, InvalidTypeError, ModelFileError
+from hystcomp._validation import as_path
+from hystcomp.errors import (
+    HystcompError,
+    InvalidParameterError,
+    InvalidTypeError,
+    ModelFileError,
+    OutputPathError,
+)
 from hystcomp.models.base import HysteresisModel
 from hystcomp.models.mpi import ModifiedPrandtlIshlinskii
 from hystcomp.models.pi import PrandtlIshlinskii
 
 MODEL_FORMAT = "hystcomp-model"
 MODEL_VERSION = 1
+#: Largest model file read (bytes); a model has a few hundred numbers, not millions.
+MAX_MODEL_FILE_BYTES = 64 * 2**20
 
 #: Model classes by the ``kind`` written in model files.
 MODEL_KINDS: dict[str, type[HysteresisModel]] = {
@@ -32,26 +45,116 @@ MODEL_KINDS: dict[str, type[HysteresisModel]] = {
 }
 
 
+def check_output_path(path: str | os.PathLike, *, inputs=(), what: str = "output") -> Path:
+    """Check that ``path`` can be written without harm, before any work is done.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The file to write.
+    inputs : sequence of str or path-like
+        Files the same command reads: writing over one of them would destroy it.
+    what : str
+        What the file is, for messages (e.g. ``"model file"``).
+
+    Returns
+    -------
+    Path
+
+    Raises
+    ------
+    OutputPathError
+        If the folder does not exist, ``path`` is a folder, or ``path`` is one of ``inputs``.
+    """
+    path = as_path(path, "path", "check_output_path")
+    if path.is_dir():
+        raise OutputPathError(
+            f"Cannot write the {what} {str(path)!r}: it is a folder. Give a file name, "
+            f"e.g. {str(path / 'out')!r} with a suffix."
+        )
+    if not path.parent.is_dir():
+        raise OutputPathError(
+            f"Cannot write the {what} {str(path)!r}: the folder {str(path.parent)!r} does not "
+            "exist. Create it first or choose another output path."
+        )
+    for source in inputs:
+        if source is not None and _same_file(path, as_path(source, "inputs", "check_output_path")):
+            raise OutputPathError(
+                f"Cannot write the {what} {str(path)!r}: it is the input file "
+                f"{str(source)!r}, which would be overwritten. Choose another output path."
+            )
+    return path
+
+
+def _same_file(a: Path, b: Path) -> bool:
+    with contextlib.suppress(OSError):
+        if a.exists() and b.exists():
+            return os.path.samefile(a, b)
+    return os.path.abspath(a) == os.path.abspath(b)
+
+
+def _mode_for(path: Path) -> int:
+    """Permissions for a new ``path``: those of the file it replaces, else the umask's."""
+    with contextlib.suppress(OSError):
+        return path.stat().st_mode & 0o777
+    umask = os.umask(0)
+    os.umask(umask)
+    return 0o666 & ~umask
+
+
+@contextlib.contextmanager
+def atomic_paths(*paths: str | os.PathLike):
+    """Yield a list of temporary paths beside ``paths``; on success rename each onto its path.
+
+    All outputs of a command are written to temporary files first, so a failure anywhere
+    leaves every existing file untouched and removes the temporary files. Each temporary
+    name keeps its path's suffix, so writers that choose the format by suffix work on it.
+
+    Raises
+    ------
+    OutputPathError
+        If a path cannot be written (see :func:`check_output_path`), or the write fails
+        (permissions, a full disk).
+    """
+    if not paths:
+        raise InvalidParameterError("atomic_paths needs at least one path to write.")
+    paths = [check_output_path(p) for p in paths]
+    tmps: list[Path] = []
+    current = paths[0]
+    try:
+        try:
+            for current in paths:
+                fd, tmp = tempfile.mkstemp(
+                    prefix=f".{current.stem}.", suffix=f".tmp{current.suffix}", dir=current.parent
+                )
+                os.close(fd)
+                tmps.append(Path(tmp))
+                os.chmod(tmp, _mode_for(current))
+            current = None  # the caller writes any of them
+            yield list(tmps)
+            for tmp, current in zip(tmps, paths, strict=True):
+                os.replace(tmp, current)
+        except OSError as exc:
+            names = ", ".join(repr(str(p)) for p in ([current] if current else paths))
+            raise OutputPathError(
+                f"Cannot write {names}: {exc.strerror or exc}. Check the permissions and the "
+                "free space of the folder."
+            ) from None
+    finally:
+        for tmp in tmps:
+            with contextlib.suppress(FileNotFoundError):
+                os.unlink(tmp)
+
+
 @contextlib.contextmanager
 def atomic_path(path: str | os.PathLike):
     """Yield a temporary path beside ``path``; on success rename it onto ``path``.
 
-    A failure leaves any existing ``path`` untouched and removes the temporary file.
+    A failure leaves any existing ``path`` untouched and removes the temporary file
+    (:func:`atomic_paths` with one path).
     """
-    path = Path(path)
-    if not path.parent.is_dir():
-        raise ModelFileError(
-            f"Cannot write {str(path)!r}: the folder {str(path.parent)!r} does not exist. "
-            "Create it first or choose another output path."
-        )
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    os.close(fd)
-    try:
-        yield Path(tmp)
-        os.replace(tmp, path)
-    finally:
-        with contextlib.suppress(FileNotFoundError):
-            os.unlink(tmp)
+    with atomic_paths(path) as (tmp,):
+        yield tmp
 
 
 def model_to_dict(model: HysteresisModel) -> dict[str, Any]:
@@ -64,15 +167,48 @@ def model_to_dict(model: HysteresisModel) -> dict[str, Any]:
     return {"format": MODEL_FORMAT, "version": MODEL_VERSION, **model.to_dict()}
 
 
+def model_text(model: HysteresisModel) -> str:
+    """The model file's text (JSON) for ``model``."""
+    try:
+        return json.dumps(model_to_dict(model), indent=2, allow_nan=False) + "\n"
+    except ValueError:
+        raise ModelFileError(
+            f"This {type(model).__name__} holds a non-finite number (NaN or infinity), which "
+            "a model file cannot store; refit the model."
+        ) from None
+
+
 def save_model(model: HysteresisModel, path: str | os.PathLike) -> None:
     """Write ``model`` to ``path`` as JSON (atomically: a failure leaves ``path`` as it was)."""
-    text = json.dumps(model_to_dict(model), indent=2, allow_nan=False)
+    text = model_text(model)
     with atomic_path(path) as tmp:
-        tmp.write_text(text + "\n", encoding="utf-8")
+        tmp.write_text(text, encoding="utf-8")
 
 
-def model_from_dict(doc: Any, source: str = "the model document") -> HysteresisModel:
-    """Build a model from a JSON document, checking format, version, kind and values."""
+def _check_value(value: Any, where: str, source: str, *, depth: int = 0) -> None:
+    """A parameter value: a JSON number, null, or an array (of arrays) of them."""
+    if value is None or (isinstance(value, int | float) and not isinstance(value, bool)):
+        return
+    if isinstance(value, list | tuple) and depth < 2:
+        for i, item in enumerate(value):
+            _check_value(item, f"{where}[{i}]", source, depth=depth + 1)
+        return
+    if isinstance(value, bool):
+        found = f"the boolean {json.dumps(value)}"
+    elif isinstance(value, str):
+        found = f"the text {value[:40]!r}"
+    elif isinstance(value, list | tuple):
+        found = "an array nested too deep"
+    else:
+        found = "an object"
+    raise ModelFileError(
+        f"{source} has {found} at {where}, where a number or an array of numbers belongs; "
+        "the file is corrupt or was edited by hand."
+    )
+
+
+def _check_document(doc: Any, source: str) -> type[HysteresisModel]:
+    """Check the shape of a model document and return the class of its kind."""
     if not isinstance(doc, dict) or doc.get("format") != MODEL_FORMAT:
         raise ModelFileError(
             f'{source} is not a hystcomp model file (no "format": "{MODEL_FORMAT}"). '
@@ -89,43 +225,118 @@ def model_from_dict(doc: Any, source: str = "the model document") -> HysteresisM
     if version < 1:
         raise ModelFileError(f"{source} has an invalid format version {version}.")
     kind = doc.get("kind")
-    if kind not in MODEL_KINDS:
+    if not isinstance(kind, str) or kind not in MODEL_KINDS:
         raise ModelFileError(
-            f"{source} has model kind {kind!r}; expected one of {sorted(MODEL_KINDS)}."
+            f"{source} has model kind {kind!r}; expected one of {sorted(MODEL_KINDS)}. "
+            "A newer hystcomp may know it: upgrade hystcomp."
         )
-    if not isinstance(doc.get("parameters"), dict):
+    cls = MODEL_KINDS[kind]
+    params = doc.get("parameters")
+    if not isinstance(params, dict):
         raise ModelFileError(f'{source} has no "parameters" object; the file is corrupt.')
+    signature = inspect.signature(cls.from_parameters).parameters
+    required = [n for n, p in signature.items() if p.default is inspect.Parameter.empty]
+    for name in required:
+        if name not in params:
+            raise ModelFileError(
+                f'{source} has no "{name}" in its parameters, which a {kind!r} model needs; '
+                "the file is corrupt or was edited by hand."
+            )
+    for name, value in params.items():
+        if name not in signature:
+            raise ModelFileError(
+                f'{source} has an unknown parameter "{name}" for a {kind!r} model (expected '
+                f"{', '.join(signature)}); the file is corrupt or from another program."
+            )
+        _check_value(value, f'parameters["{name}"]', source)
+    for key in ("hyperparameters", "fit_report"):
+        if key in doc and not isinstance(doc[key], dict):
+            raise ModelFileError(
+                f'{source} has a "{key}" that is not an object; the file is corrupt.'
+            )
+    for name, value in doc.get("hyperparameters", {}).items():
+        if isinstance(value, dict | list | tuple) and not (
+            isinstance(value, list | tuple) and all(isinstance(v, int | float) for v in value)
+        ):
+            raise ModelFileError(
+                f'{source} has an invalid hyperparameter "{name}" ({json.dumps(value)[:60]}); '
+                "the file is corrupt or was edited by hand."
+            )
+    return cls
+
+
+def model_from_dict(doc: Any, source: str = "the model document") -> HysteresisModel:
+    """Build a model from a JSON document, checking format, version, kind, keys and values.
+
+    Raises
+    ------
+    ModelFileError
+        Naming the key at fault and the fix.
+    """
+    cls = _check_document(doc, source)
     try:
-        return MODEL_KINDS[kind].from_dict(doc)
+        return cls.from_dict(doc)
     except HystcompError as exc:
         raise ModelFileError(f"{source} holds invalid parameters: {exc}") from None
-    except (TypeError, ValueError, KeyError) as exc:
+    except (TypeError, ValueError, KeyError, AttributeError, IndexError, OverflowError) as exc:
         raise ModelFileError(
-            f"{source} holds invalid parameters for a {kind!r} model ({exc}); "
+            f"{source} holds invalid parameters for a {doc['kind']!r} model ({exc}); "
             "the file is corrupt or was edited by hand."
         ) from None
+    except MemoryError:
+        raise ModelFileError(
+            f"{source} describes a model too large for this computer's memory; the file is "
+            "corrupt or was edited by hand."
+        ) from None
+
+
+def _refuse_constant(name: str):
+    raise ValueError(f"{name} is not a number a model file may hold")
 
 
 def load_model(path: str | os.PathLike) -> HysteresisModel:
-    """Read a model file written by :func:`save_model` or the ``hystcomp`` command."""
-    path = Path(path)
+    """Read a model file written by :func:`save_model` or the ``hystcomp`` command.
+
+    Raises
+    ------
+    ModelFileError
+        If the file is missing, not a regular file, too large, not JSON, holds NaN or
+        Infinity, or is not a valid model of a known kind and supported version.
+    """
+    path = as_path(path, "path", "load_model")
+    name = repr(str(path))
     try:
+        if path.is_dir():
+            raise ModelFileError(f"{name} is a folder, not a model file.")
+        if path.exists() and not path.is_file():
+            raise ModelFileError(f"{name} is not a regular file (a device or a pipe?).")
+        if path.exists() and path.stat().st_size > MAX_MODEL_FILE_BYTES:
+            raise ModelFileError(
+                f"{name} is {path.stat().st_size} bytes, too large for a model file "
+                f"(at most {MAX_MODEL_FILE_BYTES}); check the path."
+            )
         text = path.read_text(encoding="utf-8")
     except FileNotFoundError:
-        raise ModelFileError(f"Model file {str(path)!r} does not exist; check the path.") from None
-    except IsADirectoryError:
-        raise ModelFileError(f"{str(path)!r} is a folder, not a model file.") from None
+        raise ModelFileError(f"Model file {name} does not exist; check the path.") from None
     except UnicodeDecodeError:
         raise ModelFileError(
-            f"{str(path)!r} is not a text file; a model file is JSON written by hystcomp."
+            f"{name} is not a text file; a model file is JSON written by hystcomp."
         ) from None
     except OSError as exc:
-        raise ModelFileError(f"Cannot read model file {str(path)!r}: {exc.strerror}.") from None
+        raise ModelFileError(f"Cannot read model file {name}: {exc.strerror or exc}.") from None
     try:
-        doc = json.loads(text)
+        doc = json.loads(text, parse_constant=_refuse_constant)
     except json.JSONDecodeError as exc:
         raise ModelFileError(
-            f"{str(path)!r} is not valid JSON (line {exc.lineno}: {exc.msg}); "
+            f"{name} is not valid JSON (line {exc.lineno}: {exc.msg}); "
             "a model file is written by 'hystcomp identify' or hystcomp.save_model."
         ) from None
-    return model_from_dict(doc, source=repr(str(path)))
+    except ValueError as exc:  # NaN/Infinity, or an integer too long to read
+        raise ModelFileError(
+            f"{name} is not a valid model file: {exc}. Model files hold finite numbers only."
+        ) from None
+    except RecursionError:
+        raise ModelFileError(
+            f"{name} nests arrays or objects too deeply to be a model file."
+        ) from None
+    return model_from_dict(doc, source=name)

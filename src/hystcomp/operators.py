@@ -186,8 +186,8 @@ def chain_parts(p):
 def chain_blocks(p, u, out, work):
     """Run every sample of ``u`` through packed chain ``p`` into ``out``; state kept in ``p``.
 
-    A non-finite sample holds the last output and increments the non-finite counter.
-    Samples go through in blocks of :data:`BLOCK`, stage by stage: the stateless dead-zone
+    A non-finite sample, or one whose result overflows, holds the last output and
+    increments the non-finite counter; the plays advance only on a finite input. Samples go through in blocks of :data:`BLOCK`, stage by stage: the stateless dead-zone
     stages as passes over the block, the plays and the output limits sample by sample.
     ``out`` is the work buffer of the stages before the plays and ``work`` (at least
     ``min(BLOCK, u.size)`` long if the chain has dead-zones after the plays) that of the
@@ -221,17 +221,20 @@ def chain_blocks(p, u, out, work):
                 z[k] = ub[k] - in_offset
         if play_r.size > 0:
             for k in range(ub.size):
-                if ub[k] - ub[k] == 0.0:  # finite: the plays advance
+                if abs(z[k]) < np.inf:  # finite (input and dead-zones): the plays advance
                     z[k] = play_step(z[k], play_r, play_w, plays)
         zb = z
         if post_r.size > 0:
             zb = work[: ub.size]
             deadzone_block(z, 0.0, post_r, post_w, zb)
         for k in range(ub.size):
-            if ub[k] - ub[k] != 0.0:  # NaN or +-inf: hold the last output
+            zk = zb[k] + out_offset
+            # NaN or +-inf input, or a result that overflowed (a finite input near the
+            # float range): hold the last output. Written as comparisons with inf, which
+            # the fast-math flags in use keep.
+            if ub[k] - ub[k] != 0.0 or not abs(zk) < np.inf:
                 held += 1.0
             else:
-                zk = zb[k] + out_offset
                 if slewing:
                     zk = min(max(zk, last - max_step), last + max_step)
                 last = min(max(zk, low), high)

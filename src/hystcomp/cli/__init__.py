@@ -1,12 +1,15 @@
 """The ``hystcomp`` command.
 
 Each subcommand lives in its own module of this package and registers itself on
-:data:`main`. Exit status: 0 on success, 2 on bad usage or bad input (one line, no
-traceback), 1 on an internal fault.
+:data:`main`. Exit status: 0 on success, 2 on bad usage or bad input (one line on
+standard error that names the problem and the fix, no traceback), 1 on an internal fault,
+141 when standard output is closed early (``| head``).
 """
 
 from __future__ import annotations
 
+import contextlib
+import os
 import sys
 
 import click
@@ -15,10 +18,15 @@ from hystcomp.errors import HystcompError
 
 EXIT_BAD_INPUT = 2
 EXIT_INTERNAL = 1
+EXIT_BROKEN_PIPE = 141  # 128 + SIGPIPE, as a shell reports a command killed by it
+
+
+def _one_line(text: str) -> str:
+    return " ".join(str(text).split())
 
 
 class _Group(click.Group):
-    """A click group that turns hystcomp's errors into one line and exit status 2."""
+    """A click group that turns bad usage and hystcomp's errors into one line and exit 2."""
 
     def main(self, args=None, prog_name=None, complete_var=None, standalone_mode=True, **extra):
         try:
@@ -26,18 +34,33 @@ class _Group(click.Group):
         except click.exceptions.Abort:
             click.echo("hystcomp: aborted", err=True)
             sys.exit(EXIT_INTERNAL)
+        except click.UsageError as exc:
+            hint = f" (see '{exc.ctx.command_path} --help')" if exc.ctx is not None else ""
+            click.echo(f"hystcomp: error: {_one_line(exc.format_message())}{hint}", err=True)
+            sys.exit(EXIT_BAD_INPUT)
         except click.ClickException as exc:
-            exc.show()
+            click.echo(f"hystcomp: error: {_one_line(exc.format_message())}", err=True)
             sys.exit(exc.exit_code)
         except HystcompError as exc:
-            click.echo(f"hystcomp: error: {exc}", err=True)
+            click.echo(f"hystcomp: error: {_one_line(exc)}", err=True)
             sys.exit(EXIT_BAD_INPUT)
+        except MemoryError:
+            click.echo(
+                "hystcomp: error: not enough memory for this input; use a shorter record, "
+                "fewer operators or a lower sample rate.",
+                err=True,
+            )
+            sys.exit(EXIT_BAD_INPUT)
+        except BrokenPipeError:  # the reader of standard output went away (e.g. | head)
+            with contextlib.suppress(OSError, ValueError):  # no flush error at exit either
+                os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+            sys.exit(EXIT_BROKEN_PIPE)
         except KeyboardInterrupt:
             click.echo("hystcomp: interrupted", err=True)
             sys.exit(130)
         except Exception as exc:  # noqa: BLE001 - an internal fault: say so, briefly
             click.echo(
-                f"hystcomp: internal error: {type(exc).__name__}: {exc} "
+                f"hystcomp: internal error: {type(exc).__name__}: {_one_line(exc)} "
                 "(please report it with the command you ran)",
                 err=True,
             )

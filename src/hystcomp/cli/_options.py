@@ -1,15 +1,101 @@
-"""Options shared by several subcommands: data columns, sample rate, output file."""
+"""Options shared by several subcommands, and the checks every option value goes through.
+
+Every value is checked when click parses it (a callback), so that a bad option is refused
+before any file is read or any work is done, with one line naming the option and the fix.
+"""
 
 from __future__ import annotations
 
+import math
+
 import click
 
-from hystcomp.data import parse_columns
+from hystcomp._validation import MAX_MAGNITUDE
+from hystcomp.data import check_writable, parse_columns
+from hystcomp.errors import InvalidParameterError
+from hystcomp.io import check_output_path
+
+#: Largest --operators / --deadzones (the paper uses 16; the fit's cost grows as n^2 per sample).
+MAX_OPERATORS = 1000
+
+
+def _finite(value: float, param) -> float:
+    if not (math.isfinite(value) and abs(value) <= MAX_MAGNITUDE):
+        raise click.BadParameter(
+            f"must be a finite number of size at most {MAX_MAGNITUDE:g}; got {value!r}.",
+            param=param,
+        )
+    return value
+
+
+def positive(unit: str):
+    """A callback: the value, if given, must be a finite number > 0 (in ``unit``)."""
+
+    def check(ctx, param, value):
+        if value is None:
+            return None
+        if not (_finite(value, param) > 0):
+            raise click.BadParameter(f"must be a number > 0 ({unit}); got {value!r}.", param=param)
+        return value
+
+    return check
+
+
+def nonnegative(unit: str):
+    """A callback: the value, if given, must be a finite number >= 0 (in ``unit``)."""
+
+    def check(ctx, param, value):
+        if value is None:
+            return None
+        if not (_finite(value, param) >= 0):
+            raise click.BadParameter(f"must be a number >= 0 ({unit}); got {value!r}.", param=param)
+        return value
+
+    return check
+
+
+def fraction(ctx, param, value):
+    """A callback: the value, if given, must lie strictly between 0 and 1."""
+    if value is not None and not 0.0 < value < 1.0:
+        raise click.BadParameter(
+            f"must be between 0 and 1 (exclusive); got {value!r}.", param=param
+        )
+    return value
+
+
+def count(ctx, param, value):
+    """A callback: an operator count between 1 and :data:`MAX_OPERATORS`."""
+    if value is not None and not 1 <= value <= MAX_OPERATORS:
+        raise click.BadParameter(
+            f"must be between 1 and {MAX_OPERATORS} (the paper uses 16); got {value}.",
+            param=param,
+        )
+    return value
+
+
+def voltage_range(ctx, param, value):
+    """A callback: ``LO HI`` in V, finite, with ``LO < HI``."""
+    if value is None:
+        return None
+    lo, hi = (_finite(v, param) for v in value)
+    if not lo < hi:
+        raise click.BadParameter(f"must be LO HI with LO < HI (V); got {lo:g} {hi:g}.", param=param)
+    return (lo, hi)
+
+
+def columns(ctx, param, value):
+    """A callback: a column mapping such as ``v=1,x=5`` (see :func:`parse_columns`)."""
+    try:
+        return parse_columns(value)
+    except InvalidParameterError as exc:
+        raise click.BadParameter(str(exc), param=param) from None
+
 
 columns_option = click.option(
     "--columns",
     metavar="SPEC",
     default=None,
+    callback=columns,
     help=(
         "Which file columns hold t, v, x: 1-based numbers for text tables (v=1,x=5) or "
         "names (v=volts,x=disp). Default: columns named t, v, x."
@@ -21,6 +107,7 @@ fs_option = click.option(
     type=float,
     default=None,
     metavar="HZ",
+    callback=positive("Hz"),
     help="Sample rate in Hz, for files without a time column t.",
 )
 
@@ -36,6 +123,12 @@ def output_option(required: bool = True, what: str = "output"):
     )
 
 
-def read_options(columns: str | None, sample_rate: float | None) -> dict:
+def read_options(columns: dict | None, sample_rate: float | None) -> dict:
     """Keyword arguments for :func:`hystcomp.data.read_table` from the shared options."""
-    return {"columns": parse_columns(columns), "sample_rate": sample_rate}
+    return {"columns": columns, "sample_rate": sample_rate}
+
+
+def check_data_output(path, *, inputs=(), what: str = "output"):
+    """Refuse, before any work, a data output that cannot be written or would overwrite an input."""
+    check_output_path(path, inputs=inputs, what=what)
+    return check_writable(path)

@@ -2,12 +2,52 @@
 
 from __future__ import annotations
 
+import inspect
+
 import click
+import numpy as np
 
 from hystcomp.cli import main
-from hystcomp.cli._options import columns_option, fs_option, output_option, read_options
-from hystcomp.data import rate_of, read_table, write_table
+from hystcomp.cli._options import (
+    check_data_output,
+    columns_option,
+    fs_option,
+    output_option,
+    positive,
+    read_options,
+    voltage_range,
+)
+from hystcomp.data import read_table, write_table
+from hystcomp.errors import InvalidParameterError
 from hystcomp.io import load_model
+
+
+def inverse_options(model, table, *, slew_rate, narrow_range) -> dict:
+    """Keyword arguments of ``model.inverse`` for the command's options.
+
+    The slew-rate limit is per sample, so it needs the reference's own sample rate. With
+    uneven sampling the shortest interval is taken: the limit then holds on every interval.
+    """
+    options = {}
+    if slew_rate is not None:
+        shortest = float(np.min(np.diff(table["t"])))
+        options.update(slew_rate=slew_rate, sample_rate=1.0 / shortest)
+    if narrow_range is not None:
+        (lo, hi), (low, high) = model.voltage_range_, narrow_range
+        if low < lo or high > hi:
+            raise click.BadParameter(
+                f"may only narrow the model's voltage range {lo:g} .. {hi:g} V: the model was "
+                f"identified inside it and would command voltages it never saw. Got {low:g} "
+                f"{high:g}; choose limits within it, or identify over a wider range.",
+                param_hint="'--voltage-range'",
+            )
+        if "voltage_range" not in inspect.signature(model.inverse).parameters:
+            raise InvalidParameterError(
+                f"--voltage-range is not available for {model.kind!r} models; their "
+                "compensator is clamped to the model's own voltage range."
+            )
+        options["voltage_range"] = narrow_range
+    return options
 
 
 @main.command("compensate")
@@ -21,19 +61,36 @@ from hystcomp.io import load_model
     type=float,
     default=None,
     metavar="V/S",
-    help="Largest voltage slew rate of the output (none by default).",
+    callback=positive("V/s"),
+    help="Largest voltage slew rate of the output, in V/s, at the reference's own sample "
+    "rate (none by default).",
 )
-def compensate(model_file, reference_file, output, columns, sample_rate, slew_rate):
+@click.option(
+    "--voltage-range",
+    "narrow_range",
+    nargs=2,
+    type=float,
+    default=None,
+    metavar="LO HI",
+    callback=voltage_range,
+    help="Clamp the output to this range in V, inside the model's range (it may only "
+    "narrow it) [the model's range].",
+)
+def compensate(model_file, reference_file, output, columns, sample_rate, slew_rate, narrow_range):
     """Voltage that makes the actuator of MODEL.json follow REFERENCE (columns t, x).
 
-    Uses the model's inverse (eqs. 23-26 for PI/MPI), clamped to the model's voltage range.
-    Writes t (s), v (V) and x_ref (µm).
+    Uses the model's inverse (eqs. 23-26 for PI/MPI), clamped to the model's voltage range
+    (or a narrower --voltage-range). Writes t (s), v (V) and x_ref (µm).
     """
+    check_data_output(output, inputs=(model_file, reference_file), what="voltage file")
     model = load_model(model_file)
     table = read_table(reference_file, ("x",), **read_options(columns, sample_rate))
-    options = {}
-    if slew_rate is not None:
-        options = {"slew_rate": slew_rate, "sample_rate": rate_of(table["t"])}
-    v = model.inverse(**options).simulate(table["x"])
+    options = inverse_options(model, table, slew_rate=slew_rate, narrow_range=narrow_range)
+    compensator = model.inverse(**options)
+    v = compensator.simulate(table["x"])
     write_table(output, {"t": table["t"], "v": v, "x_ref": table["x"]})
-    click.echo(f"wrote {output}: {v.size} samples, v from {v.min():.4g} to {v.max():.4g} V")
+    lo, hi = compensator.voltage_range
+    click.echo(
+        f"wrote {output}: {v.size} samples, v from {v.min():.4g} to {v.max():.4g} V "
+        f"(clamped to {lo:.4g} .. {hi:.4g} V)"
+    )

@@ -5,7 +5,7 @@ from __future__ import annotations
 import click
 
 from hystcomp.cli import main
-from hystcomp.cli._options import output_option
+from hystcomp.cli._options import check_data_output, output_option, positive, voltage_range
 from hystcomp.data import format_csv, write_table
 from hystcomp.identify.excitation import (
     DEFAULT_SAMPLE_RATE,
@@ -34,6 +34,7 @@ SIGNALS = {
     default=DEFAULT_SAMPLE_RATE,
     show_default=True,
     metavar="HZ",
+    callback=positive("Hz"),
     help="Sample rate in Hz.",
 )
 @click.option(
@@ -43,10 +44,17 @@ SIGNALS = {
     default=(0.0, 120.0),
     show_default=True,
     metavar="LO HI",
+    callback=voltage_range,
     help="Amplifier range in V; the paper's amplitudes are scaled from 0..120 V to it.",
 )
 @click.option(
-    "--frequency", type=float, default=1.0, show_default=True, metavar="HZ", help="Period rate."
+    "--frequency",
+    type=float,
+    default=1.0,
+    show_default=True,
+    metavar="HZ",
+    callback=positive("Hz"),
+    help="Period rate.",
 )
 def excite(model, output, sample_rate, voltage_range, frequency):
     """Write the identification input for MODEL (pi, mpi or preisach).
@@ -55,6 +63,8 @@ def excite(model, output, sample_rate, voltage_range, frequency):
     5, 10, ..., 120 V at 1 Hz (Section III-A). Each starts and ends at the lower end of the
     range. Columns: t (s), v (V).
     """
+    if output is not None:
+        check_data_output(output, what="signal file")
     shape, amplitudes = SIGNALS[model]
     t, v = shape(
         scaled_amplitudes(amplitudes, voltage_range=voltage_range),

@@ -8,12 +8,19 @@ import click
 import numpy as np
 
 from hystcomp.cli import main
-from hystcomp.cli._options import columns_option, fs_option, read_options
+from hystcomp.cli._options import (
+    columns_option,
+    count,
+    fraction,
+    fs_option,
+    nonnegative,
+    read_options,
+    voltage_range,
+)
 from hystcomp.data import read_record
 from hystcomp.errors import IdentificationError
-from hystcomp.experiment.fig_identification import FORMATS, plot_identification
 from hystcomp.identify.scoring import error_report, holdout_report, straight_line, transient_end
-from hystcomp.io import MODEL_KINDS, save_model
+from hystcomp.io import MODEL_KINDS, atomic_paths, check_output_path, model_text
 
 DEFAULT_OPERATORS = 16
 
@@ -56,8 +63,16 @@ def _sizes(model) -> str:
 @click.option(
     "--model", "kind", type=click.Choice(list(LABELS)), required=True, help="Model family."
 )
-@click.option("--operators", type=int, default=None, help="Number of plays n+1 [16].")
-@click.option("--deadzones", type=int, default=None, help="Number of dead-zones m+1, mpi [16].")
+@click.option(
+    "--operators", type=int, default=None, callback=count, help="Number of plays n+1 [16]."
+)
+@click.option(
+    "--deadzones",
+    type=int,
+    default=None,
+    callback=count,
+    help="Number of dead-zones m+1, mpi [16].",
+)
 @columns_option
 @fs_option
 @click.option(
@@ -65,6 +80,7 @@ def _sizes(model) -> str:
     type=float,
     default=None,
     metavar="SECONDS",
+    callback=nonnegative("s"),
     help="Start of the record left out of the fit [until the input first reaches an end "
     "of its range].",
 )
@@ -74,6 +90,7 @@ def _sizes(model) -> str:
     type=float,
     default=None,
     metavar="LO HI",
+    callback=voltage_range,
     help="Amplifier range in V, the compensator's clamp [the record's range].",
 )
 @click.option(
@@ -81,6 +98,7 @@ def _sizes(model) -> str:
     type=float,
     default=None,
     metavar="FRACTION",
+    callback=fraction,
     help="Fit on the first part only and report how well the model predicts this last "
     "fraction of the record, against a straight line.",
 )
@@ -104,12 +122,15 @@ def identify(
     PI and MPI: constrained least squares (eqs. 16-19) with invertible weights; the
     start-up transient, the input range (bipolar too) and a displacement offset are handled.
     """
-    if holdout is not None and not 0.0 < holdout < 1.0:
-        raise click.BadParameter(f"must be between 0 and 1; got {holdout}.", param_hint="--holdout")
-    if transient is not None and not transient >= 0.0:
-        raise click.BadParameter(f"must be >= 0 s; got {transient}.", param_hint="--transient")
-    if plot is not None and Path(plot).suffix.lower() not in FORMATS:
-        raise click.BadParameter(f"must end in {', '.join(FORMATS)}.", param_hint="--plot")
+    check_output_path(output, inputs=(data,), what="model file")
+    if plot is not None:  # matplotlib is imported only when a figure is asked for
+        from hystcomp.experiment.fig_identification import FORMATS, plot_identification
+
+        if Path(plot).suffix.lower() not in FORMATS:
+            raise click.BadParameter(f"must end in {', '.join(FORMATS)}.", param_hint="--plot")
+        check_output_path(plot, inputs=(data,), what="figure")
+        if Path(plot).resolve() == Path(output).resolve():
+            raise click.BadParameter("names the same file as -o.", param_hint="--plot")
     model = build_estimator(
         kind, operators=operators, deadzones=deadzones, voltage_range=voltage_range
     )
@@ -155,10 +176,16 @@ def identify(
             f"{held['model_rms_um']:.4g} µm, straight line rms {held['line_rms_um']:.4g} µm: "
             f"{held['improvement']:.3g}x better"
         )
-    if plot is not None:
-        a, b = straight_line(v[start:], x[start:])
-        line = a * v[start:] + b
-        plot_identification(v[start:], x[start:], line, x_model[start:], plot, model_name=label)
-        click.echo(f"  wrote {plot}")
-    save_model(model, output)
-    click.echo(f"  wrote {output}")
+    # Everything is computed; now write all outputs at once (a failure writes none of them).
+    text = model_text(model)
+    outputs = [output] if plot is None else [output, plot]
+    with atomic_paths(*outputs) as (tmp_model, *tmp_plot):
+        tmp_model.write_text(text, encoding="utf-8")
+        if plot is not None:
+            a, b = straight_line(v[start:], x[start:])
+            line = a * v[start:] + b
+            plot_identification(
+                v[start:], x[start:], line, x_model[start:], tmp_plot[0], model_name=label
+            )
+    for path in outputs[::-1]:
+        click.echo(f"  wrote {path}")

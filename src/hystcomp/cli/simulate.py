@@ -5,7 +5,13 @@ from __future__ import annotations
 import click
 
 from hystcomp.cli import main
-from hystcomp.cli._options import columns_option, fs_option, output_option, read_options
+from hystcomp.cli._options import (
+    check_data_output,
+    columns_option,
+    fs_option,
+    output_option,
+    read_options,
+)
 from hystcomp.data import read_table, write_table
 from hystcomp.io import load_model
 
@@ -21,6 +27,7 @@ def simulate(model_file, input_file, output, columns, sample_rate):
 
     Writes t (s), v (V) and the modelled displacement x (µm).
     """
+    check_data_output(output, inputs=(model_file, input_file), what="result file")
     model = load_model(model_file)
     table = read_table(input_file, ("v",), **read_options(columns, sample_rate))
     v = table["v"]

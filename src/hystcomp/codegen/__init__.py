@@ -13,7 +13,6 @@ the same files for all of them. PI and MPI compensators share the chain template
 
 from __future__ import annotations
 
-import contextlib
 import os
 from collections.abc import Callable
 from pathlib import Path
@@ -21,7 +20,7 @@ from pathlib import Path
 from hystcomp.codegen.c99 import CTemplate, check_prefix, render
 from hystcomp.codegen.chain import chain_template
 from hystcomp.errors import InvalidParameterError, InvalidTypeError
-from hystcomp.io import atomic_path
+from hystcomp.io import atomic_paths
 
 DEFAULT_PREFIX = "hystcomp_compensator"
 
@@ -110,15 +109,8 @@ def export_c(
             )
         directory.mkdir()
     paths = (directory / f"{prefix}.h", directory / f"{prefix}.c")
-    try:
-        # both files renamed into place only once both are written (the .c first)
-        with contextlib.ExitStack() as stack:
-            tmp_h, tmp_c = (stack.enter_context(atomic_path(path)) for path in paths)
-            tmp_h.write_text(header, encoding="ascii")
-            tmp_c.write_text(source_text, encoding="ascii")
-    except OSError as exc:
-        raise InvalidParameterError(
-            f"Cannot write the C files into {str(directory)!r}: {exc.strerror} "
-            f"({exc.filename}). Check that NAME.h and NAME.c can be written there."
-        ) from None
+    # both files checked before anything is written, renamed into place only once both are
+    with atomic_paths(*paths) as (tmp_h, tmp_c):
+        tmp_h.write_text(header, encoding="ascii")
+        tmp_c.write_text(source_text, encoding="ascii")
     return paths

@@ -45,6 +45,11 @@ def chain_template(compensator) -> CTemplate:
         ]
         template.step_body += [
             "",
+            "if (!isfinite(z)) { /* overflow on a huge finite x_ref: hold, plays unmoved */",
+            "    s->nonfinite_count++;",
+            "    return s->last;",
+            "}",
+            "",
             "/* play operators, eq. 11, and their weighted sum, eq. 12 */",
             "{",
             "    double acc = 0.0;",

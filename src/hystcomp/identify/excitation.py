@@ -7,16 +7,41 @@ from __future__ import annotations
 
 import numpy as np
 
-from hystcomp._validation import check_range, check_real
+from hystcomp._validation import as_vector, check_range, check_real
+from hystcomp.errors import InvalidParameterError
 
 DEFAULT_SAMPLE_RATE = 20_000.0  # Hz, the paper's rig (Section II)
 PI_AMPLITUDES = (30.0, 60.0, 90.0, 120.0)  # V, Section IV-A (ii)
 PREISACH_AMPLITUDES = tuple(float(a) for a in range(5, 125, 5))  # V, Section III-A (i)
+MIN_SAMPLES_PER_PERIOD = 4  # fewer cannot draw a triangle or a sinusoid
+MAX_SAMPLES = 10**8  # 1.6 GB of t and v; beyond that the request is a mistake
 
 
-def _periods(sample_rate: float, frequency: float) -> np.ndarray:
+def _periods(owner, amplitudes, sample_rate, frequency, v_min):
+    """Validated amplitudes and ``v_min``, and the phase of one period in [0, 1)."""
+    amplitudes = as_vector(amplitudes, "amplitudes", owner)
+    if np.any(amplitudes < 0):
+        raise InvalidParameterError(
+            f"The 'amplitudes' parameter of {owner} must hold amplitudes >= 0 V (each period "
+            f"rises from v_min by its amplitude). Got {amplitudes.min()!r}."
+        )
+    v_min = check_real(v_min, "v_min", owner)
+    sample_rate = check_real(sample_rate, "sample_rate", owner, positive=True)
+    frequency = check_real(frequency, "frequency", owner, positive=True)
     n = round(sample_rate / frequency)
-    return np.arange(n) / n  # phase of one period, in [0, 1)
+    if n < MIN_SAMPLES_PER_PERIOD:
+        raise InvalidParameterError(
+            f"{owner}: a sample rate of {sample_rate:g} Hz gives {n} samples per period at "
+            f"{frequency:g} Hz; at least {MIN_SAMPLES_PER_PERIOD} are needed. Raise the sample "
+            "rate or lower the frequency."
+        )
+    if n * amplitudes.size + 1 > MAX_SAMPLES:
+        raise InvalidParameterError(
+            f"{owner}: {amplitudes.size} periods of {n} samples ({sample_rate:g} Hz at "
+            f"{frequency:g} Hz) make {n * amplitudes.size + 1} samples, more than "
+            f"{MAX_SAMPLES}. Lower the sample rate or raise the frequency."
+        )
+    return amplitudes, v_min, np.arange(n) / n
 
 
 def triangle_sequence(
@@ -42,9 +67,8 @@ def triangle_sequence(
     >>> v.tolist()
     [0.0, 5.0, 10.0, 5.0, 0.0, 10.0, 20.0, 10.0, 0.0]
     """
-    phase = _periods(
-        check_real(sample_rate, "sample_rate", "triangle_sequence", positive=True),
-        check_real(frequency, "frequency", "triangle_sequence", positive=True),
+    amplitudes, v_min, phase = _periods(
+        "triangle_sequence", amplitudes, sample_rate, frequency, v_min
     )
     shape = 1.0 - np.abs(1.0 - 2.0 * phase)  # 0 -> 1 -> 0
     v = np.concatenate([a * shape for a in amplitudes] + [np.zeros(1)]) + v_min
@@ -69,9 +93,8 @@ def sinusoid_sequence(
     t, v : ndarray
         Time in s and voltage in V.
     """
-    phase = _periods(
-        check_real(sample_rate, "sample_rate", "sinusoid_sequence", positive=True),
-        check_real(frequency, "frequency", "sinusoid_sequence", positive=True),
+    amplitudes, v_min, phase = _periods(
+        "sinusoid_sequence", amplitudes, sample_rate, frequency, v_min
     )
     shape = 0.5 * (1.0 - np.cos(2.0 * np.pi * phase))
     v = np.concatenate([a * shape for a in amplitudes] + [np.zeros(1)]) + v_min
@@ -81,5 +104,7 @@ def sinusoid_sequence(
 def scaled_amplitudes(amplitudes, paper_range=(0.0, 120.0), voltage_range=(0.0, 120.0)):
     """The paper's amplitudes rescaled from 0..120 V to another ``voltage_range``."""
     lo, hi = check_range(voltage_range, "voltage_range", "scaled_amplitudes")
+    paper_range = check_range(paper_range, "paper_range", "scaled_amplitudes")
+    amplitudes = as_vector(amplitudes, "amplitudes", "scaled_amplitudes")
     scale = (hi - lo) / (paper_range[1] - paper_range[0])
-    return tuple(a * scale for a in amplitudes)
+    return tuple(float(a) * scale for a in amplitudes)

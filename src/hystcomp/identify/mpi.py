@@ -31,7 +31,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from hystcomp._validation import check_int
+from hystcomp._validation import as_vector, check_int, check_real
+from hystcomp.errors import InvalidParameterError
 from hystcomp.identify.lsq import constrained_lsq, normal_equations
 from hystcomp.identify.pi import DEFAULT_MARGIN, check_margin, paper_thresholds, prepare_record
 
@@ -81,8 +82,17 @@ def absorb_bias(weights, initial_state, input_offset: float, bias: float):
     >>> absorb_bias(np.array([0.5, 0.5]), np.zeros(2), 10.0, 2.0)
     (array([2., 2.]), 8.0)
     """
-    shift = bias / float(np.sum(weights))
-    return np.asarray(initial_state, dtype=np.float64) + shift, input_offset - shift
+    weights = as_vector(weights, "weights", "absorb_bias")
+    initial_state = as_vector(initial_state, "initial_state", "absorb_bias", length=weights.size)
+    input_offset = check_real(input_offset, "input_offset", "absorb_bias")
+    bias = check_real(bias, "bias", "absorb_bias")
+    total = float(np.sum(weights))
+    if total == 0.0:
+        raise InvalidParameterError(
+            "absorb_bias: the weights sum to 0, so a bias cannot be absorbed."
+        )
+    shift = bias / total
+    return initial_state + shift, input_offset - shift
 
 
 def fit_mpi(

@@ -36,8 +36,9 @@ def paper_thresholds(n_operators: int, span: float) -> np.ndarray:
     >>> paper_thresholds(4, 120.0).tolist()
     [0.0, 30.0, 60.0, 90.0]
     """
-    n_operators = check_int(n_operators, "n_operators", "paper_thresholds")
-    return np.arange(n_operators) / n_operators * float(span)
+    n_operators = check_int(n_operators, "n_operators", "paper_thresholds", maximum=10**6)
+    span = check_real(span, "span", "paper_thresholds", positive=True, bound=np.inf)
+    return np.arange(n_operators) / n_operators * span
 
 
 @dataclass(frozen=True)
@@ -84,7 +85,8 @@ def prepare_record(v, x, *, n_weights: int, transient, owner: str) -> PreparedRe
             f"{owner}: the input 'v' is constant after the start-up transient (sample "
             f"{start} on). Set a shorter transient."
         )
-    if np.dot(u_fit - u_fit.mean(), x_fit - x_fit.mean()) <= 0.0:
+    # scaled by the spans, so that the sign survives records of any magnitude
+    if np.dot((u_fit - u_fit.mean()) / span, (x_fit - x_fit.mean()) / x_span) <= 0.0:
         raise IdentificationError(
             f"{owner}: the displacement 'x' falls as the voltage 'v' rises. The models "
             "describe an actuator whose displacement rises with its voltage: flip the sign "

@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from hystcomp._validation import as_signal, check_int
-from hystcomp.errors import IdentificationError
+from hystcomp.errors import IdentificationError, InvalidSignalError
 
 #: How close (as a fraction of the input span) the input must come to an end of its range.
 END_TOLERANCE = 0.01
@@ -84,8 +84,14 @@ def error_report(x, x_model, start: int = 0) -> dict:
         range (``rms_error_percent``, ``max_error_percent``), ``displacement_range_um``,
         ``n_samples`` (the record), ``n_used`` and ``first_used_sample``.
     """
-    x = np.asarray(x, dtype=np.float64)[start:]
-    err = np.asarray(x_model, dtype=np.float64)[start:] - x
+    x, x_model = _pair(x, x_model, "x", "x_model", "error_report")
+    start = check_int(start, "start", "error_report", minimum=0)
+    if start >= x.size:
+        raise IdentificationError(
+            f"error_report: 'start' ({start}) leaves no sample of the {x.size} to score."
+        )
+    x = x[start:]
+    err = x_model[start:] - x
     span = float(np.ptp(x))
     rms = float(np.sqrt(np.mean(err**2)))
     worst = float(np.abs(err).max())
@@ -101,6 +107,17 @@ def error_report(x, x_model, start: int = 0) -> dict:
     }
 
 
+def _pair(a, b, name_a: str, name_b: str, owner: str):
+    """Two finite signals of the same length."""
+    a, b = as_signal(a, name_a), as_signal(b, name_b)
+    if a.size != b.size:
+        raise InvalidSignalError(
+            f"{owner}: {name_a!r} and {name_b!r} must have one sample each per instant. "
+            f"Got {a.size} and {b.size}."
+        )
+    return a, b
+
+
 def straight_line(v, x) -> tuple[float, float]:
     """Least-squares line ``x = a v + b`` (a in µm/V, b in µm): the no-hysteresis baseline.
 
@@ -110,9 +127,9 @@ def straight_line(v, x) -> tuple[float, float]:
     >>> round(a, 9), round(b, 9)
     (2.0, 1.0)
     """
-    v = np.asarray(v, dtype=np.float64)
+    v, x = _pair(v, x, "v", "x", "straight_line")
     design = np.column_stack([v, np.ones_like(v)])
-    (a, b), *_ = np.linalg.lstsq(design, np.asarray(x, dtype=np.float64), rcond=None)
+    (a, b), *_ = np.linalg.lstsq(design, x, rcond=None)
     return float(a), float(b)
 
 
@@ -129,8 +146,14 @@ def holdout_report(model, v, x, n_fit: int, start: int = 0) -> dict:
         ``n_holdout``, ``model_rms_um``, ``line_rms_um`` and ``improvement`` (their ratio,
         > 1 when the model predicts better than the line).
     """
-    v = np.asarray(v, dtype=np.float64)
-    x = np.asarray(x, dtype=np.float64)
+    v, x = _pair(v, x, "v", "x", "holdout_report")
+    n_fit = check_int(n_fit, "n_fit", "holdout_report", minimum=1)
+    start = check_int(start, "start", "holdout_report", minimum=0)
+    if not start < n_fit < v.size:
+        raise IdentificationError(
+            f"holdout_report: need start < n_fit < {v.size} samples (a fit part and a held-out "
+            f"part). Got start={start}, n_fit={n_fit}."
+        )
     model_err = model.simulate(v)[n_fit:] - x[n_fit:]
     a, b = straight_line(v[start:n_fit], x[start:n_fit])
     line_err = a * v[n_fit:] + b - x[n_fit:]

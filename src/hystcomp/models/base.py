@@ -7,7 +7,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from hystcomp._validation import as_vector, check_int, check_range, check_real
-from hystcomp.errors import NotFittedError
+from hystcomp.errors import InvalidParameterError, NotFittedError
 from hystcomp.identify.pi import check_margin
 from hystcomp.models.compensator import ChainSystem
 
@@ -62,7 +62,15 @@ class HysteresisModel(ChainSystem):
 
     @classmethod
     def from_dict(cls, data: dict[str, Any]):
-        """Inverse of :meth:`to_dict` (validates everything through ``from_parameters``)."""
+        """Inverse of :meth:`to_dict` (validates everything through ``from_parameters``).
+
+        :func:`hystcomp.io.model_from_dict` checks a whole document (keys, JSON types) first.
+        """
+        if not (isinstance(data, dict) and isinstance(data.get("parameters"), dict)):
+            raise InvalidParameterError(
+                f"{cls.__name__}.from_dict needs a dict with a 'parameters' dict (as written "
+                f"by to_dict). Got {type(data).__name__}."
+            )
         model = cls.from_parameters(**data["parameters"])
         for name, value in data.get("hyperparameters", {}).items():
             if name in cls._hyper:
@@ -70,6 +78,26 @@ class HysteresisModel(ChainSystem):
         if "fit_report" in data:
             model.fit_report_ = dict(data["fit_report"])
         return model
+
+    def _clamp_range(self, voltage_range, owner: str) -> tuple[float, float]:
+        """The compensator's clamp: ``voltage_range_``, or a ``voltage_range`` inside it.
+
+        A compensator may be told to stay in a narrower range than the model's (a stage
+        rated below the amplifier), never a wider one: the model was identified inside its
+        range and says nothing about the actuator outside it.
+        """
+        lo, hi = self.voltage_range_
+        if voltage_range is None:
+            return lo, hi
+        low, high = check_range(voltage_range, "voltage_range", owner)
+        if low < lo or high > hi:
+            raise InvalidParameterError(
+                f"The 'voltage_range' parameter of {owner} may only narrow the model's voltage "
+                f"range {lo:g} .. {hi:g} V: the model was identified inside it and would "
+                f"command voltages it never saw. Got {low:g} .. {high:g} V; choose limits "
+                f"within {lo:g} .. {hi:g} V, or identify the model over a wider range."
+            )
+        return low, high
 
     def _adopt(self, fitted: HysteresisModel, fit_report: dict) -> None:
         """Take the learned parameters of ``fitted`` (built by ``from_parameters``, so validated)."""

@@ -13,9 +13,16 @@ import numpy as np
 
 from hystcomp.errors import NotInvertibleError
 
+#: Largest inverse weight (eq. 25) accepted: with the bounded parameters and signals of
+#: :mod:`hystcomp._validation`, no sum or product in the inverse can then overflow.
+MAX_INVERSE_WEIGHT = 1e24
+
 
 def check_invertible(weights: np.ndarray, what: str) -> None:
     """Raise :class:`NotInvertibleError` unless every partial sum of ``weights`` is positive.
+
+    Also refuses partial sums so close to zero that the inverse weights of eq. (25) would
+    exceed :data:`MAX_INVERSE_WEIGHT` (or overflow): such an inverse is not computable.
 
     Examples
     --------
@@ -33,6 +40,19 @@ def check_invertible(weights: np.ndarray, what: str) -> None:
             f"{what} is not invertible: the partial sum of weights w_0 + ... + w_{i} = "
             f"{partial[i]:.6g} is not positive (index {i}). Eqs. 24-26 need every partial sum "
             f"> 0: identify the model with the invertibility constraint, or change weights[{i}].",
+            index=i,
+        )
+    with np.errstate(over="ignore", divide="ignore"):
+        gains = np.abs(np.r_[1.0 / partial[0], weights[1:] / (partial[1:] * partial[:-1])])
+    bad = np.flatnonzero(~(gains <= MAX_INVERSE_WEIGHT))
+    if bad.size:
+        i = int(bad[0])
+        raise NotInvertibleError(
+            f"{what} is not invertible in floating point: the partial sum of weights "
+            f"w_0 + ... + w_{i} = {partial[i]:.6g} is so close to 0 that the inverse weight "
+            f"w'_{i} of eq. 25 would be {gains[i]:.3g} in size (index {i}; at most "
+            f"{MAX_INVERSE_WEIGHT:g}). Identify the model with the invertibility constraint, "
+            f"or change weights[{i}].",
             index=i,
         )
 

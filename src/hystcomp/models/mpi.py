@@ -175,12 +175,12 @@ class ModifiedPrandtlIshlinskii(HysteresisModel):
             out_offset=self.output_offset_,
         )
 
-    def inverse(self, *, slew_rate=None, sample_rate=20_000.0) -> Compensator:
+    def inverse(self, *, slew_rate=None, sample_rate=20_000.0, voltage_range=None) -> Compensator:
         """The analytic inverse MPI, eq. (23): ``v = v_0 + H^-1[S^-1[x - x_0]]``, clamped.
 
         ``S^-1`` is a dead-zone superposition and ``H^-1`` a PI model, both from eqs. 24-25
-        (and eq. 26 for the initial states). ``slew_rate`` (V/s) and ``sample_rate`` (Hz)
-        are as in :meth:`PrandtlIshlinskii.inverse`.
+        (and eq. 26 for the initial states). ``slew_rate`` (V/s), ``sample_rate`` (Hz) and
+        ``voltage_range`` (a narrower clamp, V) are as in :meth:`PrandtlIshlinskii.inverse`.
 
         Raises
         ------
@@ -192,7 +192,7 @@ class ModifiedPrandtlIshlinskii(HysteresisModel):
         check_invertible(self.weights_, f"The hysteresis operator H of this {owner} model")
         check_invertible(self.deadzone_weights_, f"The saturation operator S of this {owner} model")
         max_step = slew_to_step(slew_rate, sample_rate, owner)
-        lo, hi = self.voltage_range_
+        lo, hi = self._clamp_range(voltage_range, f"{owner}.inverse")
         packed = operators.pack_chain(
             pre=invert_superposition(self.deadzone_thresholds_, self.deadzone_weights_),
             plays=(
@@ -205,7 +205,7 @@ class ModifiedPrandtlIshlinskii(HysteresisModel):
             high=hi,
             max_step=max_step,
         )
-        return Compensator(packed, kind=self.kind, voltage_range=self.voltage_range_)
+        return Compensator(packed, kind=self.kind, voltage_range=(lo, hi))
 
     @staticmethod
     def forward_deadzones(inverse_thresholds, inverse_weights) -> tuple[np.ndarray, np.ndarray]:

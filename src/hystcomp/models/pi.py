@@ -158,7 +158,7 @@ class PrandtlIshlinskii(HysteresisModel):
             out_offset=self.output_offset_,
         )
 
-    def inverse(self, *, slew_rate=None, sample_rate=20_000.0) -> Compensator:
+    def inverse(self, *, slew_rate=None, sample_rate=20_000.0, voltage_range=None) -> Compensator:
         """The analytic inverse PI (eqs. 24-26) as a compensator clamped to the voltage range.
 
         Parameters
@@ -167,6 +167,8 @@ class PrandtlIshlinskii(HysteresisModel):
             Largest output slew rate in V/s (none by default).
         sample_rate : float, default 20000
             Sample rate in Hz at which the compensator runs; sets the per-sample slew step.
+        voltage_range : (float, float), optional
+            A narrower output clamp in V, inside ``voltage_range_`` (never wider).
 
         Raises
         ------
@@ -177,9 +179,9 @@ class PrandtlIshlinskii(HysteresisModel):
         owner = type(self).__name__
         check_invertible(self.weights_, f"This {owner} model")
         max_step = slew_to_step(slew_rate, sample_rate, owner)
+        lo, hi = self._clamp_range(voltage_range, f"{owner}.inverse")
         r_inv, w_inv = invert_superposition(self.thresholds_, self.weights_)
         z0 = inverse_initial_state(self.weights_, self.initial_state_)
-        lo, hi = self.voltage_range_
         packed = operators.pack_chain(
             plays=(r_inv, w_inv, z0),
             in_offset=self.output_offset_,
@@ -188,4 +190,4 @@ class PrandtlIshlinskii(HysteresisModel):
             high=hi,
             max_step=max_step,
         )
-        return Compensator(packed, kind=self.kind, voltage_range=self.voltage_range_)
+        return Compensator(packed, kind=self.kind, voltage_range=(lo, hi))
