@@ -21,6 +21,7 @@ from hystcomp.errors import HystcompError, InvalidTypeError, ModelFileError
 from hystcomp.models.base import HysteresisModel
 from hystcomp.models.mpi import ModifiedPrandtlIshlinskii
 from hystcomp.models.pi import PrandtlIshlinskii
+from hystcomp.models.preisach import Preisach
 
 MODEL_FORMAT = "hystcomp-model"
 MODEL_VERSION = 1
@@ -29,6 +30,7 @@ MODEL_VERSION = 1
 MODEL_KINDS: dict[str, type[HysteresisModel]] = {
     PrandtlIshlinskii.kind: PrandtlIshlinskii,
     ModifiedPrandtlIshlinskii.kind: ModifiedPrandtlIshlinskii,
+    Preisach.kind: Preisach,
 }
 
 
