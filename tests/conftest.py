@@ -112,7 +112,9 @@ def monotone_theta(rng, degree, span, stroke):
         for p in range(k + 1)
     }
     theta = everett_from_density(nu, mu, degree)
-    full = sum(c * span ** (i + j) for c, (i, j) in zip(theta, _exps(degree)) if i == 0)
+    full = sum(
+        c * span ** (i + j) for c, (i, j) in zip(theta, _exps(degree), strict=True) if i == 0
+    )
     return theta * stroke / full
 
 

@@ -97,7 +97,10 @@ def preisach_extrema(v, everett, v_min, v_max):
                 break
             (alphas if want_max else betas).append(target)
             want_max = not want_max
-        x = sum(everett(a, b0) - everett(a, b1) for a, b0, b1 in zip(alphas, betas, betas[1:]))
+        x = sum(
+            everett(a, b0) - everett(a, b1)
+            for a, b0, b1 in zip(alphas, betas, betas[1:], strict=False)
+        )
         if want_max:  # rising from betas[-1]
             x += everett(u[k], betas[-1])
         else:  # falling from alphas[-1]

@@ -427,7 +427,7 @@ def turning_points(v, delta, out):
     first_is_max = direction == -1
     out[0] = i_hi if first_is_max else i_lo
     candidate = k
-    for k in range(k + 1, n):
+    for k in range(candidate + 1, n):
         if direction == 1:
             if v[k] >= v[candidate]:
                 candidate = k

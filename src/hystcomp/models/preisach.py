@@ -12,7 +12,7 @@ import numpy as np
 from hystcomp import preisach_kernels as pk
 from hystcomp._validation import as_signal, as_vector, check_int, check_range, check_real
 from hystcomp.errors import InvalidParameterError, InvalidTypeError
-from hystcomp.identify.preisach import EVERETT_KINDS, MAX_DEGREE, identify_preisach
+from hystcomp.identify.preisach import MAX_DEGREE, identify_preisach
 from hystcomp.models.base import HysteresisModel, slew_to_step
 from hystcomp.models.compensator import Compensator, Stepper
 
@@ -377,9 +377,7 @@ class PreisachCompensator(Compensator):
 
     def __repr__(self) -> str:
         lo, hi = self.voltage_range
-        return (
-            f"PreisachCompensator(method={self.method!r}, voltage_range=({lo:g}, {hi:g}) V)"
-        )
+        return f"PreisachCompensator(method={self.method!r}, voltage_range=({lo:g}, {hi:g}) V)"
 
 
 def _frozen(arr: np.ndarray) -> np.ndarray:

@@ -1,0 +1,1 @@
+"""The paper's experiment: references, tracking runs, metrics, tables and figures."""
