@@ -136,7 +136,9 @@ def test_record_with_one_amplitude_names_what_is_missing(rng):
     # like a periodic record of constant amplitude (the micromanipulator data)
     _, v = triangle_sequence([3.6] * 6, sample_rate=200.0)
     x = presets.paper_preisach(zero_diagonal=True).simulate(v * 120 / 3.6) - 120.0
-    with pytest.raises(IdentificationError, match=r"1 distinct maxima \(3\.6 V\).*excite preisach"):
+    with pytest.raises(
+        IdentificationError, match=r"1 distinct maximum \(3\.6 V\).*excite preisach"
+    ):
         Preisach().fit(v, x)
     with pytest.raises(IdentificationError, match=r"1 distinct maximum"):
         Preisach(everett="table").fit(v, x)

@@ -17,6 +17,7 @@ from hystcomp.io import load_model, save_model
 from hystcomp.models.compensator import Compensator, Stepper
 from hystcomp.models.mpi import ModifiedPrandtlIshlinskii
 from hystcomp.models.pi import PrandtlIshlinskii
+from hystcomp.models.preisach import Preisach
 
 __version__ = "0.1.0"
 
@@ -24,6 +25,7 @@ __all__ = [
     "Compensator",
     "ModifiedPrandtlIshlinskii",
     "PrandtlIshlinskii",
+    "Preisach",
     "Stepper",
     "__version__",
     "errors",

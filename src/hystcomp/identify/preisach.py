@@ -220,7 +220,7 @@ def fit_everett_polynomial(
         maxima = _distinct(np.asarray(alpha), 1e-3 * span)
         raise IdentificationError(
             f"The reversal curves do not determine a degree-{degree} Everett polynomial: "
-            f"they descend from {len(maxima)} distinct maxima "
+            f"they descend from {len(maxima)} distinct maxim{'um' if len(maxima) == 1 else 'a'} "
             f"({', '.join(f'{m:.4g}' for m in maxima)} V) and eq. (5) needs at least "
             f"{degree} spread over the range. {_FIX}, whose sinusoids rise to 24 "
             "different maxima, or lower the degree."
