@@ -12,12 +12,15 @@ Beside each entry the stack keeps the prefix sum of the closed contributions,
 
 so the output is ``P[L] + X(v, e[L])`` when rising and ``P[L] - X(e[L], v)`` when falling:
 one evaluation of ``X`` per sample whatever the depth of the memory, plus the amortised
-pushes and wipe-outs (each entry is pushed once and popped at most once).
+pushes and wipe-outs (each entry is pushed once and popped at most once). A prefix sum is
+written once, when its entry is pushed, and never updated, so no rounding drift builds up
+over long runs.
 
 The memory is bounded by ``depth`` entries. When a reversal would overflow it, the innermost
 stored pair (the most recent closed minor loop, the smallest) is wiped out first, as if the
-input had just passed it; the output then differs from the unbounded model by at most that
-loop's contribution. The default depth of the model is far beyond what measured signals reach.
+input had just passed it; the output then differs from the unbounded model's by the Preisach
+weight of that small loop, until a larger excursion wipes both out. The default depth of the
+model is far beyond what measured signals reach.
 
 ``X`` is either the polynomial of eq. (5) in ``a = alpha - v_min``, ``b = beta - v_min``, held
 as a coefficient matrix ``C[i, j]`` of ``b**i a**j``, or a table on a uniform grid over

