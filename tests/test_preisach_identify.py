@@ -162,6 +162,11 @@ def test_bad_options_get_clear_messages(kwargs, message, excitation):
         identify_preisach(excitation, x, **kwargs)
 
 
+def test_zero_diagonal_must_be_a_bool(excitation):
+    with pytest.raises(TypeError, match=r"'zero_diagonal'.*True or False.*'no'"):
+        identify_preisach(excitation, 0.3 * excitation, zero_diagonal="no")
+
+
 def test_mismatched_lengths_are_refused():
     with pytest.raises(InvalidSignalError, match=r"same length.*100 and 99"):
         Preisach().fit(np.zeros(100), np.zeros(99))

@@ -22,7 +22,12 @@ import scipy.sparse.linalg
 
 from hystcomp import preisach_kernels as pk
 from hystcomp._validation import as_signal, check_int, check_range, check_real
-from hystcomp.errors import IdentificationError, InvalidParameterError, InvalidSignalError
+from hystcomp.errors import (
+    IdentificationError,
+    InvalidParameterError,
+    InvalidSignalError,
+    InvalidTypeError,
+)
 
 MAX_DEGREE = 8
 EVERETT_KINDS = ("polynomial", "table")
@@ -294,8 +299,13 @@ def fit_everett_table(alpha, beta, value, *, grid_size: int, voltage_range) -> n
     return pk.antisymmetric_table(lower)
 
 
-def _check_options(degree, everett, grid_size, owner):
+def _check_options(degree, everett, grid_size, zero_diagonal, owner):
     degree = check_int(degree, "degree", owner)
+    if not isinstance(zero_diagonal, bool | np.bool_):
+        raise InvalidTypeError(
+            f"The 'zero_diagonal' parameter of {owner} must be True or False. "
+            f"Got {zero_diagonal!r} of type {type(zero_diagonal).__name__} instead."
+        )
     if degree > MAX_DEGREE:
         raise InvalidParameterError(
             f"The 'degree' parameter of {owner} must be an int in 1..{MAX_DEGREE}. "
@@ -360,7 +370,7 @@ def identify_preisach(
         If the record holds no first-order descending curve, or too few to fit X.
     """
     owner = "identify_preisach"
-    degree, grid_size = _check_options(degree, everett, grid_size, owner)
+    degree, grid_size = _check_options(degree, everett, grid_size, zero_diagonal, owner)
     curves = find_reversal_curves(v, x, tolerance=tolerance)
     v = np.ascontiguousarray(v, dtype=np.float64).reshape(-1)
     x = np.ascontiguousarray(x, dtype=np.float64).reshape(-1)
@@ -390,22 +400,10 @@ def identify_preisach(
     alpha, beta, value = everett_samples(curves, v_min=lo, bin_width=(hi - lo) / N_BINS)
     if everett == "polynomial":
         theta = fit_everett_polynomial(
-            alpha,
-            beta,
-            value,
-            degree=degree,
-            voltage_range=(lo, hi),
-            zero_diagonal=bool(zero_diagonal),
+            alpha, beta, value, degree=degree, voltage_range=(lo, hi), zero_diagonal=zero_diagonal
         )
         table = None
-        packed = pk.pack_preisach(
-            kind=pk.POLYNOMIAL,
-            coef=pk.coefficient_matrix(theta, degree),
-            v_min=lo,
-            v_max=hi,
-            offset=0.0,
-            depth=pk.DEFAULT_DEPTH,
-        )
+        kind, coef = pk.POLYNOMIAL, pk.coefficient_matrix(theta, degree)
     else:
         maxima = _distinct(alpha, 1e-3 * (hi - lo))
         if len(maxima) < 2:
@@ -416,9 +414,10 @@ def identify_preisach(
             )
         theta = None
         table = fit_everett_table(alpha, beta, value, grid_size=grid_size, voltage_range=(lo, hi))
-        packed = pk.pack_preisach(
-            kind=pk.TABLE, coef=table, v_min=lo, v_max=hi, offset=0.0, depth=pk.DEFAULT_DEPTH
-        )
+        kind, coef = pk.TABLE, table
+    packed = pk.pack_preisach(
+        kind=kind, coef=coef, v_min=lo, v_max=hi, offset=0.0, depth=pk.DEFAULT_DEPTH
+    )
     model_everett = np.empty(alpha.size)
     pk.everett_many(packed, alpha, beta, model_everett)
     h = np.empty_like(v)
