@@ -73,3 +73,82 @@ def mpi_models(draw, max_ops=8):
         output_offset=pi.output_offset_,
     )
     return model, rng
+
+
+def everett_from_density(nu, mu, degree):
+    """theta (eq. 5's order, shifted coordinates) of a Preisach model with X(v, v) = 0.
+
+    ``X(a, b) = int_b^a nu(s) ds + int int_{b <= b' <= a' <= a} mu(a', b')``: a reversible
+    part with line density ``nu(s) = sum_k nu[k] s^k`` on the diagonal and a Preisach density
+    ``mu(a, b) = sum mu[(p, q)] b^p a^q``; non-negative coefficients make every branch
+    monotone (and strictly so when ``nu[0] > 0``).
+    """
+    from hystcomp.preisach_kernels import monomial_exponents
+
+    coef = {}
+
+    def add(i, j, c):
+        coef[(i, j)] = coef.get((i, j), 0.0) + c
+
+    for k, c in enumerate(nu):
+        add(0, k + 1, c / (k + 1))
+        add(k + 1, 0, -c / (k + 1))
+    for (p, q), c in mu.items():
+        n = p + q + 2
+        add(0, n, c / ((p + 1) * n))
+        add(n, 0, c * (1 / ((p + 1) * (q + 1)) - 1 / ((p + 1) * n)))
+        add(p + 1, q + 1, -c / ((p + 1) * (q + 1)))
+    return np.array([coef.get(e, 0.0) for e in monomial_exponents(degree)])
+
+
+def monotone_theta(rng, degree, span, stroke):
+    """A random degree-``degree`` Everett polynomial with X(v, v) = 0, strictly monotone
+    branches and ``X(v_max, v_min) = stroke`` on a plane ``span`` V wide."""
+    nu = rng.uniform(0.0, 1.0, degree) / span ** np.arange(degree)
+    nu[0] = max(nu[0], 0.2)
+    mu = {
+        (p, k - p): rng.uniform(0.0, 1.0) / span ** (k + 1)
+        for k in range(degree - 1)
+        for p in range(k + 1)
+    }
+    theta = everett_from_density(nu, mu, degree)
+    full = sum(
+        c * span ** (i + j) for c, (i, j) in zip(theta, _exps(degree), strict=True) if i == 0
+    )
+    return theta * stroke / full
+
+
+def _exps(degree):
+    from hystcomp.preisach_kernels import monomial_exponents
+
+    return monomial_exponents(degree)
+
+
+@st.composite
+def preisach_models(draw, monotone=True, representation=("polynomial", "table")):
+    """A Preisach model on a random plane, with an output offset.
+
+    ``monotone``: X(v, v) = 0 and strictly monotone branches (built from a density);
+    otherwise an arbitrary polynomial or table. The table samples such a polynomial on a grid.
+    """
+    from hystcomp.models.preisach import Preisach
+    from hystcomp.preisach_kernels import n_monomials
+
+    seed = draw(st.integers(0, 2**32 - 1))
+    rng = np.random.default_rng(seed)
+    v_min = draw(st.floats(-150.0, 50.0))
+    span = draw(st.floats(1.0, 300.0))
+    degree = draw(st.integers(1, 4))
+    stroke = draw(st.floats(1.0, 100.0))
+    if monotone:
+        theta = monotone_theta(rng, degree, span, stroke)
+    else:
+        theta = rng.normal(size=n_monomials(degree)) * stroke
+        theta /= span ** np.array([i + j for i, j in _exps(degree)])
+    kw = {"voltage_range": (v_min, v_min + span), "output_offset": draw(st.floats(-200, 200))}
+    model = Preisach.from_parameters(theta=theta, **kw)
+    if draw(st.sampled_from(representation)) == "table":
+        nodes = np.linspace(v_min, v_min + span, draw(st.integers(2, 30)))
+        table = model.everett_function(nodes[:, None], nodes[None, :])
+        model = Preisach.from_parameters(table=table, **kw)
+    return model, rng

@@ -68,3 +68,94 @@ def partial_sum_lsq(design, target, blocks):
         lower[first:stop] = bound
     result = lsq_linear(design @ to_weights, target, bounds=(lower, np.inf), method="bvls")
     return to_weights @ result.x
+
+
+def everett_polynomial(theta, v_min=0.0):
+    """X(alpha, beta) of eq. (5), generalised: degree by degree, from beta^k to alpha^k."""
+    terms, k = [], 1
+    while len(terms) < len(theta):
+        terms += [(k - j, j) for j in range(k + 1)]
+        k += 1
+
+    def everett(alpha, beta):
+        a, b = alpha - v_min, beta - v_min
+        return sum(c * b**i * a**j for c, (i, j) in zip(theta, terms, strict=True))
+
+    return everett
+
+
+def everett_table(lower, v_min, v_max):
+    """Bilinear interpolation of X on a grid; above the diagonal X(a, b) = -X(b, a)."""
+    from scipy.interpolate import RegularGridInterpolator
+
+    lower = np.tril(np.asarray(lower, dtype=float))
+    full = lower - np.tril(lower, -1).T
+    nodes = np.linspace(v_min, v_max, lower.shape[0])
+    interp = RegularGridInterpolator((nodes, nodes), full)
+
+    def everett(alpha, beta):
+        return float(interp([[alpha, beta]])[0])
+
+    return everett
+
+
+def preisach_extrema(v, everett, v_min, v_max):
+    """Eqs. (3)-(4) with the alternating dominant extrema of the whole history found anew
+    at every sample (the last index of a repeated extremum counts, which is the wipe-out)."""
+    u = np.clip(np.asarray(v, dtype=float), v_min, v_max)
+    out = []
+    for k in range(u.size):
+        hist = np.concatenate([[v_min], u[: k + 1]])
+        alphas, betas = [], [v_min]
+        pos, want_max = 0, True
+        while True:
+            seg = hist[pos + 1 :]
+            target = seg.max() if want_max else seg.min()
+            pos = pos + 1 + int(np.flatnonzero(seg == target)[-1])
+            if pos == hist.size - 1:
+                break
+            (alphas if want_max else betas).append(target)
+            want_max = not want_max
+        x = sum(
+            everett(a, b0) - everett(a, b1)
+            for a, b0, b1 in zip(alphas, betas, betas[1:], strict=False)
+        )
+        if want_max:  # rising from betas[-1]
+            x += everett(u[k], betas[-1])
+        else:  # falling from alphas[-1]
+            x += everett(alphas[-1], betas[-1]) - everett(alphas[-1], u[k])
+        out.append(x)
+    return np.array(out)
+
+
+def preisach_relays(v_index, everett, nodes):
+    """Eq. (1) literally: 0/1 relays on a grid, for inputs on the grid nodes.
+
+    Relay (i, j) switches on at ``nodes[i]`` and off at ``nodes[j]`` (j < i); its weight is
+    the Preisach density integrated over its cell of the limiting triangle, from the Everett
+    function (an Everett function must vanish on the diagonal for this to hold).
+    """
+    n = len(nodes)
+    up, down, weight = [], [], []
+    for i in range(1, n):
+        for j in range(i):
+            if j + 1 <= i - 1:
+                w = (
+                    everett(nodes[i], nodes[j])
+                    - everett(nodes[i - 1], nodes[j])
+                    - everett(nodes[i], nodes[j + 1])
+                    + everett(nodes[i - 1], nodes[j + 1])
+                )
+            else:
+                w = everett(nodes[i], nodes[j])
+            up.append(i)
+            down.append(j)
+            weight.append(w)
+    up, down, weight = np.array(up), np.array(down), np.array(weight)
+    state = np.zeros(up.size, dtype=bool)
+    out = []
+    for idx in v_index:
+        state[up <= idx] = True
+        state[down >= idx] = False
+        out.append(float(weight @ state))
+    return np.array(out)

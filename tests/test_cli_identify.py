@@ -15,7 +15,6 @@ from hystcomp import presets
 from hystcomp.cli import main
 from hystcomp.data import read_record, read_table, write_table
 from hystcomp.identify.scoring import holdout_report
-from hystcomp.io import MODEL_KINDS
 
 REAL_RECORD = (
     Path(__file__).parents[2] / "shared" / "data" / "piezo-micromanipulator" / "Model_Vi_Do.dat"
@@ -148,12 +147,38 @@ def test_bad_usage_and_bad_input_exit_2_in_one_line(tmp_path, monkeypatch, args,
     assert match in result.output
 
 
-def test_preisach_is_a_clean_error_until_registered(tmp_path):
-    if "preisach" in MODEL_KINDS:
-        pytest.skip("the Preisach model is registered in this build")
-    result = run("identify", "x.csv", "--model", "preisach", "-o", tmp_path / "m.json")
-    assert_one_line_error(result)
-    assert "Preisach model is not available" in result.output
+def test_preisach_through_every_command(tmp_path):
+    """excite -> (paper's eq. 6 model as the rig) -> identify -> simulate -> compensate."""
+    true = presets.paper_preisach(zero_diagonal=True)  # the form that identify fits
+    assert run("excite", "preisach", "-o", tmp_path / "v.csv", "--fs", "500").exit_code == 0
+    t, v = (read_table(tmp_path / "v.csv", ("v",))[k] for k in "tv")
+    write_table(tmp_path / "rec.csv", {"t": t, "v": v, "x": true.simulate(v) - 120.0})
+    result = run("identify", tmp_path / "rec.csv", "--model", "preisach", "-o", tmp_path / "m.json")
+    assert result.exit_code == 0, result.output
+    assert result.output.startswith("Preisach model from")
+    model = hystcomp.load_model(tmp_path / "m.json")
+    assert model.kind == "preisach"
+    assert model.output_offset_ == pytest.approx(-120.0, abs=1e-3)
+    alpha, beta = np.meshgrid(np.linspace(0.0, 120.0, 7), np.linspace(0.0, 120.0, 7))
+    plane = alpha >= beta
+    np.testing.assert_allclose(
+        model.everett_function(alpha[plane], beta[plane]),
+        true.everett_function(alpha[plane], beta[plane]),
+        atol=1e-3,
+    )
+    assert run("simulate", tmp_path / "m.json", tmp_path / "v.csv", "-o", tmp_path / "x.csv")
+    np.testing.assert_allclose(read_table(tmp_path / "x.csv", ("x",))["x"], model.simulate(v))
+
+    t = np.arange(20_001) / 20_000.0
+    x_ref = -115.0 + 25.0 * (1.0 - np.abs(1.0 - 2.0 * (t % 1.0)))  # 1 Hz triangle, 5..30 µm
+    write_table(tmp_path / "ref.csv", {"t": t, "x": x_ref})
+    args = ["compensate", tmp_path / "m.json", tmp_path / "ref.csv", "-o", tmp_path / "v2.csv"]
+    assert run(*args).exit_code == 0
+    v2 = read_table(tmp_path / "v2.csv", ("v",))["v"]
+    assert np.abs(model.simulate(v2) - x_ref)[1000:].max() < 0.005 * 25.0
+    assert run(*args, "--voltage-range", 20, 60).exit_code == 0
+    v3 = read_table(tmp_path / "v2.csv", ("v",))["v"]
+    assert (v3.min(), v3.max()) == (20.0, 60.0)
 
 
 def test_failed_identify_keeps_the_existing_model_file(tmp_path):

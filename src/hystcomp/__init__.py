@@ -18,6 +18,7 @@ from hystcomp.io import load_model, save_model
 from hystcomp.models.compensator import Compensator, Stepper
 from hystcomp.models.mpi import ModifiedPrandtlIshlinskii
 from hystcomp.models.pi import PrandtlIshlinskii
+from hystcomp.models.preisach import Preisach
 
 __version__ = "0.1.0"
 
@@ -25,6 +26,7 @@ __all__ = [
     "Compensator",
     "ModifiedPrandtlIshlinskii",
     "PrandtlIshlinskii",
+    "Preisach",
     "Record",
     "Stepper",
     "__version__",

@@ -32,6 +32,7 @@ from hystcomp.errors import (
 from hystcomp.models.base import HysteresisModel
 from hystcomp.models.mpi import ModifiedPrandtlIshlinskii
 from hystcomp.models.pi import PrandtlIshlinskii
+from hystcomp.models.preisach import Preisach
 
 MODEL_FORMAT = "hystcomp-model"
 MODEL_VERSION = 1
@@ -42,6 +43,7 @@ MAX_MODEL_FILE_BYTES = 64 * 2**20
 MODEL_KINDS: dict[str, type[HysteresisModel]] = {
     PrandtlIshlinskii.kind: PrandtlIshlinskii,
     ModifiedPrandtlIshlinskii.kind: ModifiedPrandtlIshlinskii,
+    Preisach.kind: Preisach,
 }
 
 

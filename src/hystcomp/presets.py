@@ -15,6 +15,8 @@ Assumptions, since the paper leaves them implicit:
   give. We take the self-consistent value: the ``M`` for which the model's own largest
   displacement on the paper's identification triangle (30..120 V) equals ``M``
   (:data:`PAPER_MPI_MAX_DISPLACEMENT`, about 36 µm, found by fixed-point iteration).
+
+For the Preisach model (eqs. 5-6), see :func:`paper_preisach`.
 """
 
 from __future__ import annotations
@@ -24,6 +26,7 @@ import numpy as np
 from hystcomp.identify.excitation import triangle_sequence
 from hystcomp.models.mpi import ModifiedPrandtlIshlinskii
 from hystcomp.models.pi import PrandtlIshlinskii, paper_thresholds
+from hystcomp.models.preisach import Preisach
 
 PAPER_V_MAX = 120.0  # V, eq. (16)
 
@@ -142,3 +145,50 @@ def paper_mpi() -> ModifiedPrandtlIshlinskii:
     35.89
     """
     return paper_mpi_with(PAPER_MPI_MAX_DISPLACEMENT)
+
+
+#: Eq. (6), the coefficients of eq. (5) in µm/V, µm/V^2 and µm/V^3 (eq. 5's order).
+PAPER_PREISACH_THETA = np.array(
+    [-0.137, 0.15, 0.0014, -0.0045, 0.00298, 0.0000025, -0.000007, 0.000019, -0.000014]
+)
+
+
+def paper_preisach(*, zero_diagonal: bool = False) -> Preisach:
+    """The Preisach model of eqs. (5)-(6): a cubic Everett polynomial on 0..120 V.
+
+    Assumptions, since the paper leaves them implicit:
+
+    * ``theta`` of eq. (6) is in µm/V^k, with alpha and beta in V: then ``X(120, 0) =
+      36.72 µm``, the stroke of eq. (20)'s PI model (37.8 µm) and of the MPI model (35.9 µm);
+      read in m it would be a stroke of 37 m.
+    * The Preisach plane is the amplifier's 0..120 V, ``beta_0 = v_min = 0`` (the sinusoids
+      of the identification start there), no output offset.
+    * Eq. (6) does not satisfy ``X(v, v) = 0``, which eq. (2) implies: ``X(v, v) = 0.013 v
+      - 0.00012 v^2 + 5e-7 v^3`` rises to 0.70 µm at 120 V (the paper's least squares was not
+      constrained, and the printed digits are few). Used in eqs. (3)-(4) as written, such an
+      X makes the output step by ``X(v, v)`` at every reversal of the input, and the inverse
+      multiplicative structure (eq. 10) then chatters after each reversal. By default the
+      preset keeps eq. (6) as printed; ``zero_diagonal=True`` replaces the three pure-beta
+      coefficients by the values that make ``X(v, v) = 0`` (``theta_0 = -theta_1``,
+      ``theta_2 = -(theta_3 + theta_4)``, ``theta_5 = -(theta_6 + theta_7 + theta_8)``),
+      which keeps the initial ascending curve ``X(v, 0)`` and the major loop's end points and
+      changes a descending branch by ``X(beta, beta)`` (at most 0.7 µm).
+
+    Examples
+    --------
+    >>> model = paper_preisach()
+    >>> round(float(model.everett_function(120.0, 0.0)), 3)
+    36.72
+    >>> round(float(model.simulate([0.0, 120.0])[-1]), 3)
+    36.72
+    >>> abs(float(paper_preisach(zero_diagonal=True).everett_function(120.0, 120.0))) < 1e-12
+    True
+    """
+    theta = PAPER_PREISACH_THETA.copy()
+    if zero_diagonal:
+        theta[0] = -theta[1]
+        theta[2] = -(theta[3] + theta[4])
+        theta[5] = -(theta[6] + theta[7] + theta[8])
+    return Preisach.from_parameters(
+        theta=theta, voltage_range=(0.0, PAPER_V_MAX), output_offset=0.0
+    )

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import inspect
-
 import click
 import numpy as np
 
@@ -18,7 +16,6 @@ from hystcomp.cli._options import (
     voltage_range,
 )
 from hystcomp.data import read_table, write_table
-from hystcomp.errors import InvalidParameterError
 from hystcomp.io import load_model
 
 
@@ -40,11 +37,6 @@ def inverse_options(model, table, *, slew_rate, narrow_range) -> dict:
                 f"identified inside it and would command voltages it never saw. Got {low:g} "
                 f"{high:g}; choose limits within it, or identify over a wider range.",
                 param_hint="'--voltage-range'",
-            )
-        if "voltage_range" not in inspect.signature(model.inverse).parameters:
-            raise InvalidParameterError(
-                f"--voltage-range is not available for {model.kind!r} models; their "
-                "compensator is clamped to the model's own voltage range."
             )
         options["voltage_range"] = narrow_range
     return options

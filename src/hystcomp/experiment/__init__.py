@@ -1,1 +1,1 @@
-"""The paper's experiment: comparison runs, metrics, tables and figures."""
+"""The paper's experiment: references, tracking runs, metrics, tables and figures."""

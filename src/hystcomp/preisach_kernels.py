@@ -1,0 +1,456 @@
+"""Classical Preisach model as compiled kernels (paper eqs. 2-5 and 10).
+
+The model output follows eqs. (3)-(4): a memory of alternating dominant extrema
+``beta_0 = v_min < ... `` with the wipe-out property, and the Everett-type function
+``X(alpha, beta)`` of eq. (2). The memory is a stack ``e[0..L]`` (``e[0] = beta_0 = v_min``,
+then ``alpha_1, beta_1, alpha_2, ...``): an even top ``L`` means the input rises from the
+minimum ``e[L]`` (eq. 3), an odd top means it falls from the maximum ``e[L]`` (eq. 4).
+Beside each entry the stack keeps the prefix sum of the closed contributions,
+
+    P[j] = P[j-1] + X(e[j], e[j-1])   (j odd, a maximum)
+    P[j] = P[j-1] - X(e[j-1], e[j])   (j even, a minimum),
+
+so the output is ``P[L] + X(v, e[L])`` when rising and ``P[L] - X(e[L], v)`` when falling:
+one evaluation of ``X`` per sample whatever the depth of the memory, plus the amortised
+pushes and wipe-outs (each entry is pushed once and popped at most once). A prefix sum is
+written once, when its entry is pushed, and never updated, so no rounding drift builds up
+over long runs.
+
+The memory is bounded by ``depth`` entries. When a reversal would overflow it, the innermost
+stored pair (the most recent closed minor loop, the smallest) is wiped out first, as if the
+input had just passed it; the output then differs from the unbounded model's by the Preisach
+weight of that small loop, until a larger excursion wipes both out. The default depth of the
+model is far beyond what measured signals reach.
+
+``X`` is either the polynomial of eq. (5) in ``a = alpha - v_min``, ``b = beta - v_min``, held
+as a coefficient matrix ``C[i, j]`` of ``b**i a**j``, or a table on a uniform grid over
+``[v_min, v_max]`` interpolated bilinearly; the table holds ``X(alpha_i, beta_j)`` for
+``j <= i`` and its antisymmetric extension ``X(alpha_i, beta_j) = -X(alpha_j, beta_i)`` above
+the diagonal, so that the interpolant vanishes on the diagonal as eq. (2) requires.
+
+Everything (parameters, state, memory) is packed into one float64 array, so a streaming step
+is one compiled call on one array, as :mod:`hystcomp.operators` does for the play chain.
+The same :func:`preisach_step` serves the forward model, the inverse multiplicative structure
+(eq. 10) and the exact inverse, in batch and streaming use. These functions trust their input.
+"""
+
+from __future__ import annotations
+
+import numba
+import numpy as np
+
+from hystcomp.operators import FASTMATH
+
+# Modes of a packed system: what a step maps.
+FORWARD, MULTIPLICATIVE, EXACT = 0, 1, 2
+# Representations of X.
+POLYNOMIAL, TABLE = 0, 1
+# Header slots.
+MODE, KIND, V_MIN, V_MAX, OFFSET, GRID_STEP, N_COEF, DEPTH, RHO, MAX_STEP, LOW, HIGH = range(12)
+HEADER = 12
+# State slots (from state_start(p)): stack top, last input, last H (without offset),
+# last output, count of non-finite inputs. The stack and its prefix sums follow.
+ST_TOP, ST_INPUT, ST_H, ST_LAST, ST_NONFINITE = range(5)
+N_STATE = 5
+#: Default bound on the stored extrema: 512 nested reversals, far beyond measured signals.
+DEFAULT_DEPTH = 1024
+
+
+def _kernel(func):
+    return numba.njit(cache=True, fastmath=FASTMATH, nogil=True)(func)
+
+
+def monomial_exponents(degree: int) -> list[tuple[int, int]]:
+    """Exponents ``(i, j)`` of the monomials ``beta**i * alpha**j`` of X, in eq. (5)'s order.
+
+    Degree by degree, and within degree ``k`` from ``beta**k`` to ``alpha**k``; degree 3 is
+    eq. (5): ``beta, alpha, beta^2, beta alpha, alpha^2, beta^3, beta^2 alpha, beta alpha^2,
+    alpha^3``.
+
+    Examples
+    --------
+    >>> monomial_exponents(2)
+    [(1, 0), (0, 1), (2, 0), (1, 1), (0, 2)]
+    """
+    return [(k - j, j) for k in range(1, degree + 1) for j in range(k + 1)]
+
+
+def n_monomials(degree: int) -> int:
+    """Number of coefficients of a degree-``degree`` X: ``degree (degree + 3) / 2`` (9 for 3)."""
+    return degree * (degree + 3) // 2
+
+
+def coefficient_matrix(theta: np.ndarray, degree: int) -> np.ndarray:
+    """``C[i, j]``, the coefficient of ``b**i a**j``, from theta in eq. (5)'s order."""
+    c = np.zeros((degree + 1, degree + 1))
+    for value, (i, j) in zip(theta, monomial_exponents(degree), strict=True):
+        c[i, j] = value
+    return c
+
+
+def antisymmetric_table(lower: np.ndarray) -> np.ndarray:
+    """The full grid table from its lower triangle (diagonal included): ``T[j, i] = -T[i, j]``."""
+    strict = np.tril(lower, -1)
+    return strict - strict.T + np.diag(np.diag(lower))
+
+
+def pack_preisach(
+    *,
+    kind: int,
+    coef: np.ndarray,
+    v_min: float,
+    v_max: float,
+    offset: float,
+    depth: int,
+    mode: int = FORWARD,
+    rho: float = 1.0,
+    max_step: float = np.inf,
+    clamp: tuple[float, float] | None = None,
+) -> np.ndarray:
+    """Pack a Preisach system in its initial state: all relays off at ``v_min``.
+
+    Parameters
+    ----------
+    kind : int
+        :data:`POLYNOMIAL` (``coef`` from :func:`coefficient_matrix`) or :data:`TABLE`
+        (``coef`` from :func:`antisymmetric_table` on a uniform grid over the range).
+    coef : ndarray
+        Square matrix of coefficients or table values (µm).
+    v_min, v_max : float
+        The Preisach plane ``v_min <= beta <= alpha <= v_max`` (V); inputs are clamped to it.
+    offset : float
+        Output offset ``x_0`` added to ``H`` (µm).
+    depth : int
+        Largest number of stored extrema (>= 3).
+    mode : int
+        :data:`FORWARD` (v -> x), :data:`MULTIPLICATIVE` or :data:`EXACT` (x_ref -> v).
+    rho : float
+        The gain of the inverse multiplicative structure (µm/V), eq. (10).
+    max_step : float
+        Largest change of a compensator's output per sample (V).
+    clamp : (float, float), optional
+        A compensator's output range (V), inside the plane; the whole plane by default.
+    """
+    low, high = (v_min, v_max) if clamp is None else clamp
+    n = coef.shape[0]
+    step = (v_max - v_min) / (n - 1) if kind == TABLE else 0.0
+    header = np.array(
+        [mode, kind, v_min, v_max, offset, step, n, depth, rho, max_step, low, high],
+        dtype=np.float64,
+    )
+    last = offset if mode == FORWARD else v_min
+    state = np.array([0.0, v_min, 0.0, last, 0.0])
+    stack = np.zeros(depth)
+    stack[0] = v_min
+    parts = [header, np.ascontiguousarray(coef, dtype=np.float64).ravel(), state, stack]
+    return np.concatenate([*parts, np.zeros(depth)])
+
+
+@_kernel
+def state_start(p):
+    """Index of the first state slot of packed system ``p``."""
+    n = int(p[N_COEF])
+    return HEADER + n * n
+
+
+@_kernel
+def everett(p, alpha, beta):
+    """``X(alpha, beta)`` of eq. (2) in µm, for voltages inside the plane."""
+    a = alpha - p[V_MIN]
+    b = beta - p[V_MIN]
+    n = int(p[N_COEF])
+    if p[KIND] == POLYNOMIAL:
+        # sum_i b^i (sum_j C[i, j] a^j), Horner in both variables
+        acc = 0.0
+        for i in range(n - 1, -1, -1):
+            row = HEADER + i * n
+            inner = 0.0
+            for j in range(n - 1 - i, -1, -1):
+                inner = inner * a + p[row + j]
+            acc = acc * b + inner
+        return acc
+    u = a / p[GRID_STEP]
+    w = b / p[GRID_STEP]
+    i = min(max(int(u), 0), n - 2)
+    j = min(max(int(w), 0), n - 2)
+    s = u - i
+    t = w - j
+    k = HEADER + i * n + j
+    return (1.0 - s) * ((1.0 - t) * p[k] + t * p[k + 1]) + s * (
+        (1.0 - t) * p[k + n] + t * p[k + n + 1]
+    )
+
+
+@_kernel
+def everett_many(p, alpha, beta, out):
+    """``out[k] = X(alpha[k], beta[k])`` for voltages inside the plane."""
+    for k in range(alpha.size):
+        out[k] = everett(p, alpha[k], beta[k])
+
+
+@_kernel
+def _push(p, e, q, top, value):
+    """Push a turning point (a maximum on an even top, a minimum on an odd one)."""
+    if top + 1 >= int(p[DEPTH]):
+        top -= 2  # full: wipe out the innermost stored pair first
+    if top % 2 == 0:
+        c = everett(p, value, p[e + top])
+    else:
+        c = -everett(p, p[e + top], value)
+    p[e + top + 1] = value
+    p[q + top + 1] = p[q + top] + c
+    return top + 1
+
+
+@_kernel
+def preisach_apply(p, v):
+    """Apply input ``v`` (clamped to the plane) and return ``H(v)`` without offset, eqs. (3)-(4)."""
+    s = state_start(p)
+    e = s + N_STATE
+    q = e + int(p[DEPTH])
+    v = min(max(v, p[V_MIN]), p[V_MAX])
+    top = int(p[s + ST_TOP])
+    previous = p[s + ST_INPUT]
+    if top % 2 == 0:
+        if v < previous:
+            top = _push(p, e, q, top, previous)
+    elif v > previous:
+        top = _push(p, e, q, top, previous)
+    if top % 2 == 0:
+        while top >= 2 and v >= p[e + top - 1]:
+            top -= 2  # wipe-out: the input passed the maximum alpha_N
+        h = p[q + top] + everett(p, v, p[e + top])
+    else:
+        while top >= 3 and v <= p[e + top - 1]:
+            top -= 2  # wipe-out: the input passed the minimum beta_N
+        h = p[q + top] - everett(p, p[e + top], v)
+    p[s + ST_TOP] = top
+    p[s + ST_INPUT] = v
+    p[s + ST_H] = h
+    return h
+
+
+@_kernel
+def _branch(p, base, pivot, rising, v):
+    """A monotone branch: ``base + X(v, pivot)`` rising, ``base - X(pivot, v)`` falling."""
+    if rising:
+        return base + everett(p, v, pivot)
+    return base - everett(p, pivot, v)
+
+
+@_kernel
+def _root(p, base, pivot, rising, lo, hi, target):
+    """``v`` in ``[lo, hi]`` with branch(v) = target, given branch(lo) < target <= branch(hi).
+
+    Illinois (modified regula falsi) with a bisection every fourth step: the bracket
+    always shrinks, and smooth branches converge superlinearly.
+    """
+    g_lo = _branch(p, base, pivot, rising, lo) - target
+    g_hi = _branch(p, base, pivot, rising, hi) - target
+    if g_lo >= 0.0:
+        return lo
+    if g_hi <= 0.0:
+        return hi
+    f_lo = g_lo  # Illinois scales these; keep the true residuals for the final choice
+    f_hi = g_hi
+    tol_x = 1e-13 * (1.0 + abs(target))
+    side = 0
+    for it in range(200):
+        if it % 4 == 3 or g_hi == g_lo:
+            m = 0.5 * (lo + hi)
+        else:
+            m = (lo * g_hi - hi * g_lo) / (g_hi - g_lo)
+            if not (lo < m < hi):
+                m = 0.5 * (lo + hi)
+        g = _branch(p, base, pivot, rising, m) - target
+        if abs(g) <= tol_x:
+            return m
+        if g < 0.0:
+            lo, g_lo, f_lo = m, g, g
+            if side == -1:
+                g_hi *= 0.5
+            side = -1
+        else:
+            hi, g_hi, f_hi = m, g, g
+            if side == 1:
+                g_lo *= 0.5
+            side = 1
+        if hi - lo <= 4e-16 * max(abs(lo), abs(hi), 1.0):
+            break
+    return lo if -f_lo < f_hi else hi
+
+
+@_kernel
+def _solve_up(p, e, q, top, previous, target):
+    """Smallest rise of the input whose branch output reaches ``target`` (> h)."""
+    if top % 2 == 1:
+        # a reversal: the branch starts at a new minimum beta = previous
+        base = p[q + top] - everett(p, p[e + top], previous)
+        pivot = previous
+        hi = p[e + top]
+        k = top - 1
+    else:
+        base = p[q + top]
+        pivot = p[e + top]
+        hi = p[e + top - 1] if top >= 2 else p[V_MAX]
+        k = top - 2
+    lo = previous
+    first = True
+    while True:
+        if target <= _branch(p, base, pivot, True, hi):
+            if first and _branch(p, base, pivot, True, lo) >= target:
+                return previous  # in the gap a non-zero X(v, v) opens at a reversal: hold
+            return _root(p, base, pivot, True, lo, hi, target)
+        if k < 0:
+            return p[V_MAX]
+        first = False
+        lo = hi
+        base = p[q + k]
+        pivot = p[e + k]
+        hi = p[e + k - 1] if k >= 2 else p[V_MAX]
+        k -= 2
+
+
+@_kernel
+def _solve_down(p, e, q, top, previous, target):
+    """Smallest fall of the input whose branch output reaches ``target`` (< h)."""
+    if top % 2 == 0:
+        # a reversal: the branch starts at a new maximum alpha = previous
+        base = p[q + top] + everett(p, previous, p[e + top])
+        pivot = previous
+        lo = p[e + top]
+        k = top - 1
+    else:
+        base = p[q + top]
+        pivot = p[e + top]
+        lo = p[e + top - 1]
+        k = top - 2
+    hi = previous
+    first = True
+    while True:
+        if target >= _branch(p, base, pivot, False, lo):
+            if first and _branch(p, base, pivot, False, hi) <= target:
+                return previous  # in the gap a non-zero X(v, v) opens at a reversal: hold
+            return _root(p, base, pivot, False, lo, hi, target)
+        if k < 1:
+            return p[V_MIN]
+        first = False
+        hi = lo
+        base = p[q + k]
+        pivot = p[e + k]
+        lo = p[e + k - 1]
+        k -= 2
+
+
+@_kernel
+def exact_input(p, target):
+    """The input that makes ``H`` reach ``target`` (µm, no offset) from the current memory.
+
+    The branch from the last input is followed through the stored extrema (where wipe-outs
+    change it) until it brackets ``target``; the range ends are returned when it never does.
+    The memory is not changed.
+    """
+    s = state_start(p)
+    e = s + N_STATE
+    q = e + int(p[DEPTH])
+    top = int(p[s + ST_TOP])
+    previous = p[s + ST_INPUT]
+    h = p[s + ST_H]
+    if target > h:
+        return _solve_up(p, e, q, top, previous, target)
+    if target < h:
+        return _solve_down(p, e, q, top, previous, target)
+    return previous
+
+
+@_kernel
+def preisach_step(p, u):
+    """One sample through packed system ``p``; updates its state and returns the output.
+
+    FORWARD maps a voltage to ``x_0 + H(v)``; MULTIPLICATIVE is eq. (10),
+    ``v[k] = v[k-1] + (x_ref[k] - x[k-1]) / rho``, i.e. ``(x_ref[k] - Gamma(v[k-1])) / rho``
+    with ``Gamma(v) = H(v) - rho v``; EXACT solves ``x_0 + H(v) = x_ref`` on the current
+    branch. Compensators slew-limit and clamp ``v``, then advance ``H``'s memory with it.
+    A non-finite ``u`` holds the last output and increments the non-finite counter.
+    """
+    s = state_start(p)
+    if u - u != 0.0:  # NaN or +-inf
+        p[s + ST_NONFINITE] += 1.0
+        return p[s + ST_LAST]
+    mode = int(p[MODE])
+    if mode == FORWARD:
+        out = preisach_apply(p, u) + p[OFFSET]
+    else:
+        previous = p[s + ST_INPUT]
+        if mode == MULTIPLICATIVE:
+            v = previous + (u - p[OFFSET] - p[s + ST_H]) / p[RHO]
+        else:
+            v = exact_input(p, u - p[OFFSET])
+        step = p[MAX_STEP]
+        v = min(max(v, previous - step), previous + step)
+        v = min(max(v, p[LOW]), p[HIGH])
+        preisach_apply(p, v)
+        out = v
+    p[s + ST_LAST] = out
+    return out
+
+
+@_kernel
+def preisach_run(p, u, out):
+    """Run every sample of ``u`` through packed system ``p`` into ``out`` (state kept in ``p``)."""
+    for k in range(u.size):
+        out[k] = preisach_step(p, u[k])
+
+
+@_kernel
+def turning_points(v, delta, out):
+    """Indices of the alternating extrema of ``v``, ignoring reversals smaller than ``delta``.
+
+    A maximum is confirmed once the signal falls more than ``delta`` below it, a minimum once
+    it rises more than ``delta`` above it (the last index of a plateau is the turning point).
+    ``out`` receives the indices, the last one being the running extremum at the end of the
+    data (not confirmed). Returns ``(count, first_is_max)``; ``count`` is 0 if ``v`` never
+    moves by more than ``delta``.
+    """
+    n = v.size
+    i_hi = 0
+    i_lo = 0
+    k = 1
+    direction = 0
+    while k < n:
+        if v[k] >= v[i_hi]:
+            i_hi = k
+        if v[k] <= v[i_lo]:
+            i_lo = k
+        if v[k] - v[i_lo] > delta:
+            direction = 1
+            break
+        if v[i_hi] - v[k] > delta:
+            direction = -1
+            break
+        k += 1
+    if direction == 0:
+        return 0, False
+    count = 1
+    first_is_max = direction == -1
+    out[0] = i_hi if first_is_max else i_lo
+    candidate = k
+    for k in range(candidate + 1, n):
+        if direction == 1:
+            if v[k] >= v[candidate]:
+                candidate = k
+            elif v[candidate] - v[k] > delta:
+                out[count] = candidate
+                count += 1
+                direction = -1
+                candidate = k
+        else:
+            if v[k] <= v[candidate]:
+                candidate = k
+            elif v[k] - v[candidate] > delta:
+                out[count] = candidate
+                count += 1
+                direction = 1
+                candidate = k
+    out[count] = candidate
+    return count + 1, first_is_max
