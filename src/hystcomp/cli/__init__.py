@@ -51,3 +51,7 @@ def main() -> None:
 
     Units: voltage in V, displacement in µm, time in s.
     """
+
+
+# The subcommands register themselves on main when imported.
+from hystcomp.cli import compare  # noqa: F401
