@@ -1,0 +1,1 @@
+"""The paper's experiment: comparison runs, metrics, tables and figures."""

@@ -26,6 +26,11 @@ def _save(fig: Figure, path: Path) -> None:
         fig.savefig(tmp, format="png", dpi=130)
 
 
+def _thin(n: int, points: int = 5000) -> slice:
+    """Every k-th sample, so that a line has about ``points`` points (plots only)."""
+    return slice(None, None, max(1, n // points))
+
+
 def _new_figure(size) -> Figure:
     fig = Figure(figsize=size, layout="constrained")
     FigureCanvasAgg(fig)
@@ -48,12 +53,13 @@ def figure_9(results: dict, path: Path) -> None:
         r = results[method]
         w = r.window
         ref, x = r.x_ref[w], r.x[w]
+        near = ref >= zone
+        low_y, high_y = min(low_y, float(x[near].min())), max(high_y, float(x[near].max()))
+        ref, x = ref[_thin(ref.size)], x[_thin(x.size)]
         style = {"color": COLOURS[method], "lw": 0.9}
         label = f"{LABELS[method]} ({r.saturation_zone_pct:.1f} % in the saturation zone)"
         ax.plot(ref, x, label=label, **style)
         inset.plot(ref, x, **style)
-        near = ref >= zone
-        low_y, high_y = min(low_y, float(x[near].min())), max(high_y, float(x[near].max()))
     for axis in (ax, inset):
         axis.plot([0.0, top], [0.0, top], color="k", lw=0.6, ls="--")
         axis.grid(alpha=0.3)
@@ -82,12 +88,14 @@ def figure_10(results: dict, path: Path) -> None:
     for row, f in zip(axes, frequencies, strict=True):
         first = results[f][METHODS[0]]
         w = first.window
-        t = first.t[w]
-        row[0].plot(t, first.x_ref[w], color="k", lw=0.8, ls="--", label="reference")
+        thin = _thin(w.stop - w.start)
+        t = first.t[w][thin]
+        row[0].plot(t, first.x_ref[w][thin], color="k", lw=0.8, ls="--", label="reference")
         for method in METHODS:
             r = results[f][method]
-            row[0].plot(t, r.x[w], color=COLOURS[method], lw=0.8, label=LABELS[method])
-            row[1].plot(t, r.e[w], color=COLOURS[method], lw=0.8, label=LABELS[method])
+            style = {"color": COLOURS[method], "lw": 0.8, "label": LABELS[method]}
+            row[0].plot(t, r.x[w][thin], **style)
+            row[1].plot(t, r.e[w][thin], **style)
         row[0].set_ylabel("displacement (µm)")
         row[1].set_ylabel("tracking error e (µm)")
         row[0].set_title(f"{f:g} Hz: tracking")

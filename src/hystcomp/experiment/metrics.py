@@ -50,16 +50,17 @@ def tracking_errors(reference, output) -> tuple[float, float]:
 def branch_means(reference, output, *, n_bins=None) -> tuple[np.ndarray, ...]:
     """Ascending and descending branches of a loop, averaged on a common grid.
 
-    Each sample goes to the branch of the step that led to it (reference rising or
-    falling; samples of a flat reference are left out). The reference range is cut into
-    ``n_bins`` equal bins and each branch is averaged in each bin, which removes the
-    sensor noise and puts both branches on the same abscissa.
+    Each step between two samples belongs to the ascending or the descending branch as the
+    reference rises or falls (steps of a flat reference are left out) and stands for its
+    mid-point, so that the turning points weigh the same on both branches. The reference
+    range is cut into ``n_bins`` equal bins and each branch is averaged in each bin, which
+    removes the sensor noise and puts both branches on the same abscissa.
 
     Returns
     -------
     centres, ascending, descending : ndarray
         Bin centres (reference unit) and the branch means (output unit); NaN where a
-        branch has no sample in a bin.
+        branch has no step in a bin.
     """
     ref, out = _pair(reference, output, 4)
     step = np.diff(ref)
@@ -73,13 +74,14 @@ def branch_means(reference, output, *, n_bins=None) -> tuple[np.ndarray, ...]:
         n_bins = int(np.clip(min(rising.sum(), falling.sum()) // 10, 8, 200))
     n_bins = check_int(n_bins, "n_bins", "branch_means", minimum=1)
     lo, hi = float(ref.min()), float(ref.max())
-    index = np.minimum(((ref[1:] - lo) / (hi - lo) * n_bins).astype(np.int64), n_bins - 1)
+    mid_ref = 0.5 * (ref[1:] + ref[:-1])
+    mid_out = 0.5 * (out[1:] + out[:-1])
+    index = np.minimum(((mid_ref - lo) / (hi - lo) * n_bins).astype(np.int64), n_bins - 1)
     means = []
     for branch in (rising, falling):
         count = np.bincount(index[branch], minlength=n_bins)
-        total = np.bincount(index[branch], weights=out[1:][branch], minlength=n_bins)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            means.append(np.where(count > 0, total / np.maximum(count, 1), np.nan))
+        total = np.bincount(index[branch], weights=mid_out[branch], minlength=n_bins)
+        means.append(np.where(count > 0, total / np.maximum(count, 1), np.nan))
     centres = lo + (np.arange(n_bins) + 0.5) * (hi - lo) / n_bins
     return centres, means[0], means[1]
 

@@ -2,7 +2,9 @@
 
 ``x_ref -> compensator -> v -> twin -> x``; the error ``e = x - x_ref`` and the hysteresis
 of ``x`` against ``x_ref`` are measured over the whole periods after the first (the axis
-leaves its rest state during the first one).
+leaves its rest state during the first one). For the uncompensated baseline ``v`` is
+proportional to ``x_ref``, so its loop against ``x_ref`` is its loop against the input,
+rescaled, as the paper measures it.
 """
 
 from __future__ import annotations

@@ -172,16 +172,16 @@ class TwinParameters:
 
 
 def dynamics_matrices(params: TwinParameters) -> tuple[np.ndarray, np.ndarray]:
-    """``(Ad, Bd)`` of the zero-order-hold discretisation of ``D(s)`` (exact, scipy.signal).
+    """``(Ad, Bd)`` of the exact zero-order-hold discretisation of ``D(s)``.
 
-    States are position (µm) and velocity (µm/s); the position is the output and the DC
-    gain is 1.
+    ``exp([[A, B], [0, 0]] Ts) = [[Ad, Bd], [0, 1]]`` (scipy.linalg.expm). States are
+    position (µm) and velocity (µm/s); the position is the output and the DC gain is 1.
     """
-    from scipy.signal import cont2discrete
+    from scipy.linalg import expm
 
     wn = 2.0 * np.pi * params.resonance_hz
-    a = np.array([[0.0, 1.0], [-(wn**2), -2.0 * params.damping_ratio * wn]])
-    b = np.array([[0.0], [wn**2]])
-    c = np.array([[1.0, 0.0]])
-    ad, bd, *_ = cont2discrete((a, b, c, np.zeros((1, 1))), params.sample_time, method="zoh")
-    return ad, bd[:, 0]
+    augmented = np.zeros((3, 3))
+    augmented[0, 1] = 1.0
+    augmented[1, :] = [-(wn**2), -2.0 * params.damping_ratio * wn, wn**2]
+    discrete = expm(augmented * params.sample_time)
+    return discrete[:2, :2], discrete[:2, 2]

@@ -123,7 +123,9 @@ class Twin:
         return sigma * self._rng.standard_normal(n)
 
     def __repr__(self) -> str:
-        return f"Twin(seed={self.seed})" if self.params == TwinParameters() else "Twin(custom)"
+        if self.params == TwinParameters():
+            return f"Twin(seed={self.seed})"
+        return f"Twin({self.params!r}, seed={self.seed})"
 
 
 class TwinStepper:
