@@ -133,8 +133,9 @@ def write_figures(comparison, out_dir: Path) -> dict[str, str | None]:
         )
     else:
         rec = comparison.record_loops
-        x_model = comparison.models["preisach"].simulate(rec.v)
-        plot_loops(rec.v, rec.x, x_model, out_dir / "fig5_preisach.png")
+        plot_loops(
+            comparison.models["preisach"], out_dir / "fig5_preisach.png", measured=(rec.v, rec.x)
+        )
         notes["fig5_preisach.png"] = None
 
     plot_identification = _hook("hystcomp.experiment.fig_identification", "plot_identification")
