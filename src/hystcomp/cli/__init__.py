@@ -77,4 +77,4 @@ def main() -> None:
 
 
 # The subcommands register themselves on main when imported.
-from hystcomp.cli import compensate, excite, export_c, identify, simulate  # noqa: F401
+from hystcomp.cli import compare, compensate, excite, export_c, identify, simulate  # noqa: F401

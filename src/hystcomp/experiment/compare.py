@@ -1,0 +1,240 @@
+"""The paper's whole experiment (Section V) on the twin: identify, compensate, track, measure.
+
+1. Run the paper's identification signals on the twin: the PI/MPI triangles of 30..120 V
+   (Section IV-A) and the Preisach sinusoids of 5..120 V (Section III-A), both at 1 Hz.
+2. Identify the three models from those records (:func:`identify_models`) and the
+   uncompensated baseline's gain ``k_lin`` (:mod:`hystcomp.experiment.baseline`).
+3. Track triangles at 1, 10 and 50 Hz with each of the four methods and measure the
+   errors (Table I) and the hysteresis (Fig. 9).
+
+:func:`run_comparison` returns everything as a :class:`Comparison`; the files (tables,
+figures, report) are written by :func:`hystcomp.experiment.report.write_outputs`.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+from collections.abc import Callable
+
+import numpy as np
+
+from hystcomp._validation import check_int, check_real
+from hystcomp.data import Record
+from hystcomp.errors import InvalidParameterError, InvalidTypeError
+from hystcomp.experiment.baseline import LinearCompensator, linear_gain
+from hystcomp.experiment.paper import DATASHEET_GAIN, METHODS
+from hystcomp.experiment.references import FREQUENCIES, REFERENCE_FRACTION, triangle_reference
+from hystcomp.experiment.tracking import TrackingResult, check_compensator, run_tracking
+from hystcomp.identify.excitation import (
+    PI_AMPLITUDES,
+    PREISACH_AMPLITUDES,
+    sinusoid_sequence,
+    triangle_sequence,
+)
+from hystcomp.models.mpi import ModifiedPrandtlIshlinskii
+from hystcomp.models.pi import PrandtlIshlinskii
+from hystcomp.models.preisach import Preisach
+from hystcomp.plant import Twin, TwinParameters
+
+#: The model kinds that :func:`identify_models` returns, and the amplitudes of Fig. 5.
+MODEL_KINDS = ("preisach", "pi", "mpi")
+FIG5_AMPLITUDES = PI_AMPLITUDES  # 30, 60, 90, 120 V
+
+
+@dataclasses.dataclass(frozen=True)
+class CompareConfig:
+    """What to run. The defaults are the paper's experiment.
+
+    Attributes
+    ----------
+    seed : int
+        Seed of the twin's sensor noise.
+    periods : int
+        Periods of each tracking reference (the first is left out of the metrics).
+    frequencies : tuple of float
+        Reference frequencies in Hz.
+    reference_fraction : float
+        Peak of the references as a fraction of the largest displacement measured in the
+        PI/MPI identification record (see :mod:`hystcomp.experiment.references`).
+    preisach_amplitudes : tuple of float
+        Amplitudes (V) of the Preisach identification sinusoids.
+    n_operators, n_deadzones, preisach_degree : int
+        Model sizes: 16 plays, 16 dead-zones and the cubic Everett function of the paper.
+    twin : TwinParameters
+        The simulated axis.
+    """
+
+    seed: int = 0
+    periods: int = 3
+    frequencies: tuple[float, ...] = FREQUENCIES
+    reference_fraction: float = REFERENCE_FRACTION
+    preisach_amplitudes: tuple[float, ...] = PREISACH_AMPLITUDES
+    n_operators: int = 16
+    n_deadzones: int = 16
+    preisach_degree: int = 3
+    twin: TwinParameters = dataclasses.field(default_factory=TwinParameters)
+
+    def __post_init__(self):
+        owner = "CompareConfig"
+        check_int(self.seed, "seed", owner, minimum=0)
+        check_int(self.periods, "periods", owner, minimum=2)
+        for name in ("n_operators", "n_deadzones", "preisach_degree"):
+            check_int(getattr(self, name), name, owner)
+        fraction = check_real(self.reference_fraction, "reference_fraction", owner, positive=True)
+        if fraction > 1.0:
+            raise InvalidParameterError(
+                f"The 'reference_fraction' parameter of {owner} must be in (0, 1]: a reference "
+                f"beyond the measured stroke cannot be tracked. Got {fraction!r} instead."
+            )
+        for name in ("frequencies", "preisach_amplitudes"):
+            values = tuple(check_real(f, name, owner, positive=True) for f in getattr(self, name))
+            if not values:
+                raise InvalidParameterError(f"The {name!r} parameter of {owner} is empty.")
+            object.__setattr__(self, name, values)
+        if not isinstance(self.twin, TwinParameters):
+            raise InvalidTypeError(
+                f"The 'twin' parameter of {owner} must be a TwinParameters. "
+                f"Got {type(self.twin).__name__}."
+            )
+
+    @classmethod
+    def quick(cls, **changes) -> CompareConfig:
+        """A short run for tests and a first look: 2 periods, four Preisach sinusoids."""
+        changes = {"periods": 2, "preisach_amplitudes": FIG5_AMPLITUDES, **changes}
+        return cls(**changes)
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class Comparison:
+    """Everything the experiment produced.
+
+    Attributes
+    ----------
+    config : CompareConfig
+    record_pi, record_preisach, record_loops : Record
+        The twin's answers to the PI/MPI triangles, the Preisach sinusoids, and the
+        30/60/90/120 V sinusoids of Fig. 5.
+    models : dict
+        The identified models by kind (``"preisach"``, ``"pi"``, ``"mpi"``).
+    gain : float
+        ``k_lin`` of the uncompensated baseline, µm/V.
+    reference_amplitude : float
+        Peak of the triangle references, µm.
+    results : dict
+        ``results[frequency][method]`` is a :class:`TrackingResult`.
+    datasheet : dict
+        ``datasheet[frequency]``: the uncompensated run with the datasheet gain instead.
+    seconds : float
+        Wall-clock time of the run.
+    """
+
+    config: CompareConfig
+    record_pi: Record
+    record_preisach: Record
+    record_loops: Record
+    models: dict
+    gain: float
+    reference_amplitude: float
+    results: dict[float, dict[str, TrackingResult]]
+    datasheet: dict[float, TrackingResult]
+    seconds: float
+
+
+def identify_models(
+    record_pi: Record, record_preisach: Record, config: CompareConfig | None = None
+) -> dict:
+    """Identify the paper's three models from the twin's records.
+
+    PI and MPI (16 plays, 16 dead-zones, Section IV-A) from the triangle record; Preisach
+    (cubic Everett function, eq. 5) from the sinusoid record. Each model's ``inverse()`` is
+    its compensator.
+    """
+    config = CompareConfig() if config is None else config
+    pi = PrandtlIshlinskii(n_operators=config.n_operators)
+    mpi = ModifiedPrandtlIshlinskii(n_operators=config.n_operators, n_deadzones=config.n_deadzones)
+    preisach = Preisach(degree=config.preisach_degree)
+    return {
+        "preisach": preisach.fit(record_preisach.v, record_preisach.x),
+        "pi": pi.fit(record_pi.v, record_pi.x),
+        "mpi": mpi.fit(record_pi.v, record_pi.x),
+    }
+
+
+def run_comparison(
+    config: CompareConfig | None = None,
+    *,
+    identify: Callable[[Record, Record, CompareConfig], dict] | None = None,
+    progress: Callable[[str], None] | None = None,
+) -> Comparison:
+    """Run the paper's experiment on the twin.
+
+    Parameters
+    ----------
+    config : CompareConfig, optional
+        What to run; the paper's experiment by default.
+    identify : callable, optional
+        ``identify(record_pi, record_preisach, config) -> {"preisach": m, "pi": m, "mpi": m}``
+        where each model has ``inverse()``; :func:`identify_models` by default.
+    progress : callable, optional
+        Called with one line of text at each stage.
+
+    Returns
+    -------
+    Comparison
+    """
+    config = CompareConfig() if config is None else config
+    if not isinstance(config, CompareConfig):
+        raise InvalidTypeError(f"'config' must be a CompareConfig. Got {type(config).__name__}.")
+    identify = identify_models if identify is None else identify
+    say = progress or (lambda _line: None)
+    start = time.perf_counter()
+    twin = Twin(config.twin, seed=config.seed)
+    fs = twin.sample_rate
+
+    say("identification experiments on the twin (triangles 30..120 V, sinusoids 5..120 V)")
+    record_pi = _measure(twin, triangle_sequence(sample_rate=fs))
+    record_preisach = _measure(twin, sinusoid_sequence(config.preisach_amplitudes, sample_rate=fs))
+    record_loops = _measure(twin, sinusoid_sequence(FIG5_AMPLITUDES, sample_rate=fs))
+
+    say("identifying the Preisach, PI and MPI models")
+    models = identify(record_pi, record_preisach, config)
+    missing = [kind for kind in MODEL_KINDS if kind not in models]
+    if missing:
+        raise InvalidParameterError(f"'identify' returned no model for {missing}.")
+    gain = linear_gain(record_pi.v, record_pi.x)
+    lo, hi = twin.voltage_range
+    compensators = {"uncompensated": LinearCompensator(gain, (lo, hi))}
+    for kind in MODEL_KINDS:
+        compensators[kind] = check_compensator(models[kind].inverse(), f"{kind} compensator")
+    datasheet_baseline = LinearCompensator(DATASHEET_GAIN, (lo, hi))
+
+    amplitude = config.reference_fraction * float(record_pi.x.max())
+    results: dict[float, dict[str, TrackingResult]] = {}
+    datasheet: dict[float, TrackingResult] = {}
+    for f in config.frequencies:
+        say(f"tracking a {f:g} Hz triangle of 0..{amplitude:.1f} µm with the four methods")
+        _, x_ref = triangle_reference(amplitude, f, periods=config.periods, sample_rate=fs)
+        results[f] = {
+            m: run_tracking(compensators[m], twin, x_ref, frequency=f, method=m) for m in METHODS
+        }
+        datasheet[f] = run_tracking(
+            datasheet_baseline, twin, x_ref, frequency=f, method="uncompensated (datasheet gain)"
+        )
+    return Comparison(
+        config=config,
+        record_pi=record_pi,
+        record_preisach=record_preisach,
+        record_loops=record_loops,
+        models=models,
+        gain=gain,
+        reference_amplitude=amplitude,
+        results=results,
+        datasheet=datasheet,
+        seconds=time.perf_counter() - start,
+    )
+
+
+def _measure(twin: Twin, signal: tuple[np.ndarray, np.ndarray]) -> Record:
+    t, v = signal
+    return Record(t=t, v=v, x=twin.run(v), source="the twin")

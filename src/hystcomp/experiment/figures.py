@@ -1,0 +1,157 @@
+"""Figures of the comparison: the paper's Figs. 9 and 10, and hooks for Figs. 5 and 8.
+
+Every figure is drawn on its own :class:`~matplotlib.figure.Figure` (no global pyplot
+state) and saved through :func:`hystcomp.io.atomic_path`, so a failure never leaves a
+broken image.
+"""
+
+from __future__ import annotations
+
+import importlib
+from pathlib import Path
+
+import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+
+from hystcomp.experiment.metrics import SATURATION_ZONE
+from hystcomp.experiment.paper import LABELS, METHODS
+from hystcomp.io import atomic_path
+
+COLOURS = {"uncompensated": "0.45", "preisach": "tab:green", "pi": "tab:blue", "mpi": "tab:red"}
+
+
+def _save(fig: Figure, path: Path) -> None:
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, format="png", dpi=130)
+
+
+def _thin(n: int, points: int = 5000) -> slice:
+    """Every k-th sample, so that a line has about ``points`` points (plots only)."""
+    return slice(None, None, max(1, n // points))
+
+
+def _new_figure(size) -> Figure:
+    fig = Figure(figsize=size, layout="constrained")
+    FigureCanvasAgg(fig)
+    return fig
+
+
+def figure_9(results: dict, path: Path) -> None:
+    """Fig. 9: measured displacement against the reference at one frequency, four methods.
+
+    ``results`` maps each method to its :class:`~hystcomp.experiment.tracking.TrackingResult`;
+    the inset zooms on the saturation zone (top quarter of the reference range).
+    """
+    fig = _new_figure((7.5, 6.0))
+    ax = fig.add_subplot()
+    top = max(float(r.x_ref.max()) for r in results.values())
+    zone = SATURATION_ZONE * top
+    inset = ax.inset_axes([0.52, 0.06, 0.45, 0.42])
+    low_y, high_y = np.inf, -np.inf
+    for method in METHODS:
+        r = results[method]
+        w = r.window
+        ref, x = r.x_ref[w], r.x[w]
+        near = ref >= zone
+        low_y, high_y = min(low_y, float(x[near].min())), max(high_y, float(x[near].max()))
+        ref, x = ref[_thin(ref.size)], x[_thin(x.size)]
+        style = {"color": COLOURS[method], "lw": 0.9}
+        label = f"{LABELS[method]} ({r.saturation_zone_pct:.1f} % in the saturation zone)"
+        ax.plot(ref, x, label=label, **style)
+        inset.plot(ref, x, **style)
+    for axis in (ax, inset):
+        axis.plot([0.0, top], [0.0, top], color="k", lw=0.6, ls="--")
+        axis.grid(alpha=0.3)
+    ax.plot([], [], color="k", lw=0.6, ls="--", label="ideal (x = x_ref)")
+    inset.set_xlim(zone, top)
+    inset.set_ylim(low_y, high_y)
+    inset.set_title("saturation zone", fontsize=8)
+    inset.tick_params(labelsize=7)
+    ax.indicate_inset_zoom(inset, edgecolor="0.3")
+    ax.set_xlabel("reference x_ref (µm)")
+    ax.set_ylabel("measured displacement x (µm)")
+    frequency = next(iter(results.values())).frequency
+    ax.set_title(f"Hysteresis compensation, {frequency:g} Hz triangle (twin)")
+    ax.legend(loc="upper left", fontsize=8)
+    _save(fig, path)
+
+
+def figure_10(results: dict, path: Path) -> None:
+    """Fig. 10: tracking (left) and tracking error (right) against time, one row per frequency.
+
+    ``results[frequency][method]`` are tracking results; the measured window is shown.
+    """
+    frequencies = sorted(results)
+    fig = _new_figure((11.0, 3.0 * len(frequencies)))
+    axes = fig.subplots(len(frequencies), 2, squeeze=False)
+    for row, f in zip(axes, frequencies, strict=True):
+        first = results[f][METHODS[0]]
+        w = first.window
+        thin = _thin(w.stop - w.start)
+        t = first.t[w][thin]
+        row[0].plot(t, first.x_ref[w][thin], color="k", lw=0.8, ls="--", label="reference")
+        for method in METHODS:
+            r = results[f][method]
+            style = {"color": COLOURS[method], "lw": 0.8, "label": LABELS[method]}
+            row[0].plot(t, r.x[w][thin], **style)
+            row[1].plot(t, r.e[w][thin], **style)
+        row[0].set_ylabel("displacement (µm)")
+        row[1].set_ylabel("tracking error e (µm)")
+        row[0].set_title(f"{f:g} Hz: tracking")
+        row[1].set_title(f"{f:g} Hz: tracking error e = x - x_ref")
+        for ax in row:
+            ax.set_xlabel("time (s)")
+            ax.grid(alpha=0.3)
+    handles, labels = axes[0, 0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="outside upper center", ncols=len(labels))
+    _save(fig, path)
+
+
+def _hook(module: str, name: str):
+    """A figure function written in another module of the package, or None if absent."""
+    try:
+        return getattr(importlib.import_module(module), name, None)
+    except ImportError:
+        return None
+
+
+def write_figures(comparison, out_dir: Path) -> dict[str, str | None]:
+    """Draw every figure into ``out_dir``; returns ``{file name: None if drawn, else why not}``."""
+    notes: dict[str, str | None] = {}
+    frequencies = sorted(comparison.results)
+    first = frequencies[0]
+    figure_9(comparison.results[first], out_dir / "fig9_compensation.png")
+    notes["fig9_compensation.png"] = None
+    figure_10(comparison.results, out_dir / "fig10_tracking.png")
+    notes["fig10_tracking.png"] = None
+
+    plot_loops = _hook("hystcomp.experiment.fig_preisach", "plot_preisach_loops")
+    if plot_loops is None:
+        notes["fig5_preisach.png"] = (
+            "not drawn: hystcomp.experiment.fig_preisach.plot_preisach_loops is not available"
+        )
+    else:
+        rec = comparison.record_loops
+        plot_loops(
+            comparison.models["preisach"], out_dir / "fig5_preisach.png", measured=(rec.v, rec.x)
+        )
+        notes["fig5_preisach.png"] = None
+
+    plot_identification = _hook("hystcomp.experiment.fig_identification", "plot_identification")
+    rec = comparison.record_pi
+    for kind in ("pi", "mpi"):
+        name = f"fig8_{kind}.png"
+        if plot_identification is None:
+            notes[name] = (
+                "not drawn: hystcomp.experiment.fig_identification.plot_identification "
+                "is not available"
+            )
+            continue
+        slope, intercept = np.polyfit(rec.v, rec.x, 1)  # "before": the best straight line
+        after = comparison.models[kind].simulate(rec.v)
+        plot_identification(
+            rec.v, rec.x, slope * rec.v + intercept, after, out_dir / name, model_name=LABELS[kind]
+        )
+        notes[name] = None
+    return notes

@@ -1,0 +1,159 @@
+"""The simulated piezo axis ("twin") of the paper's Section II, batch and streaming.
+
+``command v (V) -> amplifier (static gain, rails) -> hysteresis H -> [creep] -> D(s)
+-> capacitive sensor (gain, noise, offset) -> displacement (µm)``
+
+The twin starts at rest at the low end of its voltage range with the sensor reading
+``sensor_offset``. It is an immutable set of parameters: :meth:`Twin.run` starts from
+rest every time, and only the noise generator, seeded once, advances from run to run, so
+a sequence of experiments is reproducible from the seed.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from hystcomp._validation import as_signal, check_int, check_real
+from hystcomp.errors import InvalidTypeError
+from hystcomp.plant import _kernels as k
+from hystcomp.plant.parameters import TwinParameters, dynamics_matrices
+
+#: The Bouc-Wen state at rest: the actuator was last driven down to the low rail.
+REST_STATE = -1.0
+
+
+def _pack(params: TwinParameters) -> tuple[np.ndarray, np.ndarray]:
+    """Packed parameters and rest state for the kernels (see :mod:`._kernels`)."""
+    ad, bd = dynamics_matrices(params)
+    lo, hi = params.voltage_range
+    taus = np.asarray(params.creep_time_constants, dtype=np.float64)
+    if params.creep_gain == 0.0:
+        taus = taus[:0]
+    lags = np.exp(-params.sample_time / taus)
+    gains = np.full(taus.size, params.creep_gain / max(taus.size, 1))
+    head = [lo, hi, params.amplifier_gain, *params.anhysteretic, params.hysteresis_amplitude]
+    head += [params.hysteresis_onset, params.bouc_wen_rate, params.bouc_wen_shape]
+    head += [ad[0, 0], ad[0, 1], ad[1, 0], ad[1, 1], bd[0], bd[1], taus.size]
+    p = np.concatenate([np.asarray(head, dtype=np.float64), lags, gains])
+    p.setflags(write=False)
+    state = np.zeros(k.S_CREEP + taus.size)
+    state[k.S_Z] = REST_STATE
+    return p, state
+
+
+class Twin:
+    """The simulated piezo axis: command voltage (V) in, measured displacement (µm) out.
+
+    Parameters
+    ----------
+    params : TwinParameters, optional
+        The axis; the default is calibrated on the paper's rig (see
+        :mod:`hystcomp.plant.parameters`).
+    seed : int, default 0
+        Seed of the sensor-noise generator.
+
+    Examples
+    --------
+    >>> twin = Twin(seed=1)
+    >>> v = np.linspace(0.0, 120.0, 20_001)
+    >>> x = twin.run(v)                      # µm, with sensor noise
+    >>> round(float(twin.run_noiseless(v)[-1]), 1)
+    37.0
+    >>> t = twin.time(v.size)                # s, at 20 kHz
+    >>> float(t[1])
+    5e-05
+    """
+
+    def __init__(self, params: TwinParameters | None = None, *, seed: int = 0):
+        if params is None:
+            params = TwinParameters()
+        if not isinstance(params, TwinParameters):
+            raise InvalidTypeError(
+                f"The 'params' parameter of Twin must be a TwinParameters. "
+                f"Got {type(params).__name__}; build one with TwinParameters(...)."
+            )
+        self.params = params
+        self.seed = check_int(seed, "seed", "Twin", minimum=0)
+        self._rng = np.random.default_rng(self.seed)
+        self._p, self._rest = _pack(params)
+
+    @property
+    def sample_rate(self) -> float:
+        """Sampling frequency in Hz."""
+        return float(self.params.sample_rate)
+
+    @property
+    def voltage_range(self) -> tuple[float, float]:
+        """The amplifier's rails in V."""
+        return self.params.voltage_range
+
+    def time(self, n_samples: int) -> np.ndarray:
+        """Time of ``n_samples`` samples from 0, in s."""
+        n = check_int(n_samples, "n_samples", "Twin.time", minimum=0)
+        return np.arange(n) / self.sample_rate
+
+    def run_noiseless(self, v) -> np.ndarray:
+        """Displacement in µm for the command ``v`` in V, from rest, without sensor noise."""
+        u = as_signal(v, "v")
+        out = np.empty_like(u)
+        k.twin_run(self._p, self._rest.copy(), u, out)
+        return out + self.params.sensor_offset
+
+    def run(self, v) -> np.ndarray:
+        """Measured displacement in µm for the command ``v`` in V (from rest, with noise).
+
+        The sensor reads ``G_cap x + n`` volts and the acquisition divides by ``G_cap``.
+        """
+        x = self.run_noiseless(v)
+        return x + self._noise(x.size)
+
+    def hysteresis(self, v) -> np.ndarray:
+        """The quasi-static displacement ``H[v]`` in µm (no creep, no dynamics, no noise)."""
+        u = as_signal(v, "v")
+        out = np.empty_like(u)
+        k.hysteresis_run(self._p, self._rest.copy(), u, out)
+        return out
+
+    def stepper(self) -> TwinStepper:
+        """A streaming twin, one sample per call, with its own noise generator."""
+        return TwinStepper(self._p, self._rest, self.params, self._rng.spawn(1)[0])
+
+    def _noise(self, n: int) -> np.ndarray:
+        sigma = self.params.sensor_noise / self.params.sensor_gain
+        return sigma * self._rng.standard_normal(n)
+
+    def __repr__(self) -> str:
+        if self.params == TwinParameters():
+            return f"Twin(seed={self.seed})"
+        return f"Twin({self.params!r}, seed={self.seed})"
+
+
+class TwinStepper:
+    """The twin one sample at a time; the same kernel as :meth:`Twin.run`.
+
+    Use it in a loop with a compensator's stepper: ``x_k = twin.step(comp.step(x_ref_k))``.
+    """
+
+    def __init__(self, p, rest, params: TwinParameters, rng: np.random.Generator):
+        self._p = p
+        self._rest = rest
+        self._s = rest.copy()
+        self._offset = params.sensor_offset
+        self._sigma = params.sensor_noise / params.sensor_gain
+        self._rng = rng
+
+    def step(self, v: float) -> float:
+        """Apply one command sample (V) and return the measured displacement (µm)."""
+        v = check_real(v, "v", "TwinStepper.step")
+        return k.twin_step(self._p, self._s, v) + self._offset + self._sigma * self._rng.normal()
+
+    def step_block(self, v) -> np.ndarray:
+        """Apply a block of command samples and return the measured displacements."""
+        u = as_signal(v, "v")
+        out = np.empty_like(u)
+        k.twin_run(self._p, self._s, u, out)
+        return out + self._offset + self._sigma * self._rng.standard_normal(u.size)
+
+    def reset(self) -> None:
+        """Back to rest (the noise generator keeps going)."""
+        self._s[:] = self._rest

@@ -1,0 +1,118 @@
+"""The compare pipeline (Section V on the twin): a short run, its files, the command."""
+
+import csv
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from hystcomp import presets
+from hystcomp.cli import main
+from hystcomp.errors import InvalidParameterError
+from hystcomp.experiment import compare as compare_module
+from hystcomp.experiment.compare import CompareConfig, run_comparison
+from hystcomp.experiment.paper import METHODS
+from hystcomp.experiment.report import write_outputs
+
+PNG = b"\x89PNG\r\n\x1a\n"
+
+
+def stand_in_models(record_pi, record_preisach, config=None):
+    """The paper's identified models in place of identification (tests of the plumbing only)."""
+    return {"preisach": presets.paper_mpi(), "pi": presets.paper_pi(), "mpi": presets.paper_mpi()}
+
+
+@pytest.fixture(scope="module")
+def comparison():
+    lines = []
+    result = run_comparison(CompareConfig.quick(), identify=stand_in_models, progress=lines.append)
+    assert len(lines) == 5  # records, identification, three frequencies
+    return result
+
+
+def test_quick_comparison_runs_every_method_at_every_frequency(comparison):
+    assert sorted(comparison.results) == [1.0, 10.0, 50.0]
+    for f, by_method in comparison.results.items():
+        assert tuple(by_method) == METHODS
+        for result in by_method.values():
+            assert result.frequency == f
+            assert result.t.size == 2 * round(20_000 / f) + 1  # two periods
+            assert np.isfinite([result.rms, result.max, result.hysteresis_pct]).all()
+            assert 0 < result.rms <= result.max
+    assert comparison.reference_amplitude == pytest.approx(0.9 * comparison.record_pi.x.max())
+    assert comparison.record_preisach.v.size == 4 * 20_000 + 1  # quick: 30/60/90/120 V
+    uncompensated = comparison.results[1.0]["uncompensated"]
+    assert uncompensated.v.max() == pytest.approx(
+        comparison.reference_amplitude / comparison.gain, rel=1e-12
+    )
+
+
+def test_outputs_are_written(comparison, tmp_path):
+    out = tmp_path / "nested" / "out"
+    files = write_outputs(comparison, out)
+    names = {f.name for f in files}
+    assert {"table1.csv", "hysteresis.csv", "report.md", "fig9_compensation.png"} <= names
+    assert "fig10_tracking.png" in names
+    with open(out / "table1.csv", newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    assert list(rows[0]) == ["frequency_hz", "method", "rms_um", "max_um"]
+    assert len(rows) == 12
+    first = comparison.results[1.0]["uncompensated"]
+    assert float(rows[0]["rms_um"]) == pytest.approx(first.rms, rel=1e-5)
+    with open(out / "hysteresis.csv", newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    assert list(rows[0]) == ["method", "hysteresis_pct", "saturation_zone_pct"]
+    assert [r["method"] for r in rows] == list(METHODS)
+    for name in names - {"table1.csv", "hysteresis.csv", "report.md"}:
+        assert (out / name).read_bytes()[:8] == PNG
+    report = (out / "report.md").read_text()
+    assert "| 1 | uncompensated | " in report
+    assert f"{first.rms:.3f} | 4.700 |" in report
+    assert "datasheet gain" in report
+    assert not list(out.glob(".*.tmp"))  # no temporary file left behind
+
+
+def test_output_folder_that_is_a_file_is_refused(comparison, tmp_path):
+    path = tmp_path / "taken"
+    path.write_text("mine")
+    with pytest.raises(InvalidParameterError, match="is a file, not a folder"):
+        write_outputs(comparison, path)
+    assert path.read_text() == "mine"
+
+
+def test_config_is_validated():
+    with pytest.raises(InvalidParameterError, match="'reference_fraction'"):
+        CompareConfig(reference_fraction=1.2)
+    with pytest.raises(InvalidParameterError, match="'periods'"):
+        CompareConfig(periods=1)
+
+
+def test_real_quick_comparison():
+    c = run_comparison(CompareConfig.quick())
+    assert set(c.models) == {"preisach", "pi", "mpi"}
+    for f in c.config.frequencies:
+        by_method = c.results[f]
+        best = min(by_method[m].rms for m in METHODS[1:])
+        assert best < by_method["uncompensated"].rms / 2
+        assert by_method["mpi"].rms < by_method["uncompensated"].rms / 2
+
+
+def test_command_writes_the_files_and_prints_the_table(tmp_path, monkeypatch):
+    monkeypatch.setattr(compare_module, "identify_models", stand_in_models)
+    out = tmp_path / "cmp"
+    result = CliRunner().invoke(main, ["compare", "--quick", "--out", str(out), "--seed", "4"])
+    assert result.exit_code == 0, result.output
+    assert "uncompensated" in result.stdout
+    assert "f (Hz)" in result.stdout
+    assert "hystcomp compare: tracking a 50 Hz triangle" in result.stderr
+    assert (out / "report.md").is_file()
+    assert "seed 4" in (out / "report.md").read_text()
+
+
+def test_command_refuses_a_file_as_output_folder(tmp_path):
+    path = tmp_path / "file"
+    path.write_text("")
+    result = CliRunner().invoke(main, ["compare", "--quick", "--out", str(path)])
+    assert result.exit_code == 2
+    assert "is a file, not a folder" in result.stderr
+    assert len(result.stderr.strip().splitlines()) == 1
