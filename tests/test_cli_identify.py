@@ -14,7 +14,9 @@ import hystcomp
 from hystcomp import presets
 from hystcomp.cli import main
 from hystcomp.data import read_record, read_table, write_table
+from hystcomp.identify.excitation import triangle_sequence
 from hystcomp.identify.scoring import holdout_report
+from hystcomp.plant import Twin
 
 REAL_RECORD = (
     Path(__file__).parents[2] / "shared" / "data" / "piezo-micromanipulator" / "Model_Vi_Do.dat"
@@ -63,12 +65,15 @@ def test_identify_simulate_compensate_round_trip(tmp_path, kind, operators, tole
     t, v = (read_table(tmp_path / "v.csv", ("v",))[k] for k in "tv")
     write_table(tmp_path / "rec.csv", {"t": t, "v": v, "x": true.simulate(v)})
     args = ["identify", tmp_path / "rec.csv", "--model", kind, "--operators", operators]
+    if kind == "mpi":
+        args += ["--regularization", "0"]
     result = run(*args, "-o", tmp_path / "m.json", "--plot", tmp_path / "fig.png")
     assert result.exit_code == 0, result.output
     assert "fit error: rms" in result.output
     assert (tmp_path / "fig.png").stat().st_size > 10_000
     model = hystcomp.load_model(tmp_path / "m.json")
     assert model.kind == kind
+    assert model.get_params().get("regularization", 0.0) == 0.0
     assert model.thresholds_.size == operators
     assert model.fit_report_["n_used"] == v.size
 
@@ -130,6 +135,14 @@ def test_real_record_in_one_command_beats_a_straight_line(tmp_path, kind):
             "between 1 and",
         ),
         (["identify", "rec.csv", "--model", "pi", "--plot", "f.jpg", "-o", "m.json"], "--plot"),
+        (
+            ["identify", "rec.csv", "--model", "pi", "--regularization", "0.1", "-o", "m.json"],
+            "--regularization does not apply to --model pi",
+        ),
+        (
+            ["identify", "rec.csv", "--model", "mpi", "--regularization", "-1", "-o", "m.json"],
+            "must be a number >= 0",
+        ),
         (["identify", "rec.csv", "--model", "pi", "--columns", "v=", "-o", "m.json"], "columns"),
         (["identify", "flat.csv", "--model", "mpi", "-o", "m.json"], "is constant"),
         (["simulate", "m.json", "rec.csv", "-o", "x.csv"], "Model file 'm.json' does not exist"),
@@ -214,3 +227,17 @@ def test_python_dash_m_runs_the_command():
     )
     assert result.returncode == 0, result.stderr
     assert "identification input" in result.stdout
+
+
+def test_mpi_regularization_reaches_the_fit_and_the_model_file(tmp_path):
+    _, v = triangle_sequence(sample_rate=2000)
+    x = Twin(seed=5).run(np.repeat(v, 10))[::10]  # the twin runs at 20 kHz
+    write_table(tmp_path / "rec.csv", {"t": np.arange(v.size) / 2000, "v": v, "x": x})
+    files = {}
+    for value in ("0", "0.01"):
+        files[value] = tmp_path / f"m{value}.json"
+        args = ["identify", tmp_path / "rec.csv", "--model", "mpi", "--regularization", value]
+        assert run(*args, "-o", files[value]).exit_code == 0
+    plain, tamed = (hystcomp.load_model(files[k]) for k in ("0", "0.01"))
+    assert tamed.get_params()["regularization"] == 0.01
+    assert np.abs(tamed.deadzone_weights_).max() < np.abs(plain.deadzone_weights_).max() / 3

@@ -92,9 +92,11 @@ def test_real_quick_comparison():
     assert set(c.models) == {"preisach", "pi", "mpi"}
     for f in c.config.frequencies:
         by_method = c.results[f]
-        best = min(by_method[m].rms for m in METHODS[1:])
-        assert best < by_method["uncompensated"].rms / 2
-        assert by_method["mpi"].rms < by_method["uncompensated"].rms / 2
+        rms = {m: by_method[m].rms for m in METHODS}
+        assert rms["preisach"] < rms["uncompensated"] / 2  # the twin suits the Preisach model
+        assert max(rms["pi"], rms["mpi"]) < rms["uncompensated"] / 1.5
+        if f < 50:  # the asymmetric model beats the symmetric one (the paper's point)
+            assert rms["mpi"] < rms["pi"]
 
 
 def test_command_writes_the_files_and_prints_the_table(tmp_path, monkeypatch):

@@ -26,10 +26,14 @@ DEFAULT_OPERATORS = 16
 
 #: What each --model builds, and which size options it takes.
 LABELS = {"pi": "PI", "mpi": "MPI", "preisach": "Preisach"}
-SIZE_OPTIONS = {"pi": ("operators",), "mpi": ("operators", "deadzones"), "preisach": ()}
+SIZE_OPTIONS = {
+    "pi": ("operators",),
+    "mpi": ("operators", "deadzones", "regularization"),
+    "preisach": (),
+}
 
 
-def build_estimator(kind: str, *, operators, deadzones, voltage_range):
+def build_estimator(kind: str, *, operators, deadzones, voltage_range, regularization=None):
     """An unfitted model of ``kind`` from the registry :data:`hystcomp.io.MODEL_KINDS`."""
     cls = MODEL_KINDS.get(kind)
     if cls is None:
@@ -37,7 +41,7 @@ def build_estimator(kind: str, *, operators, deadzones, voltage_range):
             f"The {LABELS[kind]} model is not available in this version of hystcomp; "
             f"choose --model {' or '.join(k for k in LABELS if k in MODEL_KINDS)}."
         )
-    given = {"operators": operators, "deadzones": deadzones}
+    given = {"operators": operators, "deadzones": deadzones, "regularization": regularization}
     for name, value in given.items():
         if value is not None and name not in SIZE_OPTIONS[kind]:
             raise click.UsageError(f"--{name} does not apply to --model {kind}.")
@@ -46,6 +50,8 @@ def build_estimator(kind: str, *, operators, deadzones, voltage_range):
         params["n_operators"] = DEFAULT_OPERATORS if operators is None else operators
     if "deadzones" in SIZE_OPTIONS[kind]:
         params["n_deadzones"] = DEFAULT_OPERATORS if deadzones is None else deadzones
+    if regularization is not None:
+        params["regularization"] = regularization
     return cls(**params)
 
 
@@ -72,6 +78,15 @@ def _sizes(model) -> str:
     default=None,
     callback=count,
     help="Number of dead-zones m+1, mpi [16].",
+)
+@click.option(
+    "--regularization",
+    type=float,
+    default=None,
+    metavar="LAMBDA",
+    callback=nonnegative("unitless"),
+    help="Penalty on the inverse dead-zone weights, mpi [0: eq. 19 as printed]; try 1e-3 to "
+    "1e-1 when a held-out signal is predicted worse than the record is fitted.",
 )
 @columns_option
 @fs_option
@@ -109,6 +124,7 @@ def identify(
     kind,
     operators,
     deadzones,
+    regularization,
     columns,
     sample_rate,
     transient,
@@ -132,7 +148,11 @@ def identify(
         if Path(plot).resolve() == Path(output).resolve():
             raise click.BadParameter("names the same file as -o.", param_hint="--plot")
     model = build_estimator(
-        kind, operators=operators, deadzones=deadzones, voltage_range=voltage_range
+        kind,
+        operators=operators,
+        deadzones=deadzones,
+        voltage_range=voltage_range,
+        regularization=regularization,
     )
     rec = read_record(data, **read_options(columns, sample_rate))
     n = len(rec)

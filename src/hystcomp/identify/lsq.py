@@ -121,7 +121,11 @@ class LsqSolution:
     varies: np.ndarray
 
 
-def constrained_lsq(gram, *, blocks, scales, flat_tol=1e-6, ridge=1e-10) -> LsqSolution:
+#: The relative ridge that keeps the unit-scaled normal matrix positive definite.
+RIDGE = 1e-10
+
+
+def constrained_lsq(gram, *, blocks, scales, flat_tol=1e-6, ridge=RIDGE) -> LsqSolution:
     """Least squares from normal equations, every partial sum in each block above a bound.
 
     Minimises ``|Phi theta - z|^2`` subject to ``theta[a] + ... + theta[i] >= bound`` for
@@ -148,8 +152,9 @@ def constrained_lsq(gram, *, blocks, scales, flat_tol=1e-6, ridge=1e-10) -> LsqS
         Typical size of each non-constant regressor (its range), in its own units.
     flat_tol : float
         Relative standard deviation under which a regressor counts as constant.
-    ridge : float
-        Added to the diagonal of the unit-scaled normal matrix.
+    ridge : float or array_like, shape (p - 1,)
+        Added to the diagonal of the unit-scaled normal matrix: one value for every
+        regressor, or one each (a Tikhonov penalty on chosen coefficients).
 
     Returns
     -------
@@ -180,7 +185,7 @@ def constrained_lsq(gram, *, blocks, scales, flat_tol=1e-6, ridge=1e-10) -> LsqS
     idx = np.flatnonzero(varies)
     scale = 1.0 / np.sqrt(np.diag(G_c)[idx])
     quad = G_c[np.ix_(idx, idx)] * np.outer(scale, scale)
-    quad[np.diag_indices_from(quad)] += ridge
+    quad[np.diag_indices_from(quad)] += np.broadcast_to(ridge, (p - 1,))[idx]
     lin = g_c[idx] * scale
     rows, bounds = [], []
     for first, stop, bound in blocks:

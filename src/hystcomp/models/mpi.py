@@ -43,6 +43,11 @@ class ModifiedPrandtlIshlinskii(HysteresisModel):
         first reaches an end of its range (:func:`hystcomp.identify.scoring.transient_end`).
     margin : float, default 1e-3
         Invertibility margin of the fit (see :func:`hystcomp.identify.mpi.fit_mpi`).
+    regularization : float, default 0
+        Tikhonov penalty on the inverse dead-zone weights; 0 is eq. (19) as printed. A
+        deviation from the paper for records of actuators that are not exactly MPI systems
+        (see :mod:`hystcomp.identify.mpi`); choose it on a validation record with
+        :func:`hystcomp.identify.validation.choose_regularization`.
 
     Attributes
     ----------
@@ -71,7 +76,14 @@ class ModifiedPrandtlIshlinskii(HysteresisModel):
     """
 
     kind = "mpi"
-    _hyper = ("n_operators", "n_deadzones", "voltage_range", "transient", "margin")
+    _hyper = (
+        "n_operators",
+        "n_deadzones",
+        "voltage_range",
+        "transient",
+        "margin",
+        "regularization",
+    )
     _learned = (
         "thresholds",
         "weights",
@@ -84,13 +96,21 @@ class ModifiedPrandtlIshlinskii(HysteresisModel):
     )
 
     def __init__(
-        self, *, n_operators=16, n_deadzones=16, voltage_range=None, transient=None, margin=1e-3
+        self,
+        *,
+        n_operators=16,
+        n_deadzones=16,
+        voltage_range=None,
+        transient=None,
+        margin=1e-3,
+        regularization=0.0,
     ):
         self.n_operators = n_operators
         self.n_deadzones = n_deadzones
         self.voltage_range = voltage_range
         self.transient = transient
         self.margin = margin
+        self.regularization = regularization
 
     def fit(self, v, x) -> ModifiedPrandtlIshlinskii:
         """Identify the model from a measured record by eq. (19) (Section IV-A).
@@ -114,7 +134,13 @@ class ModifiedPrandtlIshlinskii(HysteresisModel):
         m = check_int(self.n_deadzones, "n_deadzones", owner)
         check_fit_options(self, owner)
         fit = fit_mpi(
-            v, x, n_operators=n, n_deadzones=m, transient=self.transient, margin=self.margin
+            v,
+            x,
+            n_operators=n,
+            n_deadzones=m,
+            transient=self.transient,
+            margin=self.margin,
+            regularization=self.regularization,
         )
         rs, ws = self.forward_deadzones(
             fit.inverse_deadzone_thresholds, fit.inverse_deadzone_weights
