@@ -143,6 +143,14 @@ def test_real_record_in_one_command_beats_a_straight_line(tmp_path, kind):
             ["identify", "rec.csv", "--model", "mpi", "--regularization", "-1", "-o", "m.json"],
             "must be a number >= 0",
         ),
+        (
+            ["identify", "rec.csv", "--model", "pi", "--degree", "2", "-o", "m.json"],
+            "--degree does not apply to --model pi",
+        ),
+        (
+            ["identify", "rec.csv", "--model", "preisach", "--degree", "0", "-o", "m.json"],
+            "--degree",
+        ),
         (["identify", "rec.csv", "--model", "pi", "--columns", "v=", "-o", "m.json"], "columns"),
         (["identify", "flat.csv", "--model", "mpi", "-o", "m.json"], "is constant"),
         (["simulate", "m.json", "rec.csv", "-o", "x.csv"], "Model file 'm.json' does not exist"),
@@ -166,7 +174,8 @@ def test_preisach_through_every_command(tmp_path):
     assert run("excite", "preisach", "-o", tmp_path / "v.csv", "--fs", "500").exit_code == 0
     t, v = (read_table(tmp_path / "v.csv", ("v",))[k] for k in "tv")
     write_table(tmp_path / "rec.csv", {"t": t, "v": v, "x": true.simulate(v) - 120.0})
-    result = run("identify", tmp_path / "rec.csv", "--model", "preisach", "-o", tmp_path / "m.json")
+    args = ["identify", tmp_path / "rec.csv", "--model", "preisach", "--degree", "3"]
+    result = run(*args, "-o", tmp_path / "m.json")
     assert result.exit_code == 0, result.output
     assert result.output.startswith("Preisach model from")
     model = hystcomp.load_model(tmp_path / "m.json")

@@ -19,6 +19,7 @@ from hystcomp.cli._options import (
 )
 from hystcomp.data import read_record
 from hystcomp.errors import IdentificationError
+from hystcomp.identify.preisach import MAX_DEGREE
 from hystcomp.identify.scoring import error_report, holdout_report, straight_line, transient_end
 from hystcomp.io import MODEL_KINDS, atomic_paths, check_output_path, model_text
 
@@ -29,11 +30,13 @@ LABELS = {"pi": "PI", "mpi": "MPI", "preisach": "Preisach"}
 SIZE_OPTIONS = {
     "pi": ("operators",),
     "mpi": ("operators", "deadzones", "regularization"),
-    "preisach": (),
+    "preisach": ("degree",),
 }
 
 
-def build_estimator(kind: str, *, operators, deadzones, voltage_range, regularization=None):
+def build_estimator(
+    kind: str, *, operators, deadzones, voltage_range, regularization=None, degree=None
+):
     """An unfitted model of ``kind`` from the registry :data:`hystcomp.io.MODEL_KINDS`."""
     cls = MODEL_KINDS.get(kind)
     if cls is None:
@@ -41,7 +44,12 @@ def build_estimator(kind: str, *, operators, deadzones, voltage_range, regulariz
             f"The {LABELS[kind]} model is not available in this version of hystcomp; "
             f"choose --model {' or '.join(k for k in LABELS if k in MODEL_KINDS)}."
         )
-    given = {"operators": operators, "deadzones": deadzones, "regularization": regularization}
+    given = {
+        "operators": operators,
+        "deadzones": deadzones,
+        "regularization": regularization,
+        "degree": degree,
+    }
     for name, value in given.items():
         if value is not None and name not in SIZE_OPTIONS[kind]:
             raise click.UsageError(f"--{name} does not apply to --model {kind}.")
@@ -52,6 +60,8 @@ def build_estimator(kind: str, *, operators, deadzones, voltage_range, regulariz
         params["n_deadzones"] = DEFAULT_OPERATORS if deadzones is None else deadzones
     if regularization is not None:
         params["regularization"] = regularization
+    if degree is not None:
+        params["degree"] = degree
     return cls(**params)
 
 
@@ -78,6 +88,12 @@ def _sizes(model) -> str:
     default=None,
     callback=count,
     help="Number of dead-zones m+1, mpi [16].",
+)
+@click.option(
+    "--degree",
+    type=click.IntRange(1, MAX_DEGREE),
+    default=None,
+    help="Degree of the Everett polynomial, preisach [3, eq. 5].",
 )
 @click.option(
     "--regularization",
@@ -124,6 +140,7 @@ def identify(
     kind,
     operators,
     deadzones,
+    degree,
     regularization,
     columns,
     sample_rate,
@@ -153,6 +170,7 @@ def identify(
         deadzones=deadzones,
         voltage_range=voltage_range,
         regularization=regularization,
+        degree=degree,
     )
     rec = read_record(data, **read_options(columns, sample_rate))
     n = len(rec)
