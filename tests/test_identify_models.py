@@ -300,5 +300,5 @@ def test_regularization_and_validation_arguments_are_checked():
         choose_regularization(hystcomp.PrandtlIshlinskii(), v, x, v, x)
     with pytest.raises(InvalidParameterError, match=r"'grid'"):
         choose_regularization(hystcomp.ModifiedPrandtlIshlinskii(), v, x, v, x, grid=[])
-    with pytest.raises(InvalidParameterError, match=r"same length"):
+    with pytest.raises(InvalidSignalError, match=r"one sample each per instant"):
         choose_regularization(hystcomp.ModifiedPrandtlIshlinskii(), v, x, v, x[:-1])

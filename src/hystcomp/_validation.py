@@ -176,6 +176,18 @@ def as_signal(value, name: str, *, min_samples: int = 1) -> np.ndarray:
     return np.ascontiguousarray(arr)
 
 
+def as_signal_pair(a, b, names: tuple[str, str], owner: str, *, min_samples: int = 1):
+    """Two signals (see :func:`as_signal`) with one sample each per instant."""
+    a = as_signal(a, names[0], min_samples=min_samples)
+    b = as_signal(b, names[1], min_samples=min_samples)
+    if a.size != b.size:
+        raise InvalidSignalError(
+            f"{owner}: {names[0]!r} and {names[1]!r} must have one sample each per instant. "
+            f"Got {a.size} and {b.size} samples."
+        )
+    return a, b
+
+
 def _real_array(value, *, copy: bool) -> np.ndarray:
     """``value`` as a float64 array; anything but real numbers raises TypeError.
 

@@ -11,8 +11,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from hystcomp._validation import as_signal, check_range, check_real
-from hystcomp.errors import IdentificationError, InvalidParameterError, InvalidSignalError
+from hystcomp._validation import as_signal, as_signal_pair, check_range, check_real
+from hystcomp.errors import IdentificationError, InvalidParameterError
 
 GAIN_METHODS = ("least-squares", "end-point")
 
@@ -37,12 +37,7 @@ def linear_gain(v, x, *, method: str = "least-squares") -> float:
             f"The 'method' parameter of linear_gain must be one of {GAIN_METHODS}. "
             f"Got {method!r} instead."
         )
-    v = as_signal(v, "v", min_samples=2)
-    x = as_signal(x, "x", min_samples=2)
-    if v.size != x.size:
-        raise InvalidSignalError(
-            f"'v' and 'x' must have one sample each per instant. Got {v.size} and {x.size}."
-        )
+    v, x = as_signal_pair(v, x, ("v", "x"), "linear_gain", min_samples=2)
     if method == "least-squares":
         gain = float(v @ x) / float(v @ v) if np.any(v) else 0.0
     else:

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from hystcomp._validation import as_signal, check_int
+from hystcomp._validation import as_signal_pair, check_int
 from hystcomp.errors import InvalidSignalError
 
 #: The paper's "saturation zone": the top quarter of the displacement range.
@@ -22,14 +22,9 @@ SATURATION_ZONE = 0.75
 
 
 def _pair(reference, output, min_samples):
-    ref = as_signal(reference, "reference", min_samples=min_samples)
-    out = as_signal(output, "output", min_samples=min_samples)
-    if ref.size != out.size:
-        raise InvalidSignalError(
-            f"'reference' and 'output' must have one sample each per instant. "
-            f"Got {ref.size} and {out.size} samples."
-        )
-    return ref, out
+    return as_signal_pair(
+        reference, output, ("reference", "output"), "metrics", min_samples=min_samples
+    )
 
 
 def tracking_errors(reference, output) -> tuple[float, float]:

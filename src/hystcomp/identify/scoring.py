@@ -8,8 +8,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from hystcomp._validation import as_signal, check_int
-from hystcomp.errors import IdentificationError, InvalidSignalError
+from hystcomp._validation import as_signal, as_signal_pair, check_int
+from hystcomp.errors import IdentificationError
 
 #: How close (as a fraction of the input span) the input must come to an end of its range.
 END_TOLERANCE = 0.01
@@ -84,7 +84,7 @@ def error_report(x, x_model, start: int = 0) -> dict:
         range (``rms_error_percent``, ``max_error_percent``), ``displacement_range_um``,
         ``n_samples`` (the record), ``n_used`` and ``first_used_sample``.
     """
-    x, x_model = _pair(x, x_model, "x", "x_model", "error_report")
+    x, x_model = as_signal_pair(x, x_model, ("x", "x_model"), "error_report")
     start = check_int(start, "start", "error_report", minimum=0)
     if start >= x.size:
         raise IdentificationError(
@@ -107,17 +107,6 @@ def error_report(x, x_model, start: int = 0) -> dict:
     }
 
 
-def _pair(a, b, name_a: str, name_b: str, owner: str):
-    """Two finite signals of the same length."""
-    a, b = as_signal(a, name_a), as_signal(b, name_b)
-    if a.size != b.size:
-        raise InvalidSignalError(
-            f"{owner}: {name_a!r} and {name_b!r} must have one sample each per instant. "
-            f"Got {a.size} and {b.size}."
-        )
-    return a, b
-
-
 def straight_line(v, x) -> tuple[float, float]:
     """Least-squares line ``x = a v + b`` (a in µm/V, b in µm): the no-hysteresis baseline.
 
@@ -127,7 +116,7 @@ def straight_line(v, x) -> tuple[float, float]:
     >>> round(a, 9), round(b, 9)
     (2.0, 1.0)
     """
-    v, x = _pair(v, x, "v", "x", "straight_line")
+    v, x = as_signal_pair(v, x, ("v", "x"), "straight_line")
     design = np.column_stack([v, np.ones_like(v)])
     (a, b), *_ = np.linalg.lstsq(design, x, rcond=None)
     return float(a), float(b)
@@ -146,7 +135,7 @@ def holdout_report(model, v, x, n_fit: int, start: int = 0) -> dict:
         ``n_holdout``, ``model_rms_um``, ``line_rms_um`` and ``improvement`` (their ratio,
         > 1 when the model predicts better than the line).
     """
-    v, x = _pair(v, x, "v", "x", "holdout_report")
+    v, x = as_signal_pair(v, x, ("v", "x"), "holdout_report")
     n_fit = check_int(n_fit, "n_fit", "holdout_report", minimum=1)
     start = check_int(start, "start", "holdout_report", minimum=0)
     if not start < n_fit < v.size:

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from hystcomp._validation import as_signal, check_real
+from hystcomp._validation import as_signal_pair, check_real
 from hystcomp.errors import InvalidParameterError, InvalidTypeError
 from hystcomp.identify.scoring import transient_end
 
@@ -85,13 +85,7 @@ def choose_regularization(estimator, v, x, v_val, x_val, *, grid=REGULARIZATION_
             f"The 'grid' parameter of {owner} must hold at least one value >= 0. "
             f"Got {list(grid)!r} instead."
         )
-    v_val = as_signal(v_val, "v_val", min_samples=2)
-    x_val = as_signal(x_val, "x_val", min_samples=2)
-    if v_val.size != x_val.size:
-        raise InvalidParameterError(
-            f"'v_val' and 'x_val' of {owner} must have the same length. "
-            f"Got {v_val.size} and {x_val.size}."
-        )
+    v_val, x_val = as_signal_pair(v_val, x_val, ("v_val", "x_val"), owner, min_samples=2)
     start = transient_end(v_val)
     scores, models = {}, {}
     for value in values:

@@ -6,10 +6,12 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from hystcomp._validation import as_vector, check_int, check_range, check_real
+from hystcomp import operators
+from hystcomp._validation import as_vector, check_int, check_range, check_real, check_thresholds
 from hystcomp.errors import InvalidParameterError, NotFittedError
 from hystcomp.identify.pi import check_margin
-from hystcomp.models.compensator import ChainSystem
+from hystcomp.models.compensator import ChainSystem, Compensator
+from hystcomp.models.inversion import inverse_initial_state, invert_superposition
 
 DEFAULT_VOLTAGE_RANGE = (0.0, 120.0)
 
@@ -149,3 +151,39 @@ def check_fit_options(model, owner) -> None:
     if model.transient is not None:
         check_int(model.transient, "transient", owner, minimum=0)
     check_margin(model.margin, owner)
+
+
+def set_plays(model, owner, *, thresholds, weights, initial_state) -> np.ndarray:
+    """Validate and set a PI-type model's plays (``thresholds_``, ``weights_``,
+    ``initial_state_``); returns the thresholds."""
+    r = check_thresholds(thresholds, "thresholds", owner)
+    model.thresholds_ = r
+    model.weights_ = as_vector(weights, "weights", owner, length=r.size)
+    model.initial_state_ = initial_state_or_zero(initial_state, r.size, owner)
+    return r
+
+
+def inverse_play_compensator(
+    model, *, slew_rate, sample_rate, voltage_range, pre=None
+) -> Compensator:
+    """The compensator of a PI-type ``model`` (invertibility already checked).
+
+    The chain ``x -> (x - x_0) -> [pre dead-zones] -> inverse plays (eqs. 24-26) -> + v_0``,
+    slew-limited and clamped to ``voltage_range_`` or a narrower ``voltage_range``.
+    """
+    owner = type(model).__name__
+    max_step = slew_to_step(slew_rate, sample_rate, owner)
+    lo, hi = model._clamp_range(voltage_range, f"{owner}.inverse")
+    packed = operators.pack_chain(
+        pre=pre,
+        plays=(
+            *invert_superposition(model.thresholds_, model.weights_),
+            inverse_initial_state(model.weights_, model.initial_state_),
+        ),
+        in_offset=model.output_offset_,
+        out_offset=model.input_offset_,
+        low=lo,
+        high=hi,
+        max_step=max_step,
+    )
+    return Compensator(packed, kind=model.kind, voltage_range=(lo, hi))

@@ -12,14 +12,13 @@ from hystcomp.models.base import (
     HysteresisModel,
     check_fit_options,
     fit_voltage_range,
-    initial_state_or_zero,
+    inverse_play_compensator,
     set_common_parameters,
-    slew_to_step,
+    set_plays,
 )
 from hystcomp.models.compensator import Compensator
 from hystcomp.models.inversion import (
     check_invertible,
-    inverse_initial_state,
     invert_superposition,
 )
 
@@ -173,12 +172,9 @@ class ModifiedPrandtlIshlinskii(HysteresisModel):
     ) -> ModifiedPrandtlIshlinskii:
         """A model with the given parameters (V, µm/V, µm, unitless); all validated."""
         owner = cls.__name__
-        r = check_thresholds(thresholds, "thresholds", owner)
         rs = check_thresholds(deadzone_thresholds, "deadzone_thresholds", owner)
-        model = cls(n_operators=r.size, n_deadzones=rs.size, voltage_range=None)
-        model.thresholds_ = r
-        model.weights_ = as_vector(weights, "weights", owner, length=r.size)
-        model.initial_state_ = initial_state_or_zero(initial_state, r.size, owner)
+        model = cls(n_operators=np.size(thresholds), n_deadzones=rs.size, voltage_range=None)
+        set_plays(model, owner, thresholds=thresholds, weights=weights, initial_state=initial_state)
         model.deadzone_thresholds_ = rs
         model.deadzone_weights_ = as_vector(
             deadzone_weights, "deadzone_weights", owner, length=rs.size
@@ -217,21 +213,13 @@ class ModifiedPrandtlIshlinskii(HysteresisModel):
         owner = type(self).__name__
         check_invertible(self.weights_, f"The hysteresis operator H of this {owner} model")
         check_invertible(self.deadzone_weights_, f"The saturation operator S of this {owner} model")
-        max_step = slew_to_step(slew_rate, sample_rate, owner)
-        lo, hi = self._clamp_range(voltage_range, f"{owner}.inverse")
-        packed = operators.pack_chain(
+        return inverse_play_compensator(
+            self,
+            slew_rate=slew_rate,
+            sample_rate=sample_rate,
+            voltage_range=voltage_range,
             pre=invert_superposition(self.deadzone_thresholds_, self.deadzone_weights_),
-            plays=(
-                *invert_superposition(self.thresholds_, self.weights_),
-                inverse_initial_state(self.weights_, self.initial_state_),
-            ),
-            in_offset=self.output_offset_,
-            out_offset=self.input_offset_,
-            low=lo,
-            high=hi,
-            max_step=max_step,
         )
-        return Compensator(packed, kind=self.kind, voltage_range=(lo, hi))
 
     @staticmethod
     def forward_deadzones(inverse_thresholds, inverse_weights) -> tuple[np.ndarray, np.ndarray]:

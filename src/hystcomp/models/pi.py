@@ -5,22 +5,20 @@ from __future__ import annotations
 import numpy as np
 
 from hystcomp import operators
-from hystcomp._validation import as_vector, check_int, check_thresholds
+from hystcomp._validation import check_int
 from hystcomp.identify.pi import fit_pi, paper_thresholds
 from hystcomp.identify.scoring import error_report
 from hystcomp.models.base import (
     HysteresisModel,
     check_fit_options,
     fit_voltage_range,
-    initial_state_or_zero,
+    inverse_play_compensator,
     set_common_parameters,
-    slew_to_step,
+    set_plays,
 )
 from hystcomp.models.compensator import Compensator
 from hystcomp.models.inversion import (
     check_invertible,
-    inverse_initial_state,
-    invert_superposition,
 )
 
 __all__ = ["PrandtlIshlinskii", "paper_thresholds"]
@@ -136,11 +134,8 @@ class PrandtlIshlinskii(HysteresisModel):
     ) -> PrandtlIshlinskii:
         """A model with the given parameters (V, µm/V, µm); every value is validated."""
         owner = cls.__name__
-        r = check_thresholds(thresholds, "thresholds", owner)
-        model = cls(n_operators=r.size, voltage_range=None)
-        model.thresholds_ = r
-        model.weights_ = as_vector(weights, "weights", owner, length=r.size)
-        model.initial_state_ = initial_state_or_zero(initial_state, r.size, owner)
+        model = cls(n_operators=np.size(thresholds), voltage_range=None)
+        set_plays(model, owner, thresholds=thresholds, weights=weights, initial_state=initial_state)
         set_common_parameters(
             model,
             owner,
@@ -178,16 +173,6 @@ class PrandtlIshlinskii(HysteresisModel):
         self._check_fitted()
         owner = type(self).__name__
         check_invertible(self.weights_, f"This {owner} model")
-        max_step = slew_to_step(slew_rate, sample_rate, owner)
-        lo, hi = self._clamp_range(voltage_range, f"{owner}.inverse")
-        r_inv, w_inv = invert_superposition(self.thresholds_, self.weights_)
-        z0 = inverse_initial_state(self.weights_, self.initial_state_)
-        packed = operators.pack_chain(
-            plays=(r_inv, w_inv, z0),
-            in_offset=self.output_offset_,
-            out_offset=self.input_offset_,
-            low=lo,
-            high=hi,
-            max_step=max_step,
+        return inverse_play_compensator(
+            self, slew_rate=slew_rate, sample_rate=sample_rate, voltage_range=voltage_range
         )
-        return Compensator(packed, kind=self.kind, voltage_range=(lo, hi))
