@@ -18,9 +18,8 @@ from hystcomp.identify.excitation import triangle_sequence
 from hystcomp.identify.scoring import holdout_report
 from hystcomp.plant import Twin
 
-REAL_RECORD = (
-    Path(__file__).parents[2] / "shared" / "data" / "piezo-micromanipulator" / "Model_Vi_Do.dat"
-)
+# A real record (MIT licence, see the README and LICENSE beside it).
+REAL_RECORD = Path(__file__).parent / "data" / "piezo-micromanipulator" / "Model_Vi_Do.dat"
 
 
 def run(*args):
@@ -93,7 +92,6 @@ def test_identify_simulate_compensate_round_trip(tmp_path, kind, operators, tole
     assert tracking < tolerance * 25.0
 
 
-@pytest.mark.skipif(not REAL_RECORD.exists(), reason=f"real record not found at {REAL_RECORD}")
 @pytest.mark.parametrize("kind", ["pi", "mpi"])
 def test_real_record_in_one_command_beats_a_straight_line(tmp_path, kind):
     out = tmp_path / "model.json"
