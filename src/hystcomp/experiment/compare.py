@@ -126,6 +126,9 @@ class Comparison:
         ``results[frequency][method]`` is a :class:`TrackingResult`.
     datasheet : dict
         ``datasheet[frequency]``: the uncompensated run with the datasheet gain instead.
+    preisach_exact : dict
+        ``preisach_exact[frequency]``: the Preisach model's exact inverse in place of the
+        inverse multiplicative structure (empty if the Preisach model has no exact inverse).
     seconds : float
         Wall-clock time of the run.
     """
@@ -139,6 +142,7 @@ class Comparison:
     reference_amplitude: float
     results: dict[float, dict[str, TrackingResult]]
     datasheet: dict[float, TrackingResult]
+    preisach_exact: dict[float, TrackingResult]
     seconds: float
 
 
@@ -214,10 +218,14 @@ def run_comparison(
     for kind in MODEL_KINDS:
         compensators[kind] = check_compensator(models[kind].inverse(), f"{kind} compensator")
     datasheet_baseline = LinearCompensator(DATASHEET_GAIN, (lo, hi))
+    exact = None
+    if isinstance(models["preisach"], Preisach):
+        exact = check_compensator(models["preisach"].inverse(method="exact"), "exact inverse")
 
     amplitude = config.reference_fraction * float(record_pi.x.max())
     results: dict[float, dict[str, TrackingResult]] = {}
     datasheet: dict[float, TrackingResult] = {}
+    preisach_exact: dict[float, TrackingResult] = {}
     for f in config.frequencies:
         say(f"tracking a {f:g} Hz triangle of 0..{amplitude:.1f} µm with the four methods")
         _, x_ref = triangle_reference(amplitude, f, periods=config.periods, sample_rate=fs)
@@ -227,6 +235,10 @@ def run_comparison(
         datasheet[f] = run_tracking(
             datasheet_baseline, twin, x_ref, frequency=f, method="uncompensated (datasheet gain)"
         )
+        if exact is not None:
+            preisach_exact[f] = run_tracking(
+                exact, twin, x_ref, frequency=f, method="preisach (exact inverse)"
+            )
     return Comparison(
         config=config,
         record_pi=record_pi,
@@ -237,6 +249,7 @@ def run_comparison(
         reference_amplitude=amplitude,
         results=results,
         datasheet=datasheet,
+        preisach_exact=preisach_exact,
         seconds=time.perf_counter() - start,
     )
 
