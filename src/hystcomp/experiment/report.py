@@ -229,7 +229,7 @@ def _setup_lines(c) -> list[str]:
             "Eq. 19 as printed (0) overfits a twin that is not an MPI system: its dead-zone "
             "weights alternate far above 1 and it tracks little better than no compensation."
         ),
-        f"Run time: {c.seconds:.1f} s.",
+        f"Run time of the experiment (identification and tracking): {c.seconds:.1f} s.",
     ]
 
 
