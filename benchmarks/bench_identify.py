@@ -1,7 +1,8 @@
 """Speed of identification: MPI 16+16 and PI 16 on the paper's 80,001-sample signal.
 
 Target: identifying MPI (16 plays, 16 dead-zones) on 80,000 samples in under 50 ms once
-compiled. The reference in the same run is NumPy's least squares on the same regressors
+compiled, for eq. 19 as printed and for the default ``regularization="auto"`` (five
+penalties on shared normal equations, each model scored). The reference in the same run is NumPy's least squares on the same regressors
 (the design matrix already built, no constraints): the constrained fit, which also builds
 its regressors and scores the model, should not be slower than that alone.
 
@@ -52,7 +53,8 @@ def run() -> list[dict]:
     x_mpi = presets.paper_mpi().simulate(v)
     x_pi = presets.paper_pi().simulate(v)
     design, target = _design(v, x_mpi, 16, 16)
-    mpi_ms, pi_ms, lstsq_ms = _best_ms(
+    mpi_ms, auto_ms, pi_ms, lstsq_ms = _best_ms(
+        lambda: ModifiedPrandtlIshlinskii(regularization=0.0).fit(v, x_mpi),
         lambda: ModifiedPrandtlIshlinskii().fit(v, x_mpi),
         lambda: PrandtlIshlinskii().fit(v, x_pi),
         lambda: np.linalg.lstsq(design, target, rcond=None),
@@ -61,11 +63,18 @@ def run() -> list[dict]:
     n = f"{v.size:,} samples"
     return [
         {
-            "name": f"identify MPI 16+16, {n}",
+            "name": f"identify MPI 16+16, eq. 19 as printed, {n}",
             "value": mpi_ms,
             "unit": "ms",
             "target": f"< {TARGET_MS:g} ms",
             "ok": mpi_ms < TARGET_MS,
+        },
+        {
+            "name": f"identify MPI 16+16, regularization auto (5 fits), {n}",
+            "value": auto_ms,
+            "unit": "ms",
+            "target": f"< {TARGET_MS:g} ms",
+            "ok": auto_ms < TARGET_MS,
         },
         {
             "name": f"identify PI 16, {n}",

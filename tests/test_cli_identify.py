@@ -139,7 +139,11 @@ def test_real_record_in_one_command_beats_a_straight_line(tmp_path, kind):
         ),
         (
             ["identify", "rec.csv", "--model", "mpi", "--regularization", "-1", "-o", "m.json"],
-            "must be a number >= 0",
+            "must be 'auto' or a number >= 0; got '-1'",
+        ),
+        (
+            ["identify", "rec.csv", "--model", "mpi", "--regularization", "best", "-o", "m.json"],
+            "must be 'auto' or a number >= 0; got 'best'",
         ),
         (
             ["identify", "rec.csv", "--model", "pi", "--degree", "2", "-o", "m.json"],
@@ -248,3 +252,11 @@ def test_mpi_regularization_reaches_the_fit_and_the_model_file(tmp_path):
     plain, tamed = (hystcomp.load_model(files[k]) for k in ("0", "0.01"))
     assert tamed.get_params()["regularization"] == 0.01
     assert np.abs(tamed.deadzone_weights_).max() < np.abs(plain.deadzone_weights_).max() / 3
+    # by default the value is chosen, printed, and kept in the file with the choice
+    result = run("identify", tmp_path / "rec.csv", "--model", "mpi", "-o", tmp_path / "auto.json")
+    assert result.exit_code == 0, result.output
+    auto = hystcomp.load_model(tmp_path / "auto.json")
+    chosen = auto.fit_report_["regularization"]
+    assert auto.get_params()["regularization"] == "auto"
+    assert f"regularization: {chosen:g} (auto" in result.output
+    assert auto.fit_report_["rms_error_um"] <= plain.fit_report_["rms_error_um"]

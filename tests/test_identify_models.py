@@ -14,7 +14,7 @@ from hystcomp.errors import (
     InvalidTypeError,
 )
 from hystcomp.identify.excitation import PI_AMPLITUDES, scaled_amplitudes, triangle_sequence
-from hystcomp.identify.mpi import absorb_bias, fit_mpi
+from hystcomp.identify.mpi import REGULARIZATION_GRID, absorb_bias, fit_mpi, fit_mpi_path
 from hystcomp.identify.pi import fit_pi
 from hystcomp.identify.scoring import transient_end
 from hystcomp.identify.validation import choose_regularization
@@ -160,8 +160,9 @@ def test_start_up_transient_is_left_out_by_default(kind):
     _, v, x = _mid_start_record(true)
     start = transient_end(v)
     assert 40 < start <= 50  # just before the first maximum of the 1 Hz sine (sample 50)
-    settled = ESTIMATORS[kind]().fit(v, x)
-    naive_fit = ESTIMATORS[kind](transient=0).fit(v, x)
+    as_printed = {"regularization": 0.0} if kind == "mpi" else {}  # the transient's effect alone
+    settled = ESTIMATORS[kind](**as_printed).fit(v, x)
+    naive_fit = ESTIMATORS[kind](transient=0, **as_printed).fit(v, x)
     assert settled.fit_report_["first_used_sample"] == start
     # scored once the sensor has settled (from 2 s on), the default fit is far better
     err_settled = np.abs(settled.simulate(v) - x)[400:].max()
@@ -192,7 +193,7 @@ def test_fit_returns_self_and_keeps_hyperparameters():
         "voltage_range": None,
         "transient": None,
         "margin": 1e-3,
-        "regularization": 0.0,
+        "regularization": "auto",
     }
     assert est.thresholds_.size == 6
     assert est.deadzone_thresholds_.size == 4
@@ -209,8 +210,9 @@ def test_fit_is_fast_enough_for_the_paper_signal_only_by_benchmark():
     # gives the same answer through the class and directly
     _, v = triangle_sequence(sample_rate=1000.0)
     x = presets.paper_mpi().simulate(v)
-    direct = fit_mpi(v, x, n_operators=8, n_deadzones=8)
-    model = hystcomp.ModifiedPrandtlIshlinskii(n_operators=8, n_deadzones=8).fit(v, x)
+    direct = fit_mpi(v, x, n_operators=8, n_deadzones=8, regularization=1e-3)
+    model = hystcomp.ModifiedPrandtlIshlinskii(n_operators=8, n_deadzones=8, regularization=1e-3)
+    model.fit(v, x)
     np.testing.assert_array_equal(model.weights_, direct.weights)
     assert model.input_offset_ == direct.input_offset
 
@@ -276,7 +278,7 @@ def test_regularization_tames_the_mpi_fit_of_an_actuator_outside_the_family():
     x = twin.run(v)
     v_val = 100.0 * (1.0 - np.abs(1.0 - 2.0 * ((np.arange(15_001) / 5000.0) % 1.0)))
     x_val = twin.run(v_val)
-    plain = hystcomp.ModifiedPrandtlIshlinskii().fit(v, x)
+    plain = hystcomp.ModifiedPrandtlIshlinskii(regularization=0.0).fit(v, x)
     tamed = hystcomp.ModifiedPrandtlIshlinskii(regularization=1e-2).fit(v, x)
     assert np.abs(plain.deadzone_weights_).max() > 5.0
     assert np.abs(tamed.deadzone_weights_).max() < 1.5
@@ -291,11 +293,61 @@ def test_regularization_tames_the_mpi_fit_of_an_actuator_outside_the_family():
     assert choice.model.regularization == choice.value
 
 
+def test_fit_path_shares_the_normal_equations_and_gives_each_fit():
+    _, v = triangle_sequence(sample_rate=1000.0)
+    x = Twin(seed=2).run(np.repeat(v, 20))[::20]
+    values = (0.0, 1e-2, 1.0)
+    for value, fit in zip(values, fit_mpi_path(v, x, regularizations=values), strict=True):
+        alone = fit_mpi(v, x, regularization=value)
+        np.testing.assert_array_equal(fit.weights, alone.weights)
+        np.testing.assert_array_equal(fit.inverse_deadzone_weights, alone.inverse_deadzone_weights)
+
+
+def test_auto_regularization_keeps_the_model_that_best_reproduces_the_record():
+    """Off the MPI family (the twin), eq. 19 as printed does not minimise the error of x;
+    "auto" keeps the grid value whose model reproduces the record best, and it predicts
+    another signal better than eq. 19 as printed does."""
+    twin = Twin(seed=3)
+    _, v = triangle_sequence(sample_rate=5000)
+    x = twin.run(np.repeat(v, 4))[::4]
+    auto = hystcomp.ModifiedPrandtlIshlinskii().fit(v, x)
+    chosen = auto.fit_report_["regularization"]
+    errors = {
+        value: hystcomp.ModifiedPrandtlIshlinskii(regularization=value)
+        .fit(v, x)
+        .fit_report_["rms_error_um"]
+        for value in REGULARIZATION_GRID
+    }
+    assert chosen > 0.0
+    assert auto.fit_report_["rms_error_um"] == min(errors.values()) == errors[chosen]
+    assert errors[chosen] < 0.85 * errors[0.0]
+    v_val = 100.0 * (1.0 - np.abs(1.0 - 2.0 * ((np.arange(15_001) / 5000.0) % 1.0)))
+    x_val = twin.run(np.repeat(v_val, 4))[::4]
+    plain = hystcomp.ModifiedPrandtlIshlinskii(regularization=0.0).fit(v, x)
+
+    def predicted(model):
+        return np.sqrt(np.mean((model.simulate(v_val) - x_val)[5000:] ** 2))
+
+    assert predicted(auto) < 0.8 * predicted(plain)
+
+
+def test_auto_regularization_is_eq_19_as_printed_on_an_mpi_system():
+    _, v = triangle_sequence(sample_rate=1000.0)
+    true = presets.paper_mpi()
+    model = hystcomp.ModifiedPrandtlIshlinskii().fit(v, true.simulate(v))
+    assert model.fit_report_["regularization"] == 0.0
+    assert model.fit_report_["rms_error_um"] < 1e-6
+
+
 def test_regularization_and_validation_arguments_are_checked():
     _, v = triangle_sequence(sample_rate=500)
     x = presets.paper_mpi().simulate(v)
     with pytest.raises(InvalidParameterError, match=r"'regularization' .* must be >= 0"):
         hystcomp.ModifiedPrandtlIshlinskii(regularization=-1.0).fit(v, x)
+    with pytest.raises(InvalidParameterError, match=r"must be 'auto' or a number >= 0"):
+        hystcomp.ModifiedPrandtlIshlinskii(regularization="best").fit(v, x)
+    with pytest.raises(InvalidParameterError, match=r"'regularizations' .* at least one"):
+        fit_mpi_path(v, x, regularizations=())
     with pytest.raises(InvalidTypeError, match=r"'regularization' hyperparameter"):
         choose_regularization(hystcomp.PrandtlIshlinskii(), v, x, v, x)
     with pytest.raises(InvalidParameterError, match=r"'grid'"):

@@ -65,6 +65,19 @@ def build_estimator(
     return cls(**params)
 
 
+def _regularization(ctx, param, value):
+    """``--regularization``: ``auto`` or a number >= 0."""
+    if value is None or value == "auto":
+        return value
+    try:
+        number = float(value)
+    except ValueError:
+        number = float("nan")
+    if not number >= 0 or number == float("inf"):
+        raise click.BadParameter(f"must be 'auto' or a number >= 0; got {value!r}.", param=param)
+    return number
+
+
 def _sizes(model) -> str:
     parts = []
     if hasattr(model, "n_operators"):
@@ -97,12 +110,11 @@ def _sizes(model) -> str:
 )
 @click.option(
     "--regularization",
-    type=float,
     default=None,
-    metavar="LAMBDA",
-    callback=nonnegative("unitless"),
-    help="Penalty on the inverse dead-zone weights, mpi [0: eq. 19 as printed]; try 1e-3 to "
-    "1e-1 when a held-out signal is predicted worse than the record is fitted.",
+    metavar="LAMBDA|auto",
+    callback=_regularization,
+    help="Penalty on the inverse dead-zone weights, mpi [auto: the value of 0, 1e-4 .. 1e-1 "
+    "whose model best reproduces the record; 0 is eq. 19 as printed].",
 )
 @columns_option
 @fs_option
@@ -202,6 +214,11 @@ def identify(
     )
     skipped = f" (first {start} left out: start-up transient)" if start else ""
     click.echo(f"  fitted on: samples {start + 1}..{n_fit}{skipped}")
+    if model.get_params().get("regularization") == "auto":
+        chosen = model.fit_report_["regularization"]
+        click.echo(
+            f"  regularization: {chosen:g} (auto: the smallest fit error of 0, 1e-4 .. 1e-1)"
+        )
     click.echo(
         f"  fit error: rms {report['rms_error_um']:.4g} µm "
         f"({report['rms_error_percent']:.3g} % of {report['displacement_range_um']:.4g} µm), "

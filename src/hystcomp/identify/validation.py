@@ -15,10 +15,8 @@ import numpy as np
 
 from hystcomp._validation import as_signal_pair, check_real
 from hystcomp.errors import InvalidParameterError, InvalidTypeError
+from hystcomp.identify.mpi import REGULARIZATION_GRID
 from hystcomp.identify.scoring import transient_end
-
-#: Candidate values of ``regularization``: none, then one per decade.
-REGULARIZATION_GRID = (0.0, 1e-4, 1e-3, 1e-2, 1e-1)
 
 
 @dataclass(frozen=True)

@@ -6,7 +6,8 @@ import numpy as np
 
 from hystcomp import operators
 from hystcomp._validation import as_vector, check_int, check_thresholds
-from hystcomp.identify.mpi import fit_mpi
+from hystcomp.errors import InvalidParameterError
+from hystcomp.identify.mpi import REGULARIZATION_GRID, check_regularization, fit_mpi_path
 from hystcomp.identify.scoring import error_report
 from hystcomp.models.base import (
     HysteresisModel,
@@ -42,10 +43,14 @@ class ModifiedPrandtlIshlinskii(HysteresisModel):
         first reaches an end of its range (:func:`hystcomp.identify.scoring.transient_end`).
     margin : float, default 1e-3
         Invertibility margin of the fit (see :func:`hystcomp.identify.mpi.fit_mpi`).
-    regularization : float, default 0
+    regularization : float or "auto", default "auto"
         Tikhonov penalty on the inverse dead-zone weights; 0 is eq. (19) as printed. A
         deviation from the paper for records of actuators that are not exactly MPI systems
-        (see :mod:`hystcomp.identify.mpi`); choose it on a validation record with
+        (see :mod:`hystcomp.identify.mpi`). ``"auto"`` fits every value of
+        :data:`~hystcomp.identify.mpi.REGULARIZATION_GRID` (0 included) and keeps the model
+        whose *output* best reproduces the record: eq. (19) minimises an equation error
+        inside the model, not the error of ``x``, and on a real actuator the two disagree.
+        With a second record of the actuator, choose it there instead with
         :func:`hystcomp.identify.validation.choose_regularization`.
 
     Attributes
@@ -59,7 +64,8 @@ class ModifiedPrandtlIshlinskii(HysteresisModel):
     voltage_range_, input_offset_, output_offset_
         As in :class:`~hystcomp.models.pi.PrandtlIshlinskii`.
     fit_report_ : dict
-        After :meth:`fit`: errors of the model on the record.
+        After :meth:`fit`: errors of the model on the record, and the ``regularization``
+        it was fitted with (the chosen value if ``"auto"``).
 
     Examples
     --------
@@ -102,7 +108,7 @@ class ModifiedPrandtlIshlinskii(HysteresisModel):
         voltage_range=None,
         transient=None,
         margin=1e-3,
-        regularization=0.0,
+        regularization="auto",
     ):
         self.n_operators = n_operators
         self.n_deadzones = n_deadzones
@@ -132,30 +138,49 @@ class ModifiedPrandtlIshlinskii(HysteresisModel):
         n = check_int(self.n_operators, "n_operators", owner)
         m = check_int(self.n_deadzones, "n_deadzones", owner)
         check_fit_options(self, owner)
-        fit = fit_mpi(
+        penalties = self._penalties(owner)
+        fits = fit_mpi_path(
             v,
             x,
             n_operators=n,
             n_deadzones=m,
             transient=self.transient,
             margin=self.margin,
-            regularization=self.regularization,
+            regularizations=penalties,
         )
-        rs, ws = self.forward_deadzones(
-            fit.inverse_deadzone_thresholds, fit.inverse_deadzone_weights
-        )
-        fitted = self.from_parameters(
-            thresholds=fit.thresholds,
-            weights=fit.weights,
-            initial_state=fit.initial_state,
-            deadzone_thresholds=rs,
-            deadzone_weights=ws,
-            voltage_range=fit_voltage_range(self.voltage_range, v, owner),
-            input_offset=fit.input_offset,
-            output_offset=fit.output_offset,
-        )
-        self._adopt(fitted, error_report(x, fitted.simulate(v), fit.first_sample))
+        voltage_range = fit_voltage_range(self.voltage_range, v, owner)
+        best = None
+        for penalty, fit in zip(penalties, fits, strict=True):
+            rs, ws = self.forward_deadzones(
+                fit.inverse_deadzone_thresholds, fit.inverse_deadzone_weights
+            )
+            candidate = self.from_parameters(
+                thresholds=fit.thresholds,
+                weights=fit.weights,
+                initial_state=fit.initial_state,
+                deadzone_thresholds=rs,
+                deadzone_weights=ws,
+                voltage_range=voltage_range,
+                input_offset=fit.input_offset,
+                output_offset=fit.output_offset,
+            )
+            report = error_report(x, candidate.simulate(v), fit.first_sample)
+            report["regularization"] = penalty
+            if best is None or report["rms_error_um"] < best[1]["rms_error_um"]:
+                best = (candidate, report)
+        self._adopt(*best)
         return self
+
+    def _penalties(self, owner: str) -> tuple[float, ...]:
+        """The regularisation values to fit: the grid for ``"auto"``, else the one given."""
+        if isinstance(self.regularization, str):
+            if self.regularization != "auto":
+                raise InvalidParameterError(
+                    f"The 'regularization' parameter of {owner} must be 'auto' or a number "
+                    f">= 0 (0: eq. 19 as printed). Got {self.regularization!r} instead."
+                )
+            return REGULARIZATION_GRID
+        return (check_regularization(self.regularization, owner),)
 
     @classmethod
     def from_parameters(
