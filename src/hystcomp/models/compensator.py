@@ -45,6 +45,7 @@ class Stepper:
         self._initial = packed
         self._p = packed.copy()
         self._start = int(self.kernels.state_start(packed))
+        self._run = self.kernels.run  # looked up once: a block call is short too
         # an instance attribute hides the method below, which documents it
         self.step = functools.partial(operators.step_function(self.kernels.step), self._p)
 
@@ -68,7 +69,7 @@ class Stepper:
         """Advance over a block of samples and return the outputs (non-finite samples held)."""
         u = np.ascontiguousarray(u, dtype=np.float64).reshape(-1)
         out = np.empty_like(u)
-        self.kernels.run(self._p, u, out)
+        self._run(self._p, u, out)
         return out
 
     def reset(self) -> None:
