@@ -98,7 +98,7 @@ def test_step_is_a_one_sample_run(rng):
     operators.chain_run(packed.copy(), u, batch)
     p = packed.copy()
     steps = [operators.chain_step(p, uk) for uk in u]
-    step = operators.chain_step_function()  # the compiled entry point the Stepper binds
+    step = operators.step_function(operators.chain_step)  # the entry point a Stepper binds
     q = packed.copy()
     bound = [step(q, uk) for uk in u]
     assert np.array_equal(steps, batch)

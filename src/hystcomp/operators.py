@@ -14,7 +14,9 @@ with any stage possibly empty: the PI model (eq. 12) is the plays alone, the MPI
 is *packed* into one float64 array (parameters, then state), so that a streaming step is one
 compiled call on one array. Batch runs and steppers both go through :func:`chain_blocks`
 (a step is a one-sample run), which uses the one play loop (:func:`play_step`) and the one
-dead-zone loop (:func:`deadzone_block`) of the package.
+dead-zone loop (:func:`deadzone_block`) of the package. :func:`step_kernel` and
+:func:`step_function` make such a one-call step for any packed system (the Preisach kernels
+use them too), and :data:`StepKernels` tells a stepper what it needs of one.
 
 Speed: a batch run takes the samples in blocks and the chain stage by stage. The dead-zones
 are stateless, so each is a pass over the block that vectorises over samples; the plays are
@@ -49,12 +51,30 @@ def _inline_kernel(func):
     return numba.njit(cache=True, fastmath=FASTMATH, nogil=True, inline="always")(func)
 
 
-def _step_kernel(func):
-    # One sample per call, so the fixed cost of a call is what counts: keep the GIL
-    # (releasing and taking it back costs more than the sample) and compile without
-    # reference counting (the views of the packed array would otherwise cost an atomic
-    # increment and decrement each, a third of the call). Such a kernel must not allocate.
-    return numba.njit(cache=True, fastmath=FASTMATH, _nrt=False)(func)
+def step_kernel(func=None, *, fastmath=FASTMATH):
+    """Compile ``func(p, u) -> float``, one sample through packed system ``p``, as a step kernel.
+
+    A decorator, bare or with arguments. One sample per call, so the fixed cost of a call is
+    what counts: the kernel keeps the GIL (releasing and taking it back costs more than the
+    sample) and is compiled without reference counting (the packed array and each view of it
+    would otherwise cost an atomic increment and decrement, a third of the chain's call); it
+    must not allocate. ``fastmath`` must be the flags of the batch kernel that the step mirrors, so
+    that the two agree bit for bit. :func:`step_function` gives its fast entry point.
+    """
+    if func is None:
+        return functools.partial(step_kernel, fastmath=fastmath)
+    return numba.njit(cache=True, fastmath=fastmath, _nrt=False)(func)
+
+
+@functools.cache
+def step_function(kernel):
+    """Step kernel ``kernel`` compiled for a float64 array and a float, as a plain ``f(p, u)``.
+
+    It skips numba's dispatch on argument types (a third of the cost of a call) and so
+    trusts its arguments more still: ``p`` must be a writable, C-contiguous float64 array.
+    The first call compiles the kernel or loads it from the on-disk cache.
+    """
+    return kernel.compile((numba.types.float64[::1], numba.types.float64))
 
 
 # Layout of a packed chain: header slots, then parameters, then state.
@@ -243,7 +263,7 @@ def chain_blocks(p, u, out, work):
     state[STATE_NONFINITE] = held
 
 
-@_step_kernel
+@step_kernel
 def chain_step(p, u):
     """One sample through packed chain ``p``; updates the state in ``p`` and returns the output.
 
@@ -257,17 +277,6 @@ def chain_step(p, u):
     return p[s + 1]
 
 
-@functools.cache
-def chain_step_function():
-    """:func:`chain_step` compiled for a float64 array and a float, as a plain ``f(p, u)``.
-
-    It skips numba's dispatch on argument types (a third of the cost of a call) and so
-    trusts its arguments more still: ``p`` must be a writable, C-contiguous float64 array.
-    The first call compiles the kernel or loads it from the on-disk cache.
-    """
-    return chain_step.compile((numba.types.float64[::1], numba.types.float64))
-
-
 @_kernel
 def chain_run(p, u, out):
     """Run every sample of ``u`` through packed chain ``p`` into ``out`` (state kept in ``p``).
@@ -277,6 +286,22 @@ def chain_run(p, u, out):
     """
     work = np.empty(min(BLOCK, u.size)) if p[N_POST] > 0 else out[:0]
     chain_blocks(p, u, out, work)
+
+
+StepKernels = namedtuple("StepKernels", "step run state_start last nonfinite")
+StepKernels.__doc__ = """What a streaming stepper needs to know of a kind of packed system.
+
+``step`` is its :func:`step_kernel`, ``run(p, u, out)`` the batch kernel that the step equals
+bit for bit, ``state_start(p)`` a plain Python function giving the index of the first state
+slot, and ``last`` and ``nonfinite`` the offsets from there of the last output and of the
+count of non-finite inputs. :data:`CHAIN_KERNELS` is that of a packed chain; the Preisach
+kernels have theirs.
+"""
+
+#: The :class:`StepKernels` of a packed chain.
+CHAIN_KERNELS = StepKernels(
+    chain_step, chain_run, chain_state_start.py_func, STATE_LAST, STATE_NONFINITE
+)
 
 
 @_kernel

@@ -39,7 +39,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from hystcomp.operators import FASTMATH
+from hystcomp.operators import FASTMATH, StepKernels, step_kernel
 
 # Modes of a packed system: what a step maps.
 FORWARD, MULTIPLICATIVE, EXACT = 0, 1, 2
@@ -363,9 +363,12 @@ def exact_input(p, target):
     return previous
 
 
-@_kernel
+@step_kernel(fastmath=FASTMATH)  # the flags of _kernel, those of preisach_run that calls it
 def preisach_step(p, u):
     """One sample through packed system ``p``; updates its state and returns the output.
+
+    The streaming step (a :func:`~hystcomp.operators.step_kernel`) and the body of the batch
+    :func:`preisach_run`, so the two agree bit for bit.
 
     FORWARD maps a voltage to ``x_0 + H(v)``; MULTIPLICATIVE is eq. (10),
     ``v[k] = v[k-1] + (x_ref[k] - x[k-1]) / rho``, i.e. ``(x_ref[k] - Gamma(v[k-1])) / rho``
@@ -400,6 +403,12 @@ def preisach_run(p, u, out):
     """Run every sample of ``u`` through packed system ``p`` into ``out`` (state kept in ``p``)."""
     for k in range(u.size):
         out[k] = preisach_step(p, u[k])
+
+
+#: The :class:`~hystcomp.operators.StepKernels` of a packed Preisach system.
+PREISACH_KERNELS = StepKernels(
+    preisach_step, preisach_run, state_start.py_func, ST_LAST, ST_NONFINITE
+)
 
 
 @_kernel

@@ -1,4 +1,7 @@
-"""Systems that run a packed operator chain: batch ``simulate`` and a streaming ``Stepper``.
+"""Batch ``simulate`` of packed operator chains, and the ``Stepper`` of every packed system.
+
+The :class:`Stepper` serves every packed system of the package (play chains here, Preisach
+systems in :mod:`hystcomp.models.preisach`) through the kernels its class names.
 
 A :class:`ChainSystem` is immutable: it holds a packed chain (see :mod:`hystcomp.operators`)
 whose state part is the initial state. ``simulate`` runs a copy, so calling it twice gives
@@ -22,19 +25,29 @@ class Stepper:
     A non-finite input sample holds the last output (the amplifier keeps its voltage) and
     is counted in :attr:`nonfinite_count`; nothing is raised inside a real-time loop.
 
-    For speed, each stepper binds :meth:`step` to the compiled kernel and its own state
+    For speed, each stepper binds :meth:`step` to the compiled step kernel and its own state
     when it is made (no method frame, no dispatch on argument types): a call from Python
-    costs about a quarter of a microsecond, 0.5 % of a 20 kHz period (``python
-    benchmarks/run.py realtime``). A loop that has its samples in blocks can use
-    :meth:`step_block`, faster per sample.
+    costs about a quarter of a microsecond, 0.5 % of a 20 kHz period, for the play chains
+    and for the Preisach model and its multiplicative inverse; the exact Preisach inverse
+    adds its root search per sample (``python benchmarks/run.py realtime`` and ``...
+    preisach``). A loop that has its samples in blocks can use :meth:`step_block`, faster
+    per sample.
+
+    The same class serves every kind of packed system: the class attribute ``kernels``
+    (:class:`~hystcomp.operators.StepKernels`) names its step and batch kernels and where
+    its state lies; it is the play chain's here and the Preisach system's in
+    :class:`~hystcomp.models.preisach.PreisachStepper`.
     """
+
+    kernels = operators.CHAIN_KERNELS
 
     def __init__(self, packed: np.ndarray):
         self._initial = packed
         self._p = packed.copy()
-        self._start = int(operators.chain_state_start.py_func(packed))
+        self._start = int(self.kernels.state_start(packed))
+        self._run = self.kernels.run  # looked up once: a block call is short too
         # an instance attribute hides the method below, which documents it
-        self.step = functools.partial(operators.chain_step_function(), self._p)
+        self.step = functools.partial(operators.step_function(self.kernels.step), self._p)
 
     def step(self, u: float) -> float:
         """Advance one sample and return the output.
@@ -50,13 +63,13 @@ class Stepper:
         float
             The output (V for a compensator, µm for a model).
         """
-        return operators.chain_step(self._p, u)
+        return self.kernels.step(self._p, u)
 
     def step_block(self, u) -> np.ndarray:
         """Advance over a block of samples and return the outputs (non-finite samples held)."""
         u = np.ascontiguousarray(u, dtype=np.float64).reshape(-1)
         out = np.empty_like(u)
-        operators.chain_run(self._p, u, out)
+        self._run(self._p, u, out)
         return out
 
     def reset(self) -> None:
@@ -65,19 +78,19 @@ class Stepper:
 
     def copy(self) -> Stepper:
         """An independent stepper in the same state."""
-        twin = Stepper(self._initial)
+        twin = type(self)(self._initial)
         twin._p[:] = self._p
         return twin
 
     @property
     def nonfinite_count(self) -> int:
         """How many non-finite input samples were held since the last reset."""
-        return int(self._p[self._start + operators.STATE_NONFINITE])
+        return int(self._p[self._start + self.kernels.nonfinite])
 
     @property
     def last_output(self) -> float:
-        """The last output (before the first sample: the clamped rest value, 0 if in range)."""
-        return float(self._p[self._start + operators.STATE_LAST])
+        """The last output (before the first sample: the rest value of the system)."""
+        return float(self._p[self._start + self.kernels.last])
 
 
 class ChainSystem(ABC):

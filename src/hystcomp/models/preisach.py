@@ -22,43 +22,13 @@ INVERSE_METHODS = ("multiplicative", "exact")
 class PreisachStepper(Stepper):
     """Streaming evaluation of a Preisach system, bit for bit equal to its batch run.
 
-    The interface of :class:`~hystcomp.models.compensator.Stepper`; a non-finite input
-    sample holds the last output and is counted in :attr:`nonfinite_count`.
+    A :class:`~hystcomp.models.compensator.Stepper` on the Preisach kernels: the same fast
+    bound :meth:`step`, :meth:`step_block`, :meth:`reset` and :meth:`copy`. A non-finite
+    input sample holds the last output (before the first sample: ``x_0`` for a model,
+    ``v_min`` for a compensator) and is counted in :attr:`nonfinite_count`.
     """
 
-    __slots__ = ()
-
-    def __init__(self, packed: np.ndarray):
-        self._initial = packed
-        self._p = packed.copy()
-        self._start = int(pk.state_start(packed))
-
-    def step(self, u: float) -> float:
-        """Advance one sample and return the output."""
-        return pk.preisach_step(self._p, u)
-
-    def step_block(self, u) -> np.ndarray:
-        """Advance over a block of samples and return the outputs (non-finite samples held)."""
-        u = np.ascontiguousarray(u, dtype=np.float64).reshape(-1)
-        out = np.empty_like(u)
-        pk.preisach_run(self._p, u, out)
-        return out
-
-    def copy(self) -> PreisachStepper:
-        """An independent stepper in the same state."""
-        twin = PreisachStepper(self._initial)
-        twin._p[:] = self._p
-        return twin
-
-    @property
-    def nonfinite_count(self) -> int:
-        """How many non-finite input samples were held since the last reset."""
-        return int(self._p[self._start + pk.ST_NONFINITE])
-
-    @property
-    def last_output(self) -> float:
-        """The last output (before the first sample: ``x_0`` for a model, ``v_min`` else)."""
-        return float(self._p[self._start + pk.ST_LAST])
+    kernels = pk.PREISACH_KERNELS
 
     @property
     def memory_depth(self) -> int:

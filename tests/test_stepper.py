@@ -1,0 +1,134 @@
+"""The one Stepper class, on every kind of packed system: play chains and Preisach systems.
+
+Each stepper binds the compiled step kernel of its kind; these tests hold that fast path to
+the batch run, bit for bit, with non-finite samples held and counted, and check that copies
+and resets are independent.
+"""
+
+import functools
+
+import numpy as np
+import pytest
+
+import hystcomp
+from hystcomp import operators, presets
+from hystcomp import preisach_kernels as pk
+from hystcomp.models.preisach import Preisach, PreisachStepper
+from tests.conftest import random_walk
+
+NON_FINITE = {7: np.nan, 300: np.inf, 301: np.nan, 1500: -np.inf}
+
+
+def _table_model():
+    # a table on a 9 x 9 grid, with a memory of 9 extrema so that the bound acts too
+    poly = presets.paper_preisach()
+    grid = np.linspace(0.0, 120.0, 9)
+    table = poly.everett_function(grid[:, None], grid[None, :])
+    return Preisach.from_parameters(table=table, max_extrema=9, output_offset=-2.0)
+
+
+def _preisach_forward():
+    return Preisach.from_parameters(theta=presets.PAPER_PREISACH_THETA, output_offset=-3.0)
+
+
+SYSTEMS = {
+    # name: (system, signal lower bound, upper bound, random-walk step)
+    "pi compensator": (lambda: presets.paper_pi().inverse(), -2.0, 38.0, 1.5),
+    "mpi compensator, slew limit": (
+        lambda: presets.paper_mpi().inverse(slew_rate=4e4),
+        -2.0,
+        38.0,
+        1.5,
+    ),
+    "preisach forward": (_preisach_forward, -5.0, 125.0, 6.0),
+    "preisach forward, table": (_table_model, -5.0, 125.0, 6.0),
+    "preisach multiplicative": (lambda: presets.paper_preisach().inverse(), -2.0, 38.0, 1.5),
+    "preisach multiplicative, slew limit": (
+        lambda: presets.paper_preisach().inverse(slew_rate=4e4),
+        -2.0,
+        38.0,
+        1.5,
+    ),
+    "preisach exact": (lambda: presets.paper_preisach().inverse(method="exact"), -2.0, 38.0, 1.5),
+}
+
+
+@pytest.fixture(params=list(SYSTEMS))
+def case(request, rng):
+    """A system, a signal with non-finite samples, and the outputs a stepper must give."""
+    make, lo, hi, step = SYSTEMS[request.param]
+    system = make()
+    u = random_walk(rng, 3000, lo, hi, step)
+    for k, value in NON_FINITE.items():
+        u[k] = value
+    finite = np.isfinite(u)
+    # a held sample leaves the state alone: the finite samples are a plain batch run, and
+    # each non-finite one repeats the output before it
+    expected = np.empty_like(u)
+    expected[finite] = system.simulate(u[finite])
+    last_finite = np.maximum.accumulate(np.where(finite, np.arange(u.size), 0))
+    expected = expected[last_finite]
+    return system, u, expected
+
+
+def test_bound_step_equals_the_batch_run_bit_for_bit(case):
+    system, u, expected = case
+    stepper = system.stepper()
+    # the fast path: the compiled entry point of the kind's step kernel, bound to the state
+    assert isinstance(stepper.step, functools.partial)
+    assert stepper.step.func is operators.step_function(stepper.kernels.step)
+    assert np.array_equal([stepper.step(uk) for uk in u], expected)
+    assert stepper.nonfinite_count == len(NON_FINITE)
+    assert stepper.last_output == expected[-1]
+    # the documented method (the kernel through numba's dispatch) and blocks: the same bits
+    other = system.stepper()
+    assert np.array_equal([type(other).step(other, uk) for uk in u], expected)
+    block = system.stepper()
+    assert np.array_equal(np.concatenate([block.step_block(b) for b in np.split(u, 6)]), expected)
+    assert block.nonfinite_count == len(NON_FINITE)
+
+
+def test_copies_and_resets_are_independent(case):
+    system, u, expected = case
+    rest = system.stepper().last_output
+    stepper = system.stepper()
+    stepper.step_block(u[:1000])  # three of the non-finite samples held
+    twin = stepper.copy()
+    assert type(twin) is type(stepper)
+    assert (twin.last_output, twin.nonfinite_count) == (expected[999], 3)
+    # the twin runs on first: the original must not move
+    assert np.array_equal([twin.step(uk) for uk in u[1000:]], expected[1000:])
+    assert (stepper.last_output, stepper.nonfinite_count) == (expected[999], 3)
+    assert np.array_equal([stepper.step(uk) for uk in u[1000:]], expected[1000:])
+    # a reset goes back to the rest state, whatever the copy does
+    twin.reset()
+    assert (twin.last_output, twin.nonfinite_count) == (rest, 0)
+    assert (stepper.last_output, stepper.nonfinite_count) == (expected[-1], len(NON_FINITE))
+    assert np.array_equal([twin.step(uk) for uk in u], expected)
+    stepper.reset()
+    assert np.array_equal(stepper.step_block(u[:500]), expected[:500])
+    assert twin.last_output == expected[-1]
+
+
+@pytest.mark.parametrize(
+    "kernels", [operators.CHAIN_KERNELS, pk.PREISACH_KERNELS], ids=["chain", "preisach"]
+)
+def test_step_kernel_is_compiled_with_the_flags_of_its_batch_kernel(kernels):
+    step, run = kernels.step.targetoptions, kernels.run.targetoptions
+    assert step["fastmath"] == run["fastmath"]
+    assert step["_nrt"] is False  # no reference counting: the fast path's premise
+
+
+def test_every_system_has_the_one_stepper_class():
+    model = presets.paper_preisach()
+    steppers = [
+        presets.paper_pi().inverse().stepper(),
+        presets.paper_mpi().stepper(),
+        model.stepper(),
+        model.inverse().stepper(),
+        model.inverse(method="exact").stepper(),
+    ]
+    assert all(isinstance(s, hystcomp.Stepper) for s in steppers)
+    assert [type(s).kernels for s in steppers[2:]] == [pk.PREISACH_KERNELS] * 3
+    assert all(isinstance(s, PreisachStepper) for s in steppers[2:])
+    assert all(type(s).kernels is operators.CHAIN_KERNELS for s in steppers[:2])
