@@ -243,6 +243,12 @@ def _preisach_model(name, identified):
 
 def _compile_preisach(compensator, folder, prefix="comp", flags=()):
     export_c(compensator, folder, prefix=prefix)
+    return build_preisach(folder, prefix, flags)
+
+
+def build_preisach(folder, prefix, flags=()):
+    """Compile the exported ``folder/prefix.c`` with :data:`PREISACH_DRIVER`; returns
+    ``run(x, reset_at=-1) -> (v, depth, nonfinite_count)``."""
     (folder / "driver.c").write_text(PREISACH_DRIVER.replace("{p}", prefix))
     lib = folder / f"lib{prefix}.so"
     cmd = [CC, *STRICT, *flags, "-shared", "-fPIC", "-o", str(lib), f"{prefix}.c", "driver.c"]
