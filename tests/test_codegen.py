@@ -352,12 +352,17 @@ def _damped_reversals(rng, x_lo, x_hi, n_bursts=40):
 @needs_cc
 @pytest.mark.parametrize("name", ["paper_eq6", "paper_zero_diagonal", "quartic_bipolar", "table"])
 @pytest.mark.parametrize("method", ["multiplicative", "exact"])
-def test_preisach_c_full_memory_behaves_as_python(name, method, identified_preisach, tmp_path, rng):
+@pytest.mark.parametrize("slewing", [False, True])
+def test_preisach_c_full_memory_behaves_as_python(
+    name, method, slewing, identified_preisach, tmp_path, rng
+):
     # a memory of 9 extrema (4 stored pairs) overflows on every burst of nested reversals
     bound = 9
     model = _preisach_model(name, identified_preisach)
+    lo, hi = model.voltage_range_
+    slew_rate = 0.01 * (hi - lo) * 20_000.0 if slewing else None
     bounded = hystcomp.Preisach.from_parameters(**model.parameters(), max_extrema=bound)
-    comp = bounded.inverse(method=method)
+    comp = bounded.inverse(method=method, slew_rate=slew_rate, sample_rate=20_000.0)
     x_lo, x_hi = np.percentile(model.simulate(np.linspace(*model.voltage_range_, 200)), [0, 100])
     x = _damped_reversals(rng, x_lo, x_hi)
     x = np.where(rng.random(x.size) < 1e-3, np.nan, x)
@@ -368,7 +373,7 @@ def test_preisach_c_full_memory_behaves_as_python(name, method, identified_preis
     assert depth_c.max() == depth_py.max() == bound
     assert np.count_nonzero(depth_py == bound) > 100  # full, and wiping out, many times
     # the bound changes the output (else this would not test it): unbounded, it differs
-    unbounded = model.inverse(method=method).stepper().step_block(x)
+    unbounded = model.inverse(method=method, slew_rate=slew_rate).stepper().step_block(x)
     assert np.abs(v_py - unbounded).max() > 1e-6
 
 
