@@ -415,6 +415,8 @@ def test_preisach_c_rounds_as_python_on_held_references(name, method, flags, tmp
     # a reversal, and X(v, v) != 0 (eq. 6 as printed) then steps the output by about 1 V.
     # The C writes X and eq. (10) as the compiled kernel evaluates them, so it decides alike,
     # whatever the compiler contracts. (The exact inverse holds its voltage in that step.)
+    # After a numba upgrade, a failure here means the kernel is compiled in another order:
+    # compare its inspect_asm() with the C of hystcomp/codegen/preisach.py.
     model = hystcomp.presets.paper_preisach() if name == "paper_eq6" else _eq6_table()
     comp = model.inverse(method=method)
     x = _held(rng, _reference(model, rng, n=40_000))
