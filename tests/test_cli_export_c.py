@@ -10,6 +10,9 @@ from click.testing import CliRunner
 
 import hystcomp
 from hystcomp.cli import main
+from hystcomp.data import read_table, write_table
+from tests.conftest import random_walk
+from tests.test_codegen import build_preisach, needs_cc
 
 
 @pytest.fixture
@@ -110,3 +113,54 @@ def test_write_failure_exits_2_and_leaves_the_other_file(model_file, tmp_path):
     assert "hystcomp_compensator.c" in result.output
     assert (tmp_path / "hystcomp_compensator.h").read_text() == "precious"
     assert not [p for p in tmp_path.iterdir() if p.name.endswith(".tmp")]
+
+
+@needs_cc
+@pytest.mark.parametrize("method", [None, "multiplicative", "exact"])
+def test_preisach_model_from_identify_exports_and_runs_as_python(method, tmp_path, rng):
+    """excite -> (eq. 6, zero diagonal, as the rig) -> identify -> export-c -> cc -> step."""
+    rig = hystcomp.presets.paper_preisach(zero_diagonal=True)
+    assert _export_run("excite", "preisach", "-o", tmp_path / "v.csv", "--fs", "500") == 0
+    t, v = (read_table(tmp_path / "v.csv", ("v",))[k] for k in "tv")
+    write_table(tmp_path / "rec.csv", {"t": t, "v": v, "x": rig.simulate(v) - 120.0})
+    model_file = tmp_path / "preisach.json"
+    args = ["identify", tmp_path / "rec.csv", "--model", "preisach", "-o", model_file]
+    assert _export_run(*args) == 0
+    out = tmp_path / "c"
+    options = [] if method is None else ["--method", method]
+    result = _export(model_file, "-o", out, "--prefix", "stage_x", "--slew-rate", "2e5", *options)
+    assert result.exit_code == 0, result.output
+    header = (out / "stage_x.h").read_text()
+    assert ("exact inverse" in header) == (method == "exact")
+    assert f"from {model_file}" in header
+    # the compiled code steps as the model file's compensator does in Python
+    model = hystcomp.load_model(model_file)
+    comp = model.inverse(method=method or "multiplicative", slew_rate=2e5, sample_rate=20_000)
+    x_ref = -120.0 + random_walk(rng, 20_000, -5.0, 45.0, 0.4)
+    x_ref[rng.choice(x_ref.size, 10, replace=False)] = np.nan
+    v_c, _, held = build_preisach(out, "stage_x")(x_ref)
+    stepper = comp.stepper()
+    np.testing.assert_allclose(v_c, stepper.step_block(x_ref), rtol=0, atol=1e-9)
+    assert held == stepper.nonfinite_count == 10
+
+
+def test_method_for_a_pi_model_exits_2_and_writes_nothing(model_file, tmp_path):
+    out = tmp_path / "c"
+    result = _export(model_file, "-o", out, "--method", "exact")
+    assert result.exit_code == 2
+    assert "'--method': applies to Preisach models only" in result.output
+    assert "MPI model" in result.output
+    assert "Drop --method" in result.output
+    assert not out.exists()
+
+
+def test_unknown_method_exits_2(tmp_path):
+    path = tmp_path / "preisach.json"
+    hystcomp.save_model(hystcomp.presets.paper_preisach(), path)
+    result = _export(path, "-o", tmp_path, "--method", "newton")
+    assert result.exit_code == 2
+    assert "'newton' is not one of 'multiplicative', 'exact'" in result.output
+
+
+def _export_run(*args):
+    return CliRunner().invoke(main, [str(a) for a in args]).exit_code

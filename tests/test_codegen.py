@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import ctypes
+import platform
 import re
 import shutil
 import subprocess
@@ -11,8 +12,10 @@ import numpy as np
 import pytest
 
 import hystcomp
+from hystcomp import preisach_kernels as pk
 from hystcomp.codegen import export_c, generate_c
 from hystcomp.errors import InvalidParameterError
+from hystcomp.identify.excitation import sinusoid_sequence
 from tests.conftest import invertible_weights, random_walk
 
 CC = shutil.which("cc")
@@ -190,3 +193,286 @@ def test_output_folder_is_made_only_if_its_parent_exists(tmp_path):
     assert (h.name, c.name) == ("hystcomp_compensator.h", "hystcomp_compensator.c")
     with pytest.raises(InvalidParameterError, match="parent 'missing' must be an existing"):
         export_c(comp, "missing/new")
+
+
+# --- Preisach compensators (eqs. 1-10): the bounded memory, eq. (10) and the exact inverse ---
+
+# Also returns the memory depth (stored extrema, as PreisachStepper.memory_depth) per sample.
+PREISACH_DRIVER = """
+#include "{p}.h"
+
+unsigned long drive(const double *x_ref, double *v, long *depth, long n, long reset_at)
+{
+    {p}_state s;
+    long k;
+    {p}_init(&s);
+    for (k = 0; k < n; k++) {
+        if (k == reset_at) {
+            {p}_reset(&s);
+        }
+        v[k] = {p}_step(&s, x_ref[k]);
+        depth[k] = s.top + 1;
+    }
+    return s.nonfinite_count;
+}
+"""
+
+
+@pytest.fixture(scope="module")
+def identified_preisach():
+    """Preisach models identified from a non-polynomial (tanh) Preisach system: a quartic X
+    on a bipolar amplifier with a sensor offset, and a 25 x 25 table."""
+    _, v = sinusoid_sequence(sample_rate=5_000.0)
+    nodes = np.linspace(0.0, 120.0, 61)
+    a, b = np.meshgrid(nodes, nodes, indexing="ij")
+    table = 0.2 * (a - b) + 9.0 * np.tanh((a - b) / 60.0) ** 2 * (1 + a / 120.0)
+    x = hystcomp.Preisach.from_parameters(table=np.tril(table)).simulate(v)
+    return {
+        "quartic_bipolar": hystcomp.Preisach(degree=4).fit(2.5 * v - 150.0, x - 120.0),
+        "table": hystcomp.Preisach(everett="table").fit(v, x),
+    }
+
+
+def _preisach_model(name, identified):
+    if name == "paper_eq6":  # eq. 6 as printed: X(v, v) != 0
+        return hystcomp.presets.paper_preisach()
+    if name == "paper_zero_diagonal":
+        return hystcomp.presets.paper_preisach(zero_diagonal=True)
+    return identified[name]
+
+
+def _compile_preisach(compensator, folder, prefix="comp", flags=()):
+    export_c(compensator, folder, prefix=prefix)
+    return build_preisach(folder, prefix, flags)
+
+
+def build_preisach(folder, prefix, flags=()):
+    """Compile the exported ``folder/prefix.c`` with :data:`PREISACH_DRIVER`; returns
+    ``run(x, reset_at=-1) -> (v, depth, nonfinite_count)``."""
+    (folder / "driver.c").write_text(PREISACH_DRIVER.replace("{p}", prefix))
+    lib = folder / f"lib{prefix}.so"
+    cmd = [CC, *STRICT, *flags, "-shared", "-fPIC", "-o", str(lib), f"{prefix}.c", "driver.c"]
+    build = subprocess.run([*cmd, "-lm"], cwd=folder, capture_output=True, text=True, check=False)
+    assert build.returncode == 0, build.stderr
+    drive = ctypes.CDLL(str(lib)).drive
+    drive.restype = ctypes.c_ulong
+    drive.argtypes = [ctypes.c_void_p] * 3 + [ctypes.c_long, ctypes.c_long]
+
+    def run(x, reset_at=-1):
+        x = np.ascontiguousarray(x, dtype=np.float64)
+        v = np.empty_like(x)
+        depth = np.empty(x.size, dtype=np.int64)
+        held = drive(x.ctypes.data, v.ctypes.data, depth.ctypes.data, x.size, reset_at)
+        return v, depth, held
+
+    return run
+
+
+def _run_python(compensator, x):
+    """The Python stepper, one sample at a time, with its memory depth after each."""
+    stepper = compensator.stepper()
+    v = np.empty_like(x)
+    depth = np.empty(x.size, dtype=np.int64)
+    for k, x_k in enumerate(x):
+        v[k] = stepper.step(x_k)
+        depth[k] = stepper.memory_depth
+    return v, depth, stepper.nonfinite_count
+
+
+def _held(rng, x, fraction=0.3):
+    """``x`` with stretches of up to 200 samples held constant: there eq. (10) settles and
+    rounding decides the memory's reversals."""
+    x = x.copy()
+    k = 0
+    while k < x.size:
+        run = int(rng.integers(1, 200))
+        if rng.random() < fraction and np.isfinite(x[k]):
+            x[k : k + run] = x[k]
+        k += run
+    return x
+
+
+@needs_cc
+@pytest.mark.parametrize("name", ["paper_eq6", "paper_zero_diagonal", "quartic_bipolar", "table"])
+@pytest.mark.parametrize("method", ["multiplicative", "exact"])
+@pytest.mark.parametrize("slewing", [False, True])
+def test_preisach_c_matches_python_sample_for_sample(
+    name, method, slewing, identified_preisach, tmp_path, rng
+):
+    model = _preisach_model(name, identified_preisach)
+    lo, hi = model.voltage_range_
+    slew_rate = 0.01 * (hi - lo) * 20_000.0 if slewing else None
+    comp = model.inverse(method=method, slew_rate=slew_rate, sample_rate=20_000.0)
+    x = _reference(model, rng, n=40_000)  # nested reversals, beyond the range, NaN, inf
+    v_c, depth_c, held = _compile_preisach(comp, tmp_path)(x)
+    v_py, depth_py, held_py = _run_python(comp, x)
+    np.testing.assert_allclose(v_c, v_py, rtol=0, atol=1e-9)
+    assert held == held_py == np.count_nonzero(~np.isfinite(x)) == 14
+    assert v_c.min() == lo  # the clamp is exercised (also by the huge finite samples)
+    assert v_c.max() == hi
+    assert depth_c.max() == depth_py.max() >= 7  # nested reversals were stored
+    if slewing:
+        assert np.abs(np.diff(v_c)).max() <= comp.max_step * (1 + 1e-12)
+        assert np.isclose(np.abs(np.diff(v_c)).max(), comp.max_step)
+
+
+@needs_cc
+@pytest.mark.parametrize("method", ["multiplicative", "exact"])
+def test_preisach_c_reset_returns_to_the_initial_state(method, tmp_path, rng):
+    model = hystcomp.presets.paper_preisach()
+    comp = model.inverse(method=method)
+    x = _reference(model, rng, n=6000)
+    v_c, depth_c, held = _compile_preisach(comp, tmp_path)(x, reset_at=3500)
+    stepper = comp.stepper()
+    first = stepper.step_block(x[:3500])
+    stepper.reset()
+    second = stepper.step_block(x[3500:])
+    np.testing.assert_allclose(v_c, np.concatenate([first, second]), rtol=0, atol=1e-9)
+    assert held == stepper.nonfinite_count  # counted since the reset only
+    assert depth_c[3500] <= 2  # the memory restarted from beta_0 = v_min
+
+
+def _damped_reversals(rng, x_lo, x_hi, n_bursts=40):
+    """Bursts of reversals of shrinking amplitude about random centres in the reachable
+    range ``x_lo .. x_hi`` (each minor loop nested in the previous one), between stretches
+    of random walk that also leave the range. No reachable sample repeats the one before it
+    (a held reference is another test: there the exact inverse's root finder, which the C
+    follows only within its tolerance, may store a different tiny loop, and a full memory
+    then wipes out a different pair)."""
+    span = x_hi - x_lo
+    parts = []
+    for _ in range(n_bursts):
+        centre = rng.uniform(x_lo + 0.3 * span, x_hi - 0.3 * span)
+        turns = centre + 0.3 * span * 0.85 ** np.arange(30) * (-1.0) ** np.arange(30)
+        parts.append(np.interp(np.arange(29 * 8 + 1) / 8.0, np.arange(30), turns))
+        parts.append(random_walk(rng, 300, x_lo - 0.3 * span, x_hi + 0.3 * span, span / 50))
+    return np.concatenate(parts)
+
+
+@needs_cc
+@pytest.mark.parametrize("name", ["paper_eq6", "paper_zero_diagonal", "quartic_bipolar", "table"])
+@pytest.mark.parametrize("method", ["multiplicative", "exact"])
+@pytest.mark.parametrize("slewing", [False, True])
+def test_preisach_c_full_memory_behaves_as_python(
+    name, method, slewing, identified_preisach, tmp_path, rng
+):
+    # a memory of 9 extrema (4 stored pairs) overflows on every burst of nested reversals
+    bound = 9
+    model = _preisach_model(name, identified_preisach)
+    lo, hi = model.voltage_range_
+    slew_rate = 0.01 * (hi - lo) * 20_000.0 if slewing else None
+    bounded = hystcomp.Preisach.from_parameters(**model.parameters(), max_extrema=bound)
+    comp = bounded.inverse(method=method, slew_rate=slew_rate, sample_rate=20_000.0)
+    x_lo, x_hi = np.percentile(model.simulate(np.linspace(*model.voltage_range_, 200)), [0, 100])
+    x = _damped_reversals(rng, x_lo, x_hi)
+    x = np.where(rng.random(x.size) < 1e-3, np.nan, x)
+    v_c, depth_c, held = _compile_preisach(comp, tmp_path)(x)
+    v_py, depth_py, held_py = _run_python(comp, x)
+    np.testing.assert_allclose(v_c, v_py, rtol=0, atol=1e-9)
+    assert held == held_py > 0
+    assert depth_c.max() == depth_py.max() == bound
+    assert np.count_nonzero(depth_py == bound) > 100  # full, and wiping out, many times
+    # the bound changes the output (else this would not test it): unbounded, it differs
+    unbounded = model.inverse(method=method, slew_rate=slew_rate).stepper().step_block(x)
+    assert np.abs(v_py - unbounded).max() > 1e-6
+
+
+def _numba_fuses_multiply_adds() -> bool:
+    """Whether numba compiles the kernels for a processor with fused multiply-adds, which
+    the generated C mirrors with fma() (x86-64 since 2013, every 64-bit ARM)."""
+    if platform.machine().lower() in ("aarch64", "arm64"):
+        return True
+    try:
+        import llvmlite.binding as llvm
+
+        return bool(llvm.get_host_cpu_features().get("fma", False))
+    except (ImportError, RuntimeError):  # pragma: no cover - unknown host
+        return False
+
+
+def _eq6_table():
+    """Eq. 6 sampled on a 25 x 25 grid: a table whose diagonal X(v, v) is not 0."""
+    nodes = np.linspace(0.0, 120.0, 25)
+    table = hystcomp.presets.paper_preisach().everett_function(nodes[:, None], nodes[None, :])
+    return hystcomp.Preisach.from_parameters(table=table)
+
+
+# -ffp-contract=fast lets the compiler fuse any a * b + c it likes (the default of GCC's GNU
+# modes); -march=native gives it the instructions to do so on x86-64.
+CONTRACTING = ("-ffp-contract=fast", *(["-march=native"] if platform.machine() == "x86_64" else []))
+
+
+@needs_cc
+@pytest.mark.skipif(
+    not _numba_fuses_multiply_adds(),
+    reason="numba does not fuse multiply-adds on this processor, the C's fma() does",
+)
+@pytest.mark.parametrize("name", ["paper_eq6", "eq6_table"])
+@pytest.mark.parametrize("method", ["multiplicative", "exact"])
+@pytest.mark.parametrize("flags", [(), CONTRACTING], ids=["iso", "contracting"])
+def test_preisach_c_rounds_as_python_on_held_references(name, method, flags, tmp_path, rng):
+    # Where eq. (10) settles on a held reference, the sign of a last-bit change of v decides
+    # a reversal, and X(v, v) != 0 (eq. 6 as printed) then steps the output by about 1 V.
+    # The C writes X and eq. (10) as the compiled kernel evaluates them, so it decides alike,
+    # whatever the compiler contracts. (The exact inverse holds its voltage in that step.)
+    # After a numba upgrade, a failure here means the kernel is compiled in another order:
+    # compare its inspect_asm() with the C of hystcomp/codegen/preisach.py.
+    model = hystcomp.presets.paper_preisach() if name == "paper_eq6" else _eq6_table()
+    comp = model.inverse(method=method)
+    x = _held(rng, _reference(model, rng, n=40_000))
+    v_c, depth_c, held = _compile_preisach(comp, tmp_path, flags=flags)(x)
+    v_py, depth_py, held_py = _run_python(comp, x)
+    np.testing.assert_allclose(v_c, v_py, rtol=0, atol=1e-9)
+    assert held == held_py
+    if method == "multiplicative":
+        np.testing.assert_array_equal(depth_c, depth_py)  # the same decisions, every sample
+
+
+@needs_cc
+def test_preisach_source_is_freestanding_c99(tmp_path):
+    comp = _eq6_table().inverse(method="exact", slew_rate=1e5)
+    header, source = export_c(comp, tmp_path, prefix="stage_x")
+    text = source.read_text()
+    assert re.findall(r"#include\s*(\S+)", text) == ['"stage_x.h"', "<math.h>"]
+    for word in ("malloc", "calloc", "free(", "printf", "float "):
+        assert word not in text
+    # file-scope statics are constant tables or functions: no mutable global state
+    statics = re.findall(r"^static (.*)$", text, flags=re.MULTILINE)
+    assert statics
+    assert all(s.startswith("const double ") or "(" in s for s in statics), statics
+    assert "double e[1024];" in header.read_text()  # the bound of the memory, in the state
+    cmd = [CC, *STRICT, "-c", "stage_x.c", "-o", "stage_x.o"]
+    build = subprocess.run(cmd, cwd=tmp_path, capture_output=True, text=True, check=False)
+    assert build.returncode == 0, build.stderr
+
+
+@pytest.mark.parametrize("degree", [1, 2, 3, 5])
+def test_preisach_coefficients_are_baked_in_with_full_precision(degree, rng):
+    powers = np.array([i + j for i, j in pk.monomial_exponents(degree)])
+    theta = rng.normal(size=powers.size) / 100.0**powers  # X of tens of um on 0..120 V
+    model = hystcomp.Preisach.from_parameters(
+        theta=theta, voltage_range=(-20.0, 100.0), output_offset=-3.5, max_extrema=64
+    )
+    header, source = generate_c(model.inverse(rho=0.25, slew_rate=2e4), prefix="ax")
+    n = degree + 1
+    table = re.search(rf"ax_everett_coef\[{n * n}\] = \{{([^}}]*)\}}", source).group(1)
+    values = np.array([float(v) for v in table.replace("\n", " ").split(",")])
+    expected = pk.coefficient_matrix(model.theta_, degree).ravel()
+    assert np.array_equal(values, expected)  # 17 significant digits read back exactly
+    assert "/ 0.25;" in source  # rho of eq. 10
+    assert "(s->h - 3.5)" in source  # x[k-1] = H + x_0
+    assert "v = s->last + 1.0;" in source  # 2e4 V/s at 20 kHz
+    assert "if (v < -20.0)" in source
+    assert f"Everett polynomial of degree {degree}" in header
+    assert "rho 0.25 um/V" in header
+    assert "double e[64];" in header
+
+
+def test_preisach_exact_inverse_is_named_in_the_header():
+    model = hystcomp.presets.paper_preisach()
+    header, source = generate_c(model.inverse(method="exact"))
+    assert "exact inverse" in header
+    assert "_exact_input(s, x_ref)" in source
+    header, source = generate_c(model.inverse())
+    assert "inverse multiplicative structure (paper eqs. 7-10)" in header
+    assert "_exact_input" not in source

@@ -9,6 +9,7 @@ import click
 from hystcomp.cli import main
 from hystcomp.codegen import DEFAULT_PREFIX, export_c
 from hystcomp.io import load_model
+from hystcomp.models.preisach import INVERSE_METHODS
 
 
 @main.command("export-c")
@@ -43,7 +44,14 @@ from hystcomp.io import load_model
     metavar="HZ",
     help="Sample rate at which NAME_step is called; sets the slew step per sample.",
 )
-def export_c_command(model_file, directory, prefix, slew_rate, sample_rate):
+@click.option(
+    "--method",
+    type=click.Choice(INVERSE_METHODS),
+    default=None,
+    help="Preisach models only: the inverse multiplicative structure (eq. 10) or the exact "
+    "inverse [multiplicative].",
+)
+def export_c_command(model_file, directory, prefix, slew_rate, sample_rate, method):
     """Write MODEL_FILE's compensator as C99 code: NAME.h and NAME.c in folder -o.
 
     The code has the identified parameters baked in, clamps its output to the model's
@@ -55,7 +63,16 @@ def export_c_command(model_file, directory, prefix, slew_rate, sample_rate):
       double NAME_step(NAME_state *s, double x_ref);   /* um in, V out */
     """
     model = load_model(model_file)
-    compensator = model.inverse(slew_rate=slew_rate, sample_rate=sample_rate)
+    options = {"slew_rate": slew_rate, "sample_rate": sample_rate}
+    if method is not None:
+        if model.kind != "preisach":
+            raise click.BadParameter(
+                f"applies to Preisach models only; {model_file} holds a {model.kind.upper()} model, "
+                "whose inverse is analytic (eqs. 23-26). Drop --method.",
+                param_hint="'--method'",
+            )
+        options["method"] = method
+    compensator = model.inverse(**options)
     header, source = export_c(
         compensator, directory, prefix=prefix, source=str(model_file), sample_rate=sample_rate
     )

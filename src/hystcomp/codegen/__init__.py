@@ -8,7 +8,8 @@ True
 
 A template per kind of compensator (:data:`TEMPLATES`) describes its state, tables and step
 (:class:`~hystcomp.codegen.c99.CTemplate`); :func:`~hystcomp.codegen.c99.render` writes
-the same files for all of them. PI and MPI compensators share the chain template.
+the same files for all of them. PI and MPI compensators share the chain template; the
+Preisach compensators (both methods of ``Preisach.inverse``) have their own.
 """
 
 from __future__ import annotations
@@ -19,6 +20,7 @@ from pathlib import Path
 
 from hystcomp.codegen.c99 import CTemplate, check_prefix, render
 from hystcomp.codegen.chain import chain_template
+from hystcomp.codegen.preisach import preisach_template
 from hystcomp.errors import InvalidParameterError, InvalidTypeError
 from hystcomp.io import atomic_paths
 
@@ -28,6 +30,7 @@ DEFAULT_PREFIX = "hystcomp_compensator"
 TEMPLATES: dict[str, Callable[..., CTemplate]] = {
     "pi": chain_template,
     "mpi": chain_template,
+    "preisach": preisach_template,
 }
 
 __all__ = ["DEFAULT_PREFIX", "TEMPLATES", "CTemplate", "check_prefix", "export_c", "generate_c"]
@@ -80,7 +83,8 @@ def export_c(
     Parameters
     ----------
     compensator : Compensator
-        From ``model.inverse(...)`` of a PI or MPI model.
+        From ``model.inverse(...)`` of a PI, MPI or Preisach model (for Preisach, either
+        method: the inverse multiplicative structure of eq. 10 or the exact inverse).
     directory : path
         Output folder; created if its parent exists.
     prefix : str, default "hystcomp_compensator"

@@ -1,8 +1,9 @@
 """The C99 file pair that every compensator template fills in.
 
-A template (see :mod:`hystcomp.codegen.chain`) describes one compensator as a
-:class:`CTemplate`: the fields of its state, its constant tables, the body of ``reset`` and
-the body of ``step``. :func:`render` wraps them in the same files for every template::
+A template (see :mod:`hystcomp.codegen.chain` and :mod:`hystcomp.codegen.preisach`)
+describes one compensator as a :class:`CTemplate`: the fields of its state, its constant
+tables, helper functions, the body of ``reset`` and the body of ``step``. :func:`render`
+wraps them in the same files for every template::
 
     NAME.h   the state struct NAME_state and the three functions
     NAME.c   the constant tables and the functions
@@ -11,9 +12,10 @@ the body of ``step``. :func:`render` wraps them in the same files for every temp
     void   NAME_reset(NAME_state *s);              back to the initial state
     double NAME_step(NAME_state *s, double x_ref); one sample: reference (um) -> voltage (V)
 
-The generated code is C99 with nothing beyond ``<math.h>`` (only its ``isfinite``), no
-allocation, no global state, and its numbers written with 17 significant digits so that a
-double holds exactly the value the Python compensator uses.
+The generated code is C99 with nothing beyond ``<math.h>`` (its ``isfinite``, and ``fma``
+where a template mirrors the fused multiply-adds of a compiled kernel), no allocation, no
+global state, and its numbers written with 17 significant digits so that a double holds
+exactly the value the Python compensator uses.
 """
 
 from __future__ import annotations
@@ -41,6 +43,13 @@ class CTemplate:
     part then applies the slew-rate limit (``max_step`` V per sample, if finite) and the
     clamp to ``[low, high]`` V, and ``after_body`` runs last, with the final ``v`` (for
     state that follows the applied voltage).
+
+    ``functions`` are C function definitions (``static``, named ``{p}_...``) placed after
+    the tables and before ``NAME_reset``, for helpers that the bodies call. If
+    ``hold_on_overflow`` (the default), a non-finite ``v`` from a finite ``x_ref`` holds
+    the last output, as the play chain does; a template whose Python kernel instead takes
+    ``v = +-inf`` through the slew-rate limit and the clamp (to the range ends) sets it to
+    False, and its ``step_body`` must then never assign NaN.
     """
 
     kind: str
@@ -55,6 +64,8 @@ class CTemplate:
     reset_body: list[str] = field(default_factory=list)
     step_body: list[str] = field(default_factory=list)
     after_body: list[str] = field(default_factory=list)
+    functions: list[str] = field(default_factory=list)
+    hold_on_overflow: bool = True
 
 
 def check_prefix(prefix: str) -> str:
@@ -159,6 +170,7 @@ def render(
             "#include <math.h>",
             "",
             *(f"{t}\n" for t in template.tables),
+            *(f"{f}\n" for f in template.functions),
             f"void {p}_reset({p}_state *s)",
             "{",
             *(f"    {line}" for line in template.reset_body),
@@ -181,10 +193,7 @@ def render(
             "        return s->last;",
             "    }",
             *(f"    {line}" if line else "" for line in template.step_body),
-            "    if (!isfinite(v)) { /* overflow on a huge finite x_ref: hold the output */",
-            "        s->nonfinite_count++;",
-            "        return s->last;",
-            "    }",
+            *(_overflow_hold() if template.hold_on_overflow else []),
             *(f"    {line}" if line else "" for line in _limits(template)),
             *(f"    {line}" if line else "" for line in template.after_body),
             "    s->last = v;",
@@ -194,6 +203,15 @@ def render(
         ]
     )
     return header.replace("{p}", p), source_text.replace("{p}", p)
+
+
+def _overflow_hold() -> list[str]:
+    return [
+        "    if (!isfinite(v)) { /* overflow on a huge finite x_ref: hold the output */",
+        "        s->nonfinite_count++;",
+        "        return s->last;",
+        "    }",
+    ]
 
 
 def _limits(template: CTemplate) -> list[str]:
