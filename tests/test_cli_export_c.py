@@ -149,7 +149,7 @@ def test_method_for_a_pi_model_exits_2_and_writes_nothing(model_file, tmp_path):
     result = _export(model_file, "-o", out, "--method", "exact")
     assert result.exit_code == 2
     assert "'--method': applies to Preisach models only" in result.output
-    assert "MPI model" in result.output
+    assert "is MPI, whose inverse is analytic" in result.output
     assert "Drop --method" in result.output
     assert not out.exists()
 

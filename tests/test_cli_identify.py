@@ -203,6 +203,24 @@ def test_preisach_through_every_command(tmp_path):
     assert run(*args, "--voltage-range", 20, 60).exit_code == 0
     v3 = read_table(tmp_path / "v2.csv", ("v",))["v"]
     assert (v3.min(), v3.max()) == (20.0, 60.0)
+    # the exact inverse: no one-sample lag, so it tracks the model more closely than eq. 10
+    assert run(*args, "--method", "exact").exit_code == 0
+    v4 = read_table(tmp_path / "v2.csv", ("v",))["v"]
+    np.testing.assert_array_equal(v4, model.inverse(method="exact").simulate(x_ref))
+    assert np.abs(model.simulate(v4) - x_ref)[1000:].max() < 1e-6
+
+
+def test_compensate_method_is_for_preisach_models_only(tmp_path):
+    hystcomp.save_model(presets.paper_mpi(), tmp_path / "m.json")
+    write_table(tmp_path / "ref.csv", {"t": np.arange(10) / 100.0, "x": np.linspace(1, 9, 10)})
+    out = tmp_path / "v.csv"
+    out.write_text("precious")
+    args = ["compensate", tmp_path / "m.json", tmp_path / "ref.csv", "-o", out]
+    result = run(*args, "--method", "exact")
+    assert result.exit_code == 2
+    assert "'--method': applies to Preisach models only" in result.output
+    assert "m.json is MPI, whose inverse is analytic" in result.output
+    assert out.read_text() == "precious"
 
 
 def test_failed_identify_keeps_the_existing_model_file(tmp_path):

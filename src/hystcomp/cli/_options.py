@@ -14,6 +14,7 @@ from hystcomp._validation import MAX_MAGNITUDE
 from hystcomp.data import check_writable, parse_columns
 from hystcomp.errors import InvalidParameterError
 from hystcomp.io import check_output_path
+from hystcomp.models.preisach import INVERSE_METHODS
 
 #: Largest --operators / --deadzones (the paper uses 16; the fit's cost grows as n^2 per sample).
 MAX_OPERATORS = 1000
@@ -132,3 +133,25 @@ def check_data_output(path, *, inputs=(), what: str = "output"):
     """Refuse, before any work, a data output that cannot be written or would overwrite an input."""
     check_output_path(path, inputs=inputs, what=what)
     return check_writable(path)
+
+
+method_option = click.option(
+    "--method",
+    type=click.Choice(INVERSE_METHODS),
+    default=None,
+    help="Preisach models only: the inverse multiplicative structure (eq. 10) or the exact "
+    "inverse [multiplicative].",
+)
+
+
+def method_options(model, model_file, method) -> dict:
+    """``model.inverse``'s ``method`` for ``--method``, refused for a model without one."""
+    if method is None:
+        return {}
+    if model.kind != "preisach":
+        raise click.BadParameter(
+            f"applies to Preisach models only; the model in {model_file} is "
+            f"{model.kind.upper()}, whose inverse is analytic (eqs. 23-26). Drop --method.",
+            param_hint="'--method'",
+        )
+    return {"method": method}

@@ -10,6 +10,8 @@ from hystcomp.cli._options import (
     check_data_output,
     columns_option,
     fs_option,
+    method_option,
+    method_options,
     output_option,
     positive,
     read_options,
@@ -68,17 +70,22 @@ def inverse_options(model, table, *, slew_rate, narrow_range) -> dict:
     help="Clamp the output to this range in V, inside the model's range (it may only "
     "narrow it) [the model's range].",
 )
-def compensate(model_file, reference_file, output, columns, sample_rate, slew_rate, narrow_range):
+@method_option
+def compensate(
+    model_file, reference_file, output, columns, sample_rate, slew_rate, narrow_range, method
+):
     """Voltage that makes the actuator of MODEL.json follow REFERENCE (columns t, x).
 
-    Uses the model's inverse (eqs. 23-26 for PI/MPI), clamped to the model's voltage range
-    (or a narrower --voltage-range). Writes t (s), v (V) and x_ref (µm).
+    Uses the model's inverse (eqs. 23-26 for PI/MPI; for Preisach eq. 10 or, with
+    --method exact, the exact inverse), clamped to the model's voltage range (or a narrower
+    --voltage-range). Writes t (s), v (V) and x_ref (µm).
     """
     check_data_output(output, inputs=(model_file, reference_file), what="voltage file")
     model = load_model(model_file)
+    chosen = method_options(model, model_file, method)
     table = read_table(reference_file, ("x",), **read_options(columns, sample_rate))
     options = inverse_options(model, table, slew_rate=slew_rate, narrow_range=narrow_range)
-    compensator = model.inverse(**options)
+    compensator = model.inverse(**options, **chosen)
     v = compensator.simulate(table["x"])
     write_table(output, {"t": table["t"], "v": v, "x_ref": table["x"]})
     lo, hi = compensator.voltage_range

@@ -7,9 +7,9 @@ from pathlib import Path
 import click
 
 from hystcomp.cli import main
+from hystcomp.cli._options import method_option, method_options
 from hystcomp.codegen import DEFAULT_PREFIX, export_c
 from hystcomp.io import load_model
-from hystcomp.models.preisach import INVERSE_METHODS
 
 
 @main.command("export-c")
@@ -44,13 +44,7 @@ from hystcomp.models.preisach import INVERSE_METHODS
     metavar="HZ",
     help="Sample rate at which NAME_step is called; sets the slew step per sample.",
 )
-@click.option(
-    "--method",
-    type=click.Choice(INVERSE_METHODS),
-    default=None,
-    help="Preisach models only: the inverse multiplicative structure (eq. 10) or the exact "
-    "inverse [multiplicative].",
-)
+@method_option
 def export_c_command(model_file, directory, prefix, slew_rate, sample_rate, method):
     """Write MODEL_FILE's compensator as C99 code: NAME.h and NAME.c in folder -o.
 
@@ -64,15 +58,7 @@ def export_c_command(model_file, directory, prefix, slew_rate, sample_rate, meth
     """
     model = load_model(model_file)
     options = {"slew_rate": slew_rate, "sample_rate": sample_rate}
-    if method is not None:
-        if model.kind != "preisach":
-            raise click.BadParameter(
-                f"applies to Preisach models only; {model_file} holds a {model.kind.upper()} model, "
-                "whose inverse is analytic (eqs. 23-26). Drop --method.",
-                param_hint="'--method'",
-            )
-        options["method"] = method
-    compensator = model.inverse(**options)
+    compensator = model.inverse(**options, **method_options(model, model_file, method))
     header, source = export_c(
         compensator, directory, prefix=prefix, source=str(model_file), sample_rate=sample_rate
     )
