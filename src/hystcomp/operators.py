@@ -51,19 +51,18 @@ def _inline_kernel(func):
     return numba.njit(cache=True, fastmath=FASTMATH, nogil=True, inline="always")(func)
 
 
-def step_kernel(func=None, *, fastmath=FASTMATH):
+def step_kernel(func):
     """Compile ``func(p, u) -> float``, one sample through packed system ``p``, as a step kernel.
 
-    A decorator, bare or with arguments. One sample per call, so the fixed cost of a call is
-    what counts: the kernel keeps the GIL (releasing and taking it back costs more than the
-    sample) and is compiled without reference counting (the packed array and each view of it
-    would otherwise cost an atomic increment and decrement, a third of the chain's call); it
-    must not allocate. ``fastmath`` must be the flags of the batch kernel that the step mirrors, so
-    that the two agree bit for bit. :func:`step_function` gives its fast entry point.
+    One sample per call, so the fixed cost of a call is what counts: the kernel keeps the GIL
+    (releasing and taking it back costs more than the sample) and is compiled without
+    reference counting (the packed array and each view of it would otherwise cost an atomic
+    increment and decrement, a third of the chain's call); it must not allocate. Its
+    fastmath flags are those of every batch kernel of the package (:data:`FASTMATH`), so
+    that a step and the batch run it mirrors agree bit for bit. :func:`step_function` gives
+    its fast entry point.
     """
-    if func is None:
-        return functools.partial(step_kernel, fastmath=fastmath)
-    return numba.njit(cache=True, fastmath=fastmath, _nrt=False)(func)
+    return numba.njit(cache=True, fastmath=FASTMATH, _nrt=False)(func)
 
 
 @functools.cache

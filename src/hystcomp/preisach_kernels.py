@@ -363,7 +363,7 @@ def exact_input(p, target):
     return previous
 
 
-@step_kernel(fastmath=FASTMATH)  # the flags of _kernel, those of preisach_run that calls it
+@step_kernel
 def preisach_step(p, u):
     """One sample through packed system ``p``; updates its state and returns the output.
 
