@@ -28,10 +28,14 @@ from hystcomp.errors import (
     InvalidSignalError,
     InvalidTypeError,
 )
+from hystcomp.identify.preisach_lsq import fit_preisach_lsq
 
 MAX_DEGREE = 8
 EVERETT_KINDS = ("polynomial", "table")
 N_BINS = 200  # X samples per full-range curve: each curve is averaged in bins of span / N_BINS
+FIT_METHODS = ("auto", "reversal-curves", "least-squares")
+#: ``fit="auto"`` uses the reversal curves when they descend from this many distinct maxima.
+AUTO_MIN_MAXIMA = 8
 _FIX = "Record the response to the Preisach excitation (run `hystcomp excite preisach`)"
 
 
@@ -335,6 +339,7 @@ def identify_preisach(
     voltage_range=None,
     zero_diagonal=True,
     tolerance=None,
+    fit_method="auto",
 ) -> PreisachFit:
     """Identify the classical Preisach model from a record, as in Section III-A.
 
@@ -357,20 +362,36 @@ def identify_preisach(
         ``X(v, v)`` makes the output step at each reversal (tables always have it 0).
     tolerance : float, optional
         Dead band of the turning-point search (V); see :func:`find_reversal_curves`.
+    fit_method : {"auto", "reversal-curves", "least-squares"}, default "auto"
+        ``"reversal-curves"``: the paper's fit of X to the samples of eq. (2) read off the
+        first-order descending curves. ``"least-squares"``: the model's output fitted to
+        the whole record with a non-negative Preisach density
+        (:mod:`hystcomp.identify.preisach_lsq`); any record that sweeps the range will do.
+        ``"auto"``: the reversal curves when the record has them from at least
+        :data:`AUTO_MIN_MAXIMA` distinct maxima (as the response to ``hystcomp excite
+        preisach`` has: 24), else least squares.
 
     Returns
     -------
     PreisachFit
         ``output_offset`` is the least-squares constant between the record and the model
-        (the sensor offset), over the record from the first visit to its minimum on.
+        (the sensor offset), over the record from the first visit to its minimum on
+        (reversal curves) or to an end of its range (least squares). ``report["fit"]``
+        names the fit used.
 
     Raises
     ------
     IdentificationError
-        If the record holds no first-order descending curve, or too few to fit X.
+        If the record cannot determine X: for the reversal curves, no first-order descending
+        curve or too few; for least squares, an input that does not move.
     """
     owner = "identify_preisach"
     degree, grid_size = _check_options(degree, everett, grid_size, zero_diagonal, owner)
+    if fit_method not in FIT_METHODS:
+        raise InvalidParameterError(
+            f"The 'fit_method' parameter of {owner} must be one of "
+            f"{', '.join(map(repr, FIT_METHODS))}. Got {fit_method!r} instead."
+        )
     curves = find_reversal_curves(v, x, tolerance=tolerance)
     v = np.ascontiguousarray(v, dtype=np.float64).reshape(-1)
     x = np.ascontiguousarray(x, dtype=np.float64).reshape(-1)
@@ -390,6 +411,14 @@ def identify_preisach(
                 f"which spans {data_range[0]:g}..{data_range[1]:g} V. Got "
                 f"{voltage_range[0]:g}..{voltage_range[1]:g} V; widen it or pass None."
             )
+    if fit_method == "auto":
+        span = voltage_range[1] - voltage_range[0]
+        n_maxima = len(_distinct(np.array([c.alpha for c in curves]), 1e-3 * span))
+        fit_method = "reversal-curves" if n_maxima >= AUTO_MIN_MAXIMA else "least-squares"
+    if fit_method == "least-squares":
+        return _least_squares(
+            v, x, curves, degree, everett, grid_size, voltage_range, zero_diagonal
+        )
     if not curves:
         raise IdentificationError(
             "The record holds no first-order descending reversal curve (eq. 2): the input "
@@ -431,11 +460,52 @@ def identify_preisach(
     on_diagonal = np.empty_like(diagonal)
     pk.everett_many(packed, diagonal, diagonal, on_diagonal)
     report = {
+        "fit": "reversal-curves",
         "n_curves": len(curves),
         "maxima_V": [round(c.alpha, 9) for c in curves],
         "everett_rms_um": float(np.sqrt(np.mean((model_everett - value) ** 2))),
         "record_rms_um": float(np.sqrt(np.mean(residual**2))),
         "record_max_um": float(np.abs(residual).max()),
         "diagonal_max_um": float(np.abs(on_diagonal).max()),
+    }
+    return PreisachFit(theta, table, (lo, hi), offset, report)
+
+
+def _least_squares(v, x, curves, degree, everett, grid_size, voltage_range, zero_diagonal):
+    """:func:`identify_preisach` by density-constrained least squares over the whole record."""
+    if not zero_diagonal:
+        raise InvalidParameterError(
+            "zero_diagonal=False is the paper's unconstrained fit to reversal curves; the "
+            "least-squares fit keeps X(v, v) = 0 (eq. 2), which a non-negative density implies. "
+            "Pass zero_diagonal=True, or fit='reversal-curves' with a record of first-order "
+            "descending curves (`hystcomp excite preisach`)."
+        )
+    theta, table, offset, fit_report = fit_preisach_lsq(
+        v, x, everett=everett, degree=degree, grid_size=grid_size, voltage_range=voltage_range
+    )
+    lo, hi = voltage_range
+    kind, coef = (
+        (pk.POLYNOMIAL, pk.coefficient_matrix(theta, degree))
+        if table is None
+        else (
+            pk.TABLE,
+            table,
+        )
+    )
+    packed = pk.pack_preisach(
+        kind=kind, coef=coef, v_min=lo, v_max=hi, offset=offset, depth=pk.DEFAULT_DEPTH
+    )
+    model_x = np.empty_like(v)
+    pk.preisach_run(packed, v, model_x)
+    start = fit_report["first_used_sample"]
+    residual = x[start:] - model_x[start:]
+    report = {
+        "fit": "least-squares",
+        "n_curves": len(curves),
+        "maxima_V": [round(c.alpha, 9) for c in curves],
+        **fit_report,
+        "record_rms_um": float(np.sqrt(np.mean(residual**2))),
+        "record_max_um": float(np.abs(residual).max()),
+        "diagonal_max_um": 0.0,
     }
     return PreisachFit(theta, table, (lo, hi), offset, report)

@@ -96,7 +96,15 @@ class Preisach(HysteresisModel):
     """
 
     kind = "preisach"
-    _hyper = ("degree", "everett", "grid_size", "voltage_range", "zero_diagonal", "max_extrema")
+    _hyper = (
+        "degree",
+        "everett",
+        "grid_size",
+        "voltage_range",
+        "zero_diagonal",
+        "max_extrema",
+        "fit_method",
+    )
     _learned = ("voltage_range", "output_offset", "theta", "table")
 
     def __init__(
@@ -108,6 +116,7 @@ class Preisach(HysteresisModel):
         voltage_range=None,
         zero_diagonal=True,
         max_extrema=pk.DEFAULT_DEPTH,
+        fit_method="auto",
     ):
         self.degree = degree
         self.everett = everett
@@ -115,6 +124,7 @@ class Preisach(HysteresisModel):
         self.voltage_range = voltage_range
         self.zero_diagonal = zero_diagonal
         self.max_extrema = max_extrema
+        self.fit_method = fit_method
 
     @classmethod
     def from_parameters(
@@ -185,6 +195,7 @@ class Preisach(HysteresisModel):
             grid_size=self.grid_size,
             voltage_range=self.voltage_range,
             zero_diagonal=self.zero_diagonal,
+            fit_method=self.fit_method,
         )
         self.theta_ = None if result.theta is None else _frozen(result.theta)
         self.table_ = None if result.table is None else _frozen(result.table)
