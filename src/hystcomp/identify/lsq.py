@@ -264,8 +264,11 @@ def solve_inequality_qp(
     keep = np.any(cons != 0.0, axis=1)  # rows on dropped coefficients only hold at 0
     cons = cons[keep]
     try:
-        solution = quadprog.solve_qp(quad, lin, cons.T.copy(), np.zeros(cons.shape[0]))[0]
-    except ValueError as exc:
+        if cons.shape[0] == 0:
+            solution = np.linalg.solve(quad, lin)
+        else:
+            solution = quadprog.solve_qp(quad, lin, cons.T.copy(), np.zeros(cons.shape[0]))[0]
+    except (ValueError, np.linalg.LinAlgError) as exc:
         raise IdentificationError(
             f"The constrained least-squares problem could not be solved ({exc}). Check that "
             "the record is one experiment (input and displacement of the same samples)."

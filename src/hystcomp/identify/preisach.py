@@ -9,6 +9,10 @@ Nothing here assumes where the curves are: turning points are found in the input
 a dead band against noise, a maximum starts a first-order curve when the input rose to it
 straight from (within the dead band of) its minimum, which wipes the memory out. The record may
 have any voltage range (``v_min`` is its minimum), sample rate, sensor offset and noise.
+
+A record without such curves (one amplitude, the PI triangles, a random or measured record)
+is fitted by least squares over the whole record instead
+(:mod:`hystcomp.identify.preisach_lsq`); :func:`identify_preisach`'s ``fit_method`` chooses.
 """
 
 from __future__ import annotations
@@ -37,6 +41,10 @@ FIT_METHODS = ("auto", "reversal-curves", "least-squares")
 #: ``fit="auto"`` uses the reversal curves when they descend from this many distinct maxima.
 AUTO_MIN_MAXIMA = 8
 _FIX = "Record the response to the Preisach excitation (run `hystcomp excite preisach`)"
+_ANY = (
+    " Or fit by least squares, which takes any record that sweeps the range: "
+    "fit_method='least-squares' (`hystcomp identify --fit least-squares`)."
+)
 
 
 @dataclass(frozen=True)
@@ -232,7 +240,7 @@ def fit_everett_polynomial(
             f"they descend from {len(maxima)} distinct maxim{'um' if len(maxima) == 1 else 'a'} "
             f"({', '.join(f'{m:.4g}' for m in maxima)} V) and eq. (5) needs at least "
             f"{degree} spread over the range. {_FIX}, whose sinusoids rise to 24 "
-            "different maxima, or lower the degree."
+            f"different maxima, or lower the degree.{_ANY}"
         )
     fitted = dict(zip(free, coef, strict=True))
     if zero_diagonal:
@@ -423,7 +431,7 @@ def identify_preisach(
         raise IdentificationError(
             "The record holds no first-order descending reversal curve (eq. 2): the input "
             f"never rises from its minimum ({data_range[0]:g} V) to a maximum and falls back. "
-            f"{_FIX}: sinusoids of growing amplitude, each from v_min, and identify from it."
+            f"{_FIX}: sinusoids of growing amplitude, each from v_min, and identify from it.{_ANY}"
         )
     lo, hi = voltage_range
     alpha, beta, value = everett_samples(curves, v_min=lo, bin_width=(hi - lo) / N_BINS)
@@ -439,7 +447,7 @@ def identify_preisach(
             raise IdentificationError(
                 f"The reversal curves descend from {len(maxima)} distinct maximum "
                 f"({maxima[0]:.4g} V); a table of X needs curves from several maxima "
-                f"spread over the range. {_FIX}."
+                f"spread over the range. {_FIX}.{_ANY}"
             )
         theta = None
         table = fit_everett_table(alpha, beta, value, grid_size=grid_size, voltage_range=(lo, hi))
@@ -477,7 +485,7 @@ def _least_squares(v, x, curves, degree, everett, grid_size, voltage_range, zero
         raise InvalidParameterError(
             "zero_diagonal=False is the paper's unconstrained fit to reversal curves; the "
             "least-squares fit keeps X(v, v) = 0 (eq. 2), which a non-negative density implies. "
-            "Pass zero_diagonal=True, or fit='reversal-curves' with a record of first-order "
+            "Pass zero_diagonal=True, or fit_method='reversal-curves' with a record of first-order "
             "descending curves (`hystcomp excite preisach`)."
         )
     theta, table, offset, fit_report = fit_preisach_lsq(

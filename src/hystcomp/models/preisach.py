@@ -72,6 +72,14 @@ class Preisach(HysteresisModel):
         Bound of the memory (stored extrema, ``beta_0`` included). When a reversal would
         exceed it the innermost stored minor loop is wiped out first; the default is far
         beyond what measured signals reach.
+    fit_method : {"auto", "reversal-curves", "least-squares"}, default "auto"
+        How ``fit`` identifies X: ``"reversal-curves"`` is the paper's fit to the
+        first-order descending curves of the record (Section III-A, the response to
+        ``hystcomp excite preisach``); ``"least-squares"`` fits the model's output over the
+        whole record, any record that sweeps the range, with a non-negative Preisach
+        density (so every branch rises and the exact inverse exists); ``"auto"`` takes the
+        reversal curves when the record has them from 8 or more maxima, else least squares.
+        See :func:`~hystcomp.identify.preisach.identify_preisach`.
 
     Attributes
     ----------
@@ -178,8 +186,9 @@ class Preisach(HysteresisModel):
         Parameters
         ----------
         v, x : array_like
-            Input voltage (V) and displacement (µm), e.g. the response to
-            ``hystcomp excite preisach``.
+            Input voltage (V) and displacement (µm): the response to
+            ``hystcomp excite preisach`` for the paper's fit, or any record that sweeps the
+            range for least squares (``fit_method``).
 
         Returns
         -------
