@@ -6,7 +6,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from hystcomp import presets
-from hystcomp.errors import IdentificationError, InvalidParameterError
+from hystcomp.errors import InvalidParameterError
 from hystcomp.identify.excitation import (
     random_turning_points,
     sinusoid_sequence,

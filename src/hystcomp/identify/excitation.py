@@ -5,6 +5,8 @@ All signals start at the lower end of the voltage range, with the piezo at rest 
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 
 from hystcomp._validation import as_vector, check_range, check_real
@@ -177,7 +179,7 @@ def random_turning_points(
     points[[0, 2, -1]] = lo
     points[1] = hi
     pieces = [np.array([lo])]
-    for a, b in zip(points[:-1], points[1:], strict=True):
+    for a, b in itertools.pairwise(points):
         m = max(2, round(rng.uniform(shortest, longest) * sample_rate))
         phase = np.arange(1, m + 1) / m
         pieces.append(a + (b - a) * 0.5 * (1.0 - np.cos(np.pi * phase)))
