@@ -65,7 +65,7 @@ def test_fit_choices_and_the_table_go_into_the_model_file(tmp_path):
         (["--grid", "9"], r"--grid applies to --everett table"),
         (["--everett", "table", "--degree", "4"], r"--degree applies to --everett polynomial"),
         (["--fit", "paper"], r"'paper' is not one of 'auto', 'reversal-curves', 'least-squares'"),
-        (["--everett", "table", "--grid", "1"], r"--grid.*1 is not in the range 2<=x<=61"),
+        (["--everett", "table", "--grid", "1"], r"--grid.*1 is not in the range 2<=x<=41"),
     ],
 )
 def test_bad_preisach_options_are_refused_before_any_work(tmp_path, extra, message):

@@ -20,6 +20,7 @@ from hystcomp.cli._options import (
 from hystcomp.data import read_record
 from hystcomp.errors import IdentificationError
 from hystcomp.identify.preisach import EVERETT_KINDS, FIT_METHODS, MAX_DEGREE
+from hystcomp.identify.preisach_lsq import MAX_LSQ_GRID
 from hystcomp.identify.scoring import error_report, holdout_report, straight_line, transient_end
 from hystcomp.io import MODEL_KINDS, atomic_paths, check_output_path, model_text
 
@@ -33,7 +34,7 @@ SIZE_OPTIONS = {
     "preisach": ("degree", "fit", "everett", "grid"),
 }
 #: Largest --grid (the least-squares table fit has about grid^2 / 2 unknowns).
-MAX_GRID = 61
+MAX_GRID = MAX_LSQ_GRID
 
 
 def build_estimator(

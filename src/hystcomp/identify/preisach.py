@@ -32,7 +32,7 @@ from hystcomp.errors import (
     InvalidSignalError,
     InvalidTypeError,
 )
-from hystcomp.identify.preisach_lsq import fit_preisach_lsq
+from hystcomp.identify.preisach_lsq import MAX_LSQ_GRID, fit_preisach_lsq
 
 MAX_DEGREE = 8
 EVERETT_KINDS = ("polynomial", "table")
@@ -487,6 +487,13 @@ def _least_squares(v, x, curves, degree, everett, grid_size, voltage_range, zero
             "least-squares fit keeps X(v, v) = 0 (eq. 2), which a non-negative density implies. "
             "Pass zero_diagonal=True, or fit_method='reversal-curves' with a record of first-order "
             "descending curves (`hystcomp excite preisach`)."
+        )
+    if everett == "table" and grid_size > MAX_LSQ_GRID:
+        raise InvalidParameterError(
+            f"The 'grid_size' parameter of identify_preisach must be at most {MAX_LSQ_GRID} for "
+            f"the least-squares fit, whose {grid_size * (grid_size - 1) // 2} cell masses would "
+            f"make a dense problem too large to solve. Got {grid_size}; use a coarser grid "
+            "(25 puts a node every 5 V on 0..120 V) or the polynomial."
         )
     theta, table, offset, fit_report = fit_preisach_lsq(
         v, x, everett=everett, degree=degree, grid_size=grid_size, voltage_range=voltage_range

@@ -40,8 +40,13 @@ from hystcomp.errors import IdentificationError
 from hystcomp.identify.lsq import solve_inequality_qp
 from hystcomp.identify.scoring import transient_end
 
-#: Largest work of a Gram accumulation, rows * (p + 2)**2: beyond it rows are taken at a stride.
-GRAM_BUDGET = 2e9
+#: Largest work of a Gram accumulation, rows * (p + 2)**2: beyond it rows are taken at a
+#: stride (but at least :data:`MIN_ROWS` rows). A rate-independent loop is described by far
+#: fewer samples than a 20 kHz record holds; the stride only thins the noise averaging.
+GRAM_BUDGET = 5e8
+MIN_ROWS = 5_000
+#: Largest table for least squares: (n - 1) n / 2 unknowns in a dense quadratic programme.
+MAX_LSQ_GRID = 41
 #: Rows per block of the Gram accumulation.
 BLOCK = 1024
 #: Points per axis of the grid on which a polynomial's density is kept non-negative.
@@ -131,8 +136,8 @@ class EverettBasis:
         """The augmented Gram matrix ``[R | 1 | x]^T [R | 1 | x]`` over the chosen rows."""
         gram = np.zeros((self.size + 2, self.size + 2))
         for block in self.rows(v, x, start=start, stride=stride):
-            gram += block.T @ block
-        return gram
+            pk.gram_update(block, block.shape[0], gram)
+        return np.triu(gram) + np.triu(gram, 1).T
 
     def density_constraints(self) -> np.ndarray:
         """Rows ``A`` with ``A c >= 0`` iff the density (and the reversible part) is >= 0.
@@ -242,7 +247,7 @@ def fit_preisach_lsq(v, x, *, everett, degree, grid_size, voltage_range, start=N
             "actuator while the voltage sweeps its range (any waveform: `hystcomp excite "
             "preisach`, `hystcomp excite pi`, or a random one)."
         )
-    max_rows = max(20_000, int(GRAM_BUDGET / (basis.size + 2) ** 2))
+    max_rows = max(MIN_ROWS, int(GRAM_BUDGET / (basis.size + 2) ** 2))
     stride = max(1, math.ceil(used / max_rows))
     gram = basis.normal_equations(v, x, start=start, stride=stride)
     penalty = basis.smoothness_penalty()
