@@ -1,4 +1,5 @@
-"""The paper's identification signals (Section III-A for Preisach, Section IV-A for PI/MPI).
+"""The paper's identification signals (Section III-A for Preisach, Section IV-A for PI/MPI),
+and a random one (:func:`random_turning_points`) for fits that take any record.
 
 All signals start at the lower end of the voltage range, with the piezo at rest there.
 """
