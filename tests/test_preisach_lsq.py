@@ -87,6 +87,26 @@ def test_recovers_a_known_polynomial_model_from_a_random_record(random_record, r
     assert np.abs(model.simulate(check) - truth.simulate(check)).max() < 0.005  # of 36 µm
 
 
+@pytest.mark.parametrize(
+    ("voltage_range", "sample_rate", "offset"),
+    [((0.0, 3.6), 200.0, -123.0), ((-150.0, 150.0), 5_000.0, 40.0)],
+)
+def test_other_ranges_rates_and_offsets(voltage_range, sample_rate, offset, rng):
+    lo, hi = voltage_range
+    truth = Preisach.from_parameters(
+        theta=monotone_theta(rng, 3, hi - lo, 40.0), voltage_range=voltage_range
+    )
+    _, v = random_turning_points(
+        30, seed=7, durations=(0.5, 1.0), sample_rate=sample_rate, voltage_range=voltage_range
+    )
+    x = truth.simulate(v) + offset + 0.005 * rng.standard_normal(v.size)
+    for everett, bound in (("polynomial", 0.0055), ("table", 0.02)):
+        model = Preisach(fit_method="least-squares", everett=everett).fit(v, x)
+        assert model.voltage_range_ == pytest.approx(voltage_range)
+        assert model.output_offset_ == pytest.approx(offset, abs=0.02)
+        assert model.fit_report_["record_rms_um"] < bound  # noise 0.005 µm, stroke 40 µm
+
+
 def test_eq_6_from_a_random_record_to_near_the_noise(random_record, rng):
     # eq. (6) with X(v, v) = 0 has a density slightly below 0 in one corner (-6e-5 µm/V^2
     # at alpha = 120, beta = 0): the constrained fit comes as close as a monotone model can
