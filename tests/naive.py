@@ -159,3 +159,51 @@ def preisach_relays(v_index, everett, nodes):
         state[down >= idx] = False
         out.append(float(weight @ state))
     return np.array(out)
+
+
+def _overlap(lo1, hi1, lo2, hi2):
+    """Length of the intersection of the intervals [lo1, hi1] and [lo2, hi2]."""
+    return max(0.0, min(hi1, hi2) - max(lo1, lo2))
+
+
+def everett_basis_polynomial(exponents, v_min, v_max):
+    """X_m(alpha, beta) = b^i a^j - b^(i+j) on the unit square, one function per (i, j)."""
+    span = v_max - v_min
+
+    def element(i, j):
+        def everett(alpha, beta):
+            a, b = (alpha - v_min) / span, (beta - v_min) / span
+            return b**i * a**j - b ** (i + j)
+
+        return everett
+
+    return [element(i, j) for i, j in exponents]
+
+
+def everett_basis_cells(n_seg, v_min, v_max):
+    """Everett functions of unit masses on a grid: X(alpha, beta) is the part of the mass in
+    {beta <= beta' <= alpha' <= alpha}. Diagonal segments first (a mass spread along the
+    segment), then the cells (s_a, s_b), s_b < s_a, in the order (1, 0), (2, 0), (2, 1), ..."""
+    h = (v_max - v_min) / n_seg
+    g = v_min + h * np.arange(n_seg + 1)
+
+    def segment(s):
+        return lambda alpha, beta: _overlap(g[s], g[s + 1], beta, alpha) / h
+
+    def cell(sa, sb):
+        # the cell lies below the diagonal, so beta' <= alpha' holds inside it
+        def everett(alpha, beta):
+            on_alpha = _overlap(g[sa], g[sa + 1], -np.inf, alpha) / h
+            on_beta = _overlap(g[sb], g[sb + 1], beta, np.inf) / h
+            return on_alpha * on_beta
+
+        return everett
+
+    funcs = [segment(s) for s in range(n_seg)]
+    funcs += [cell(sa, sb) for sa in range(1, n_seg) for sb in range(sa)]
+    return funcs
+
+
+def preisach_regressors(v, basis, v_min, v_max):
+    """Eqs. (3)-(4) with each basis Everett function alone: one column per element."""
+    return np.column_stack([preisach_extrema(v, f, v_min, v_max) for f in basis])

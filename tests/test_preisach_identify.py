@@ -126,24 +126,29 @@ def test_fitted_model_reproduces_a_continuous_non_polynomial_preisach_system(exc
         assert np.abs(model.simulate(check) - truth.simulate(check)).max() < bound
 
 
-def test_record_without_reversal_curves_names_the_fix():
+def test_reversal_curve_fit_of_a_record_without_them_names_the_fix():
     ramp = np.linspace(0.0, 120.0, 1000)
     with pytest.raises(IdentificationError, match=r"no first-order descending.*excite preisach"):
-        Preisach().fit(ramp, 0.3 * ramp)
+        Preisach(fit_method="reversal-curves").fit(ramp, 0.3 * ramp)
+    # the default falls back to least squares, which a ramp determines along X(v, 0)
+    model = Preisach().fit(ramp, 0.3 * ramp)
+    assert model.fit_report_["fit"] == "least-squares"
+    np.testing.assert_allclose(model.simulate(ramp), 0.3 * ramp, atol=1e-6)
 
 
-def test_record_with_one_amplitude_names_what_is_missing(rng):
+def test_reversal_curve_fit_of_one_amplitude_names_what_is_missing(rng):
     # like a periodic record of constant amplitude (the micromanipulator data)
     _, v = triangle_sequence([3.6] * 6, sample_rate=200.0)
     x = presets.paper_preisach(zero_diagonal=True).simulate(v * 120 / 3.6) - 120.0
     with pytest.raises(
         IdentificationError, match=r"1 distinct maximum \(3\.6 V\).*excite preisach"
     ):
-        Preisach().fit(v, x)
+        Preisach(fit_method="reversal-curves").fit(v, x)
     with pytest.raises(IdentificationError, match=r"1 distinct maximum"):
-        Preisach(everett="table").fit(v, x)
+        Preisach(everett="table", fit_method="reversal-curves").fit(v, x)
     with pytest.raises(IdentificationError, match=r"constant"):
         Preisach().fit(np.full(10, 2.0), np.zeros(10))
+    assert Preisach().fit(v, x).fit_report_["fit"] == "least-squares"
 
 
 @pytest.mark.parametrize(

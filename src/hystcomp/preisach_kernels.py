@@ -463,3 +463,138 @@ def turning_points(v, delta, out):
                 candidate = k
     out[count] = candidate
     return count + 1, first_is_max
+
+
+# --- Regressors of the general least-squares identification ------------------------------
+#
+# A Preisach output is linear in the parameters of a linear Everett function
+# ``X = sum_m c_m X_m``: with the memory of eqs. (3)-(4), ``H[k] = sum_m c_m R_m[k]`` where
+# ``R_m`` is eqs. (3)-(4) evaluated with ``X_m`` alone. The kernels below run the memory
+# exactly as :func:`preisach_apply` does (same reversal tests, wipe-out and bounded depth)
+# and keep, beside each stored extremum, the prefix sum of the closed contributions as a
+# vector over the basis, so a regressor row costs one basis evaluation per sample.
+
+#: Bases of a linear Everett function: polynomials vanishing on the diagonal, Preisach cells.
+BASIS_POLYNOMIAL, BASIS_CELLS = 0, 1
+
+
+@_kernel
+def everett_basis(kind, exps, n_seg, v_min, v_max, alpha, beta, out):
+    """``out[m] = X_m(alpha, beta)``, the Everett function of basis element ``m`` alone.
+
+    With ``a = (alpha - v_min) / (v_max - v_min)`` and ``b`` likewise (the unit square):
+
+    * :data:`BASIS_POLYNOMIAL`: ``X_m = b**i a**j - b**(i + j)`` for the exponents
+      ``exps[m] = (i, j)``, ``j >= 1``: eq. (5)'s monomials with ``X(v, v) = 0`` built in.
+    * :data:`BASIS_CELLS`, ``n_seg`` segments of the input range: first ``n_seg`` unit masses
+      spread along the diagonal segments (a reversible part), then one unit mass spread
+      uniformly over each cell ``(s_a, s_b)``, ``s_b < s_a``, of the limiting triangle, in the
+      order ``(1, 0), (2, 0), (2, 1), (3, 0), ...``. Their Everett functions are the areas
+      (lengths) of the switched-on parts, which interpolate bilinearly between grid nodes.
+    """
+    span = v_max - v_min
+    a = (alpha - v_min) / span
+    b = (beta - v_min) / span
+    if kind == BASIS_POLYNOMIAL:
+        for m in range(exps.shape[0]):
+            i = exps[m, 0]
+            j = exps[m, 1]
+            out[m] = b**i * a**j - b ** (i + j)
+        return
+    ua = a * n_seg
+    ub = b * n_seg
+    m = 0
+    for s in range(n_seg):
+        out[m] = max(min(ua, s + 1.0) - max(ub, float(s)), 0.0)
+        m += 1
+    for sa in range(1, n_seg):
+        fa = min(max(ua - sa, 0.0), 1.0)
+        for sb in range(sa):
+            out[m] = fa * min(max(sb + 1.0 - ub, 0.0), 1.0)
+            m += 1
+
+
+@_kernel
+def _push_basis(kind, exps, n_seg, v_min, v_max, e, q, top, value, work):
+    """:func:`_push` on the basis: a turning point and its prefix-sum vector."""
+    if top + 1 >= e.size:
+        top -= 2  # full: wipe out the innermost stored pair first, as the model does
+    if top % 2 == 0:
+        everett_basis(kind, exps, n_seg, v_min, v_max, value, e[top], work)
+        sign = 1.0
+    else:
+        everett_basis(kind, exps, n_seg, v_min, v_max, e[top], value, work)
+        sign = -1.0
+    for m in range(work.size):
+        q[top + 1, m] = q[top, m] + sign * work[m]
+    e[top + 1] = value
+    return top + 1
+
+
+@_kernel
+def preisach_rows(kind, exps, n_seg, v_min, v_max, v, x, first, start, stride, memory, rows):
+    """Regressor rows ``[R_0[k] .. R_(p-1)[k], 1, x[k]]`` of samples ``k = first, ...``.
+
+    ``memory = (e, q, st)`` holds the memory between calls: the stored extrema ``e``
+    (``e[0] = v_min``; its size is the depth bound), their prefix-sum vectors ``q`` (one row
+    each, ``q[0] = 0``) and ``st = [top, last input]``; start it as :func:`pack_preisach`
+    starts a model (all relays off at ``v_min``). Every sample advances the memory; a row is
+    written for the samples ``k >= start`` with ``(k - start) % stride == 0`` until ``rows``
+    is full. Returns ``(next sample, rows written)``.
+    """
+    e, q, st = memory
+    p = q.shape[1]
+    work = np.empty(p)
+    top = int(st[0])
+    previous = st[1]
+    count = 0
+    k = first
+    while k < v.size and count < rows.shape[0]:
+        u = min(max(v[k], v_min), v_max)
+        if top % 2 == 0:
+            if u < previous:
+                top = _push_basis(kind, exps, n_seg, v_min, v_max, e, q, top, previous, work)
+        elif u > previous:
+            top = _push_basis(kind, exps, n_seg, v_min, v_max, e, q, top, previous, work)
+        if top % 2 == 0:
+            while top >= 2 and u >= e[top - 1]:
+                top -= 2
+        else:
+            while top >= 3 and u <= e[top - 1]:
+                top -= 2
+        previous = u
+        if k >= start and (k - start) % stride == 0:
+            row = rows[count]
+            if top % 2 == 0:
+                everett_basis(kind, exps, n_seg, v_min, v_max, u, e[top], work)
+                sign = 1.0
+            else:
+                everett_basis(kind, exps, n_seg, v_min, v_max, e[top], u, work)
+                sign = -1.0
+            for m in range(p):
+                row[m] = q[top, m] + sign * work[m]
+            row[p] = 1.0
+            row[p + 1] = x[k]
+            count += 1
+        k += 1
+    st[0] = top
+    st[1] = previous
+    return k, count
+
+
+@_kernel
+def gram_update(rows, count, gram):
+    """Add ``rows[:count]^T rows[:count]`` to the upper triangle of ``gram``.
+
+    A plain loop rather than BLAS: interleaved with :func:`preisach_rows` calls, a threaded
+    BLAS wakes its threads for every block, which on a loaded machine costs far more than
+    the arithmetic (measured 20x slower); zeros, frequent in Preisach regressors, are skipped.
+    """
+    p = rows.shape[1]
+    for r in range(count):
+        for i in range(p):
+            ri = rows[r, i]
+            if ri == 0.0:
+                continue
+            for j in range(i, p):
+                gram[i, j] += ri * rows[r, j]

@@ -19,7 +19,8 @@ from hystcomp.cli._options import (
 )
 from hystcomp.data import read_record
 from hystcomp.errors import IdentificationError
-from hystcomp.identify.preisach import MAX_DEGREE
+from hystcomp.identify.preisach import EVERETT_KINDS, FIT_METHODS, MAX_DEGREE
+from hystcomp.identify.preisach_lsq import MAX_LSQ_GRID
 from hystcomp.identify.scoring import error_report, holdout_report, straight_line, transient_end
 from hystcomp.io import MODEL_KINDS, atomic_paths, check_output_path, model_text
 
@@ -30,12 +31,23 @@ LABELS = {"pi": "PI", "mpi": "MPI", "preisach": "Preisach"}
 SIZE_OPTIONS = {
     "pi": ("operators",),
     "mpi": ("operators", "deadzones", "regularization"),
-    "preisach": ("degree",),
+    "preisach": ("degree", "fit", "everett", "grid"),
 }
+#: Largest --grid (the least-squares table fit has about grid^2 / 2 unknowns).
+MAX_GRID = MAX_LSQ_GRID
 
 
 def build_estimator(
-    kind: str, *, operators, deadzones, voltage_range, regularization=None, degree=None
+    kind: str,
+    *,
+    operators,
+    deadzones,
+    voltage_range,
+    regularization=None,
+    degree=None,
+    fit=None,
+    everett=None,
+    grid=None,
 ):
     """An unfitted model of ``kind`` from the registry :data:`hystcomp.io.MODEL_KINDS`."""
     cls = MODEL_KINDS.get(kind)
@@ -49,6 +61,9 @@ def build_estimator(
         "deadzones": deadzones,
         "regularization": regularization,
         "degree": degree,
+        "fit": fit,
+        "everett": everett,
+        "grid": grid,
     }
     for name, value in given.items():
         if value is not None and name not in SIZE_OPTIONS[kind]:
@@ -62,7 +77,25 @@ def build_estimator(
         params["regularization"] = regularization
     if degree is not None:
         params["degree"] = degree
+    if kind == "preisach":
+        params.update(_everett_params(fit, everett, degree, grid))
     return cls(**params)
+
+
+def _everett_params(fit, everett, degree, grid) -> dict:
+    """The Preisach estimator's ``fit_method``, ``everett`` and ``grid_size`` from the options."""
+    if everett == "table" and degree is not None:
+        raise click.UsageError("--degree applies to --everett polynomial; a table has --grid.")
+    if grid is not None and everett != "table":
+        raise click.UsageError("--grid applies to --everett table.")
+    params = {}
+    if fit is not None:
+        params["fit_method"] = fit
+    if everett is not None:
+        params["everett"] = everett
+    if grid is not None:
+        params["grid_size"] = grid
+    return params
 
 
 def _regularization(ctx, param, value):
@@ -109,6 +142,29 @@ def _sizes(model) -> str:
     help="Degree of the Everett polynomial, preisach [3, eq. 5].",
 )
 @click.option(
+    "--fit",
+    type=click.Choice(FIT_METHODS),
+    default=None,
+    help="How the preisach model is fitted [auto]: reversal-curves is the paper's fit of eq. 5 "
+    "to first-order descending curves (the record of `hystcomp excite preisach`); "
+    "least-squares fits the model's output over any record that sweeps the range, with a "
+    "non-negative Preisach density; auto takes the reversal curves when the record has them "
+    "from 8 or more maxima, else least squares.",
+)
+@click.option(
+    "--everett",
+    type=click.Choice(EVERETT_KINDS),
+    default=None,
+    help="Everett function of the preisach model: the polynomial of eq. 5 (--degree) or a "
+    "table interpolated bilinearly (--grid) [polynomial].",
+)
+@click.option(
+    "--grid",
+    type=click.IntRange(2, MAX_GRID),
+    default=None,
+    help="Nodes per axis of a preisach --everett table [25].",
+)
+@click.option(
     "--regularization",
     default=None,
     metavar="LAMBDA|auto",
@@ -153,6 +209,9 @@ def identify(
     operators,
     deadzones,
     degree,
+    fit,
+    everett,
+    grid,
     regularization,
     columns,
     sample_rate,
@@ -166,6 +225,8 @@ def identify(
 
     PI and MPI: constrained least squares (eqs. 16-19) with invertible weights; the
     start-up transient, the input range (bipolar too) and a displacement offset are handled.
+    Preisach: the paper's fit to reversal curves (Section III-A) or least squares over any
+    record (--fit).
     """
     check_output_path(output, inputs=(data,), what="model file")
     if plot is not None:  # matplotlib is imported only when a figure is asked for
@@ -183,6 +244,9 @@ def identify(
         voltage_range=voltage_range,
         regularization=regularization,
         degree=degree,
+        fit=fit,
+        everett=everett,
+        grid=grid,
     )
     rec = read_record(data, **read_options(columns, sample_rate))
     n = len(rec)
@@ -219,6 +283,8 @@ def identify(
         click.echo(
             f"  regularization: {chosen:g} (auto: the smallest fit error of 0, 1e-4 .. 1e-1)"
         )
+    if kind == "preisach":
+        click.echo(f"  Everett fit: {_preisach_fit_line(model)}")
     click.echo(
         f"  fit error: rms {report['rms_error_um']:.4g} µm "
         f"({report['rms_error_percent']:.3g} % of {report['displacement_range_um']:.4g} µm), "
@@ -244,3 +310,25 @@ def identify(
             )
     for path in outputs[::-1]:
         click.echo(f"  wrote {path}")
+
+
+def _preisach_fit_line(model) -> str:
+    """How a Preisach model was fitted, in a few words."""
+    report = model.fit_report_
+    what = (
+        f"{model.grid_size} x {model.grid_size} table"
+        if model.everett == "table"
+        else f"degree-{model.degree} polynomial"
+    )
+    if report["fit"] == "reversal-curves":
+        how = f"reversal curves from {report['n_curves']} maxima (paper, Section III-A)"
+    else:
+        how = "least squares over the record, non-negative density"
+    why = ""
+    if model.fit_method == "auto":
+        why = (
+            " (auto: first-order descending curves from 8 or more maxima)"
+            if report["fit"] == "reversal-curves"
+            else " (auto: the record has too few first-order descending curves)"
+        )
+    return f"{what}, {how}{why}"

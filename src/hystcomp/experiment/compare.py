@@ -160,7 +160,7 @@ def identify_models(
     config = CompareConfig() if config is None else config
     pi = PrandtlIshlinskii(n_operators=config.n_operators)
     mpi = ModifiedPrandtlIshlinskii(n_operators=config.n_operators, n_deadzones=config.n_deadzones)
-    preisach = Preisach(degree=config.preisach_degree)
+    preisach = Preisach(degree=config.preisach_degree, fit_method="reversal-curves")
     mpi_choice = choose_regularization(
         mpi, record_pi.v, record_pi.x, record_preisach.v, record_preisach.x
     )

@@ -1,9 +1,12 @@
-"""The paper's identification signals (Section III-A for Preisach, Section IV-A for PI/MPI).
+"""The paper's identification signals (Section III-A for Preisach, Section IV-A for PI/MPI),
+and a random one (:func:`random_turning_points`) for fits that take any record.
 
 All signals start at the lower end of the voltage range, with the piezo at rest there.
 """
 
 from __future__ import annotations
+
+import itertools
 
 import numpy as np
 
@@ -108,3 +111,83 @@ def scaled_amplitudes(amplitudes, paper_range=(0.0, 120.0), voltage_range=(0.0, 
     amplitudes = as_vector(amplitudes, "amplitudes", "scaled_amplitudes")
     scale = (hi - lo) / (paper_range[1] - paper_range[0])
     return tuple(float(a) * scale for a in amplitudes)
+
+
+def random_turning_points(
+    n_turns: int = 40,
+    *,
+    seed: int = 0,
+    durations=(0.15, 0.6),
+    sample_rate: float = DEFAULT_SAMPLE_RATE,
+    voltage_range=(0.0, 120.0),
+) -> tuple[np.ndarray, np.ndarray]:
+    """A band-limited random voltage: random turning points joined by half-cosine sweeps.
+
+    Not one of the paper's signals: a record with nested minor loops of every size, such as
+    an actuator meets in use, from which the Preisach model is identified by least squares
+    (:mod:`hystcomp.identify.preisach_lsq`). The turning points are uniform over
+    ``voltage_range``, except the first two: ``v_max`` then ``v_min`` (a major loop, so the
+    record covers the whole range at once); each sweep lasts a uniform random time in
+    ``durations``. The signal starts and ends at ``v_min``.
+
+    Parameters
+    ----------
+    n_turns : int, default 40
+        Turning points after the start (>= 8).
+    seed : int, default 0
+        Seed of the random generator (the signal is reproducible from it).
+    durations : (float, float), default (0.15, 0.6)
+        Shortest and longest sweep in s.
+    sample_rate : float, default 20000
+        In Hz.
+    voltage_range : (float, float), default (0, 120)
+        In V.
+
+    Returns
+    -------
+    t, v : ndarray
+        Time in s and voltage in V.
+
+    Examples
+    --------
+    >>> t, v = random_turning_points(8, sample_rate=100.0)
+    >>> float(v.min()), float(v.max()), float(v[0]), float(v[-1])
+    (0.0, 120.0, 0.0, 0.0)
+    """
+    owner = "random_turning_points"
+    if not isinstance(n_turns, int | np.integer) or isinstance(n_turns, bool) or n_turns < 8:
+        raise InvalidParameterError(
+            f"The 'n_turns' parameter of {owner} must be an int >= 8. Got {n_turns!r} instead."
+        )
+    if not isinstance(seed, int | np.integer) or isinstance(seed, bool) or seed < 0:
+        raise InvalidParameterError(
+            f"The 'seed' parameter of {owner} must be an int >= 0. Got {seed!r} instead."
+        )
+    shortest, longest = check_range(durations, "durations", owner)
+    if shortest <= 0:
+        raise InvalidParameterError(
+            f"The 'durations' parameter of {owner} must be two times > 0 s. Got {durations!r}."
+        )
+    sample_rate = check_real(sample_rate, "sample_rate", owner, positive=True)
+    lo, hi = check_range(voltage_range, "voltage_range", owner)
+    if shortest * sample_rate < 2:
+        raise InvalidParameterError(
+            f"{owner}: a sweep of {shortest:g} s at {sample_rate:g} Hz has fewer than 2 "
+            "samples. Raise the sample rate or the shortest duration."
+        )
+    rng = np.random.default_rng(seed)
+    points = rng.uniform(lo, hi, n_turns + 1)
+    points[[0, 2, -1]] = lo
+    points[1] = hi
+    pieces = [np.array([lo])]
+    for a, b in itertools.pairwise(points):
+        m = max(2, round(rng.uniform(shortest, longest) * sample_rate))
+        phase = np.arange(1, m + 1) / m
+        pieces.append(a + (b - a) * 0.5 * (1.0 - np.cos(np.pi * phase)))
+    v = np.concatenate(pieces)
+    if v.size > MAX_SAMPLES:
+        raise InvalidParameterError(
+            f"{owner}: {v.size} samples, more than {MAX_SAMPLES}. Fewer turning points, "
+            "shorter sweeps or a lower sample rate."
+        )
+    return np.arange(v.size) / sample_rate, v

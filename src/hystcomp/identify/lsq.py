@@ -207,3 +207,74 @@ def constrained_lsq(gram, *, blocks, scales, flat_tol=1e-6, ridge=RIDGE) -> LsqS
     coef[-1] = z_mean - mean @ coef[:-1]
     rss = float(zz - 2.0 * g @ coef + coef @ G @ coef)
     return LsqSolution(coef=coef, rss=max(rss, 0.0), varies=varies)
+
+
+def solve_inequality_qp(
+    gram, constraints, *, penalty=None, ridge=RIDGE
+) -> tuple[np.ndarray, float]:
+    """Least squares from normal equations under general inequalities ``A theta >= 0``.
+
+    The general form of :func:`constrained_lsq` (whose partial-sum blocks are one choice of
+    ``A``), for fits whose constraints are not partial sums, such as a non-negative Preisach
+    density: minimises ``|Phi theta - z|^2 + theta^T P theta`` subject to
+    ``constraints @ theta >= 0``, the constant regressor (last) unconstrained and eliminated
+    exactly first, as there. Columns are scaled to unit norm (with the penalty) and a
+    relative ``ridge`` keeps the form positive definite; a regressor that is constant over
+    the samples and unpenalised carries no information and gets coefficient 0.
+
+    Parameters
+    ----------
+    gram : ndarray, shape (p + 1, p + 1)
+        ``[Phi | z]^T [Phi | z]``, the constant regressor last in ``Phi``.
+    constraints : ndarray, shape (c, p - 1)
+        ``A``, on the non-constant coefficients.
+    penalty : ndarray, shape (p - 1, p - 1), optional
+        ``P``, positive semi-definite, in the coefficients' own units.
+    ridge : float
+        Added to the diagonal of the unit-scaled quadratic form.
+
+    Returns
+    -------
+    coef : ndarray, shape (p,)
+        The coefficients, the constant last.
+    rss : float
+        ``|Phi theta - z|^2`` (without the penalty).
+
+    Raises
+    ------
+    IdentificationError
+        If quadprog finds no solution.
+    """
+    p = gram.shape[0] - 1
+    G, g, zz = gram[:p, :p], gram[:p, p], gram[p, p]
+    count = G[-1, -1]
+    mean = G[-1, :-1] / count
+    z_mean = g[-1] / count
+    g_c = g[:-1] - count * mean * z_mean
+    quad_full = G[:-1, :-1] - count * np.outer(mean, mean)
+    if penalty is not None:
+        quad_full = quad_full + penalty
+    diag = np.maximum(np.diag(quad_full), 0.0)
+    idx = np.flatnonzero(diag > 1e-14 * max(float(diag.max()), 1e-300))
+    scale = 1.0 / np.sqrt(diag[idx])
+    quad = quad_full[np.ix_(idx, idx)] * np.outer(scale, scale)
+    quad[np.diag_indices_from(quad)] += ridge
+    lin = g_c[idx] * scale
+    cons = np.asarray(constraints, dtype=np.float64)[:, idx] * scale
+    keep = np.any(cons != 0.0, axis=1)  # rows on dropped coefficients only hold at 0
+    cons = cons[keep]
+    try:
+        if cons.shape[0] == 0:
+            solution = np.linalg.solve(quad, lin)
+        else:
+            solution = quadprog.solve_qp(quad, lin, cons.T.copy(), np.zeros(cons.shape[0]))[0]
+    except (ValueError, np.linalg.LinAlgError) as exc:
+        raise IdentificationError(
+            f"The constrained least-squares problem could not be solved ({exc}). Check that "
+            "the record is one experiment (input and displacement of the same samples)."
+        ) from None
+    coef = np.zeros(p)
+    coef[idx] = solution * scale
+    coef[-1] = z_mean - mean @ coef[:-1]
+    rss = float(zz - 2.0 * g @ coef + coef @ G @ coef)
+    return coef, max(rss, 0.0)

@@ -9,6 +9,10 @@ Nothing here assumes where the curves are: turning points are found in the input
 a dead band against noise, a maximum starts a first-order curve when the input rose to it
 straight from (within the dead band of) its minimum, which wipes the memory out. The record may
 have any voltage range (``v_min`` is its minimum), sample rate, sensor offset and noise.
+
+A record without such curves (one amplitude, the PI triangles, a random or measured record)
+is fitted by least squares over the whole record instead
+(:mod:`hystcomp.identify.preisach_lsq`); :func:`identify_preisach`'s ``fit_method`` chooses.
 """
 
 from __future__ import annotations
@@ -28,11 +32,19 @@ from hystcomp.errors import (
     InvalidSignalError,
     InvalidTypeError,
 )
+from hystcomp.identify.preisach_lsq import MAX_LSQ_GRID, fit_preisach_lsq
 
 MAX_DEGREE = 8
 EVERETT_KINDS = ("polynomial", "table")
 N_BINS = 200  # X samples per full-range curve: each curve is averaged in bins of span / N_BINS
+FIT_METHODS = ("auto", "reversal-curves", "least-squares")
+#: ``fit="auto"`` uses the reversal curves when they descend from this many distinct maxima.
+AUTO_MIN_MAXIMA = 8
 _FIX = "Record the response to the Preisach excitation (run `hystcomp excite preisach`)"
+_ANY = (
+    " Or fit by least squares, which takes any record that sweeps the range: "
+    "fit_method='least-squares' (`hystcomp identify --fit least-squares`)."
+)
 
 
 @dataclass(frozen=True)
@@ -228,7 +240,7 @@ def fit_everett_polynomial(
             f"they descend from {len(maxima)} distinct maxim{'um' if len(maxima) == 1 else 'a'} "
             f"({', '.join(f'{m:.4g}' for m in maxima)} V) and eq. (5) needs at least "
             f"{degree} spread over the range. {_FIX}, whose sinusoids rise to 24 "
-            "different maxima, or lower the degree."
+            f"different maxima, or lower the degree.{_ANY}"
         )
     fitted = dict(zip(free, coef, strict=True))
     if zero_diagonal:
@@ -335,6 +347,7 @@ def identify_preisach(
     voltage_range=None,
     zero_diagonal=True,
     tolerance=None,
+    fit_method="auto",
 ) -> PreisachFit:
     """Identify the classical Preisach model from a record, as in Section III-A.
 
@@ -357,20 +370,36 @@ def identify_preisach(
         ``X(v, v)`` makes the output step at each reversal (tables always have it 0).
     tolerance : float, optional
         Dead band of the turning-point search (V); see :func:`find_reversal_curves`.
+    fit_method : {"auto", "reversal-curves", "least-squares"}, default "auto"
+        ``"reversal-curves"``: the paper's fit of X to the samples of eq. (2) read off the
+        first-order descending curves. ``"least-squares"``: the model's output fitted to
+        the whole record with a non-negative Preisach density
+        (:mod:`hystcomp.identify.preisach_lsq`); any record that sweeps the range will do.
+        ``"auto"``: the reversal curves when the record has them from at least
+        :data:`AUTO_MIN_MAXIMA` distinct maxima (as the response to ``hystcomp excite
+        preisach`` has: 24), else least squares.
 
     Returns
     -------
     PreisachFit
         ``output_offset`` is the least-squares constant between the record and the model
-        (the sensor offset), over the record from the first visit to its minimum on.
+        (the sensor offset), over the record from the first visit to its minimum on
+        (reversal curves) or to an end of its range (least squares). ``report["fit"]``
+        names the fit used.
 
     Raises
     ------
     IdentificationError
-        If the record holds no first-order descending curve, or too few to fit X.
+        If the record cannot determine X: for the reversal curves, no first-order descending
+        curve or too few; for least squares, an input that does not move.
     """
     owner = "identify_preisach"
     degree, grid_size = _check_options(degree, everett, grid_size, zero_diagonal, owner)
+    if fit_method not in FIT_METHODS:
+        raise InvalidParameterError(
+            f"The 'fit_method' parameter of {owner} must be one of "
+            f"{', '.join(map(repr, FIT_METHODS))}. Got {fit_method!r} instead."
+        )
     curves = find_reversal_curves(v, x, tolerance=tolerance)
     v = np.ascontiguousarray(v, dtype=np.float64).reshape(-1)
     x = np.ascontiguousarray(x, dtype=np.float64).reshape(-1)
@@ -390,11 +419,19 @@ def identify_preisach(
                 f"which spans {data_range[0]:g}..{data_range[1]:g} V. Got "
                 f"{voltage_range[0]:g}..{voltage_range[1]:g} V; widen it or pass None."
             )
+    if fit_method == "auto":
+        span = voltage_range[1] - voltage_range[0]
+        n_maxima = len(_distinct(np.array([c.alpha for c in curves]), 1e-3 * span))
+        fit_method = "reversal-curves" if n_maxima >= AUTO_MIN_MAXIMA else "least-squares"
+    if fit_method == "least-squares":
+        return _least_squares(
+            v, x, curves, degree, everett, grid_size, voltage_range, zero_diagonal
+        )
     if not curves:
         raise IdentificationError(
             "The record holds no first-order descending reversal curve (eq. 2): the input "
             f"never rises from its minimum ({data_range[0]:g} V) to a maximum and falls back. "
-            f"{_FIX}: sinusoids of growing amplitude, each from v_min, and identify from it."
+            f"{_FIX}: sinusoids of growing amplitude, each from v_min, and identify from it.{_ANY}"
         )
     lo, hi = voltage_range
     alpha, beta, value = everett_samples(curves, v_min=lo, bin_width=(hi - lo) / N_BINS)
@@ -410,7 +447,7 @@ def identify_preisach(
             raise IdentificationError(
                 f"The reversal curves descend from {len(maxima)} distinct maximum "
                 f"({maxima[0]:.4g} V); a table of X needs curves from several maxima "
-                f"spread over the range. {_FIX}."
+                f"spread over the range. {_FIX}.{_ANY}"
             )
         theta = None
         table = fit_everett_table(alpha, beta, value, grid_size=grid_size, voltage_range=(lo, hi))
@@ -431,11 +468,59 @@ def identify_preisach(
     on_diagonal = np.empty_like(diagonal)
     pk.everett_many(packed, diagonal, diagonal, on_diagonal)
     report = {
+        "fit": "reversal-curves",
         "n_curves": len(curves),
         "maxima_V": [round(c.alpha, 9) for c in curves],
         "everett_rms_um": float(np.sqrt(np.mean((model_everett - value) ** 2))),
         "record_rms_um": float(np.sqrt(np.mean(residual**2))),
         "record_max_um": float(np.abs(residual).max()),
         "diagonal_max_um": float(np.abs(on_diagonal).max()),
+    }
+    return PreisachFit(theta, table, (lo, hi), offset, report)
+
+
+def _least_squares(v, x, curves, degree, everett, grid_size, voltage_range, zero_diagonal):
+    """:func:`identify_preisach` by density-constrained least squares over the whole record."""
+    if not zero_diagonal:
+        raise InvalidParameterError(
+            "zero_diagonal=False is the paper's unconstrained fit to reversal curves; the "
+            "least-squares fit keeps X(v, v) = 0 (eq. 2), which a non-negative density implies. "
+            "Pass zero_diagonal=True, or fit_method='reversal-curves' with a record of first-order "
+            "descending curves (`hystcomp excite preisach`)."
+        )
+    if everett == "table" and grid_size > MAX_LSQ_GRID:
+        raise InvalidParameterError(
+            f"The 'grid_size' parameter of identify_preisach must be at most {MAX_LSQ_GRID} for "
+            f"the least-squares fit, whose {grid_size * (grid_size - 1) // 2} cell masses would "
+            f"make a dense problem too large to solve. Got {grid_size}; use a coarser grid "
+            "(25 puts a node every 5 V on 0..120 V) or the polynomial."
+        )
+    theta, table, offset, fit_report = fit_preisach_lsq(
+        v, x, everett=everett, degree=degree, grid_size=grid_size, voltage_range=voltage_range
+    )
+    lo, hi = voltage_range
+    kind, coef = (
+        (pk.POLYNOMIAL, pk.coefficient_matrix(theta, degree))
+        if table is None
+        else (
+            pk.TABLE,
+            table,
+        )
+    )
+    packed = pk.pack_preisach(
+        kind=kind, coef=coef, v_min=lo, v_max=hi, offset=offset, depth=pk.DEFAULT_DEPTH
+    )
+    model_x = np.empty_like(v)
+    pk.preisach_run(packed, v, model_x)
+    start = fit_report["first_used_sample"]
+    residual = x[start:] - model_x[start:]
+    report = {
+        "fit": "least-squares",
+        "n_curves": len(curves),
+        "maxima_V": [round(c.alpha, 9) for c in curves],
+        **fit_report,
+        "record_rms_um": float(np.sqrt(np.mean(residual**2))),
+        "record_max_um": float(np.abs(residual).max()),
+        "diagonal_max_um": 0.0,
     }
     return PreisachFit(theta, table, (lo, hi), offset, report)

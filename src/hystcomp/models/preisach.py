@@ -72,6 +72,14 @@ class Preisach(HysteresisModel):
         Bound of the memory (stored extrema, ``beta_0`` included). When a reversal would
         exceed it the innermost stored minor loop is wiped out first; the default is far
         beyond what measured signals reach.
+    fit_method : {"auto", "reversal-curves", "least-squares"}, default "auto"
+        How ``fit`` identifies X: ``"reversal-curves"`` is the paper's fit to the
+        first-order descending curves of the record (Section III-A, the response to
+        ``hystcomp excite preisach``); ``"least-squares"`` fits the model's output over the
+        whole record, any record that sweeps the range, with a non-negative Preisach
+        density (so every branch rises and the exact inverse exists); ``"auto"`` takes the
+        reversal curves when the record has them from 8 or more maxima, else least squares.
+        See :func:`~hystcomp.identify.preisach.identify_preisach`.
 
     Attributes
     ----------
@@ -96,7 +104,15 @@ class Preisach(HysteresisModel):
     """
 
     kind = "preisach"
-    _hyper = ("degree", "everett", "grid_size", "voltage_range", "zero_diagonal", "max_extrema")
+    _hyper = (
+        "degree",
+        "everett",
+        "grid_size",
+        "voltage_range",
+        "zero_diagonal",
+        "max_extrema",
+        "fit_method",
+    )
     _learned = ("voltage_range", "output_offset", "theta", "table")
 
     def __init__(
@@ -108,6 +124,7 @@ class Preisach(HysteresisModel):
         voltage_range=None,
         zero_diagonal=True,
         max_extrema=pk.DEFAULT_DEPTH,
+        fit_method="auto",
     ):
         self.degree = degree
         self.everett = everett
@@ -115,6 +132,7 @@ class Preisach(HysteresisModel):
         self.voltage_range = voltage_range
         self.zero_diagonal = zero_diagonal
         self.max_extrema = max_extrema
+        self.fit_method = fit_method
 
     @classmethod
     def from_parameters(
@@ -168,8 +186,9 @@ class Preisach(HysteresisModel):
         Parameters
         ----------
         v, x : array_like
-            Input voltage (V) and displacement (µm), e.g. the response to
-            ``hystcomp excite preisach``.
+            Input voltage (V) and displacement (µm): the response to
+            ``hystcomp excite preisach`` for the paper's fit, or any record that sweeps the
+            range for least squares (``fit_method``).
 
         Returns
         -------
@@ -185,6 +204,7 @@ class Preisach(HysteresisModel):
             grid_size=self.grid_size,
             voltage_range=self.voltage_range,
             zero_diagonal=self.zero_diagonal,
+            fit_method=self.fit_method,
         )
         self.theta_ = None if result.theta is None else _frozen(result.theta)
         self.table_ = None if result.table is None else _frozen(result.table)

@@ -1,0 +1,267 @@
+"""Identification of the classical Preisach model from any record, by least squares.
+
+The paper identifies the Everett function of eq. (5) from first-order descending reversal
+curves (:mod:`hystcomp.identify.preisach`). Any record determines it, though: given the
+input's memory of alternating dominant extrema with the wipe-out property (eqs. 3-4), the
+output of a Preisach model at each sample is a sum of Everett differences over the memory
+staircase, so for an Everett function that is linear in its parameters,
+``X = sum_m c_m X_m``, the output ``x[k] = x_0 + sum_m c_m R_m[k]`` is linear in ``c`` and
+``x_0``. :func:`~hystcomp.preisach_kernels.preisach_rows` computes the regressors
+``R_m[k]`` (eqs. 3-4 with ``X_m`` alone) in one pass over the record, and the normal
+equations are accumulated block by block, as :mod:`hystcomp.identify.lsq` does for PI.
+
+Two bases (see :func:`~hystcomp.preisach_kernels.everett_basis`):
+
+* ``"polynomial"``: eq. (5)'s monomials of any degree with ``X(v, v) = 0`` built in (eq. 2);
+* ``"table"``: non-negative masses on the cells of a uniform grid of the limiting triangle
+  and on its diagonal segments, whose Everett function is exactly the bilinear interpolation
+  of its values on the grid nodes: the table representation of :class:`~hystcomp.Preisach`.
+
+The fit is constrained to a non-negative Preisach density ``mu = -d2X / (dalpha dbeta)``
+(and a non-negative reversible part ``dX/dalpha`` on the diagonal): then every branch of
+the model rises with the input (``dX/dalpha = X_alpha(alpha, alpha) + integral of mu >= 0``)
+and the exact inverse exists. For the table this holds exactly (the unknowns are the
+masses); for the polynomial it is enforced on a grid of ``(alpha, beta)`` points.
+
+The memory starts with every relay off at ``v_min`` (as the model does), and only the
+samples from the first time the input reaches an end of its range
+(:func:`~hystcomp.identify.scoring.transient_end`) enter the fit: from there on the memory
+is known whatever state the actuator started in.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from hystcomp import preisach_kernels as pk
+from hystcomp.errors import IdentificationError
+from hystcomp.identify.lsq import solve_inequality_qp
+from hystcomp.identify.scoring import transient_end
+
+#: Largest work of a Gram accumulation, rows * (p + 2)**2: beyond it rows are taken at a
+#: stride (but at least :data:`MIN_ROWS` rows). A rate-independent loop is described by far
+#: fewer samples than a 20 kHz record holds; the stride only thins the noise averaging.
+GRAM_BUDGET = 5e8
+MIN_ROWS = 5_000
+#: Largest table for least squares: (n - 1) n / 2 unknowns in a dense quadratic programme.
+MAX_LSQ_GRID = 41
+#: Rows per block of the Gram accumulation.
+BLOCK = 1024
+#: Points per axis of the grid on which a polynomial's density is kept non-negative.
+DENSITY_GRID = 25
+#: Weight of the table's smoothness penalty, relative to the mean diagonal of the normal matrix.
+SMOOTHING = 1e-3
+
+
+class EverettBasis:
+    """A linear Everett function ``X = sum_m c_m X_m`` over the Preisach plane ``[lo, hi]``.
+
+    Parameters
+    ----------
+    everett : {"polynomial", "table"}
+        Monomials vanishing on the diagonal, or masses on a grid's cells and diagonal.
+    degree : int
+        Degree of the polynomial (3 is eq. 5).
+    grid_size : int
+        Nodes per axis of the table (``grid_size - 1`` segments of the range).
+    voltage_range : (float, float)
+        The Preisach plane in V.
+    """
+
+    def __init__(self, everett: str, *, degree: int, grid_size: int, voltage_range):
+        self.everett = everett
+        self.degree = degree
+        self.grid_size = grid_size
+        self.lo, self.hi = (float(v) for v in voltage_range)
+        if everett == "polynomial":
+            self.kind = pk.BASIS_POLYNOMIAL
+            free = [(i, j) for i, j in pk.monomial_exponents(degree) if j > 0]
+            self.exps = np.array(free, dtype=np.int64).reshape(-1, 2)
+            self.n_seg = 0
+            self.size = len(free)
+        else:
+            self.kind = pk.BASIS_CELLS
+            self.exps = np.zeros((0, 2), dtype=np.int64)
+            self.n_seg = grid_size - 1
+            self.size = self.n_seg * (self.n_seg + 1) // 2
+
+    def evaluate(self, alpha, beta) -> np.ndarray:
+        """``X_m(alpha, beta)`` for every basis element, shape ``(n, size)``."""
+        alpha, beta = np.broadcast_arrays(np.asarray(alpha, float), np.asarray(beta, float))
+        out = np.empty((alpha.size, self.size))
+        for k, (a, b) in enumerate(zip(alpha.ravel(), beta.ravel(), strict=True)):
+            pk.everett_basis(self.kind, self.exps, self.n_seg, self.lo, self.hi, a, b, out[k])
+        return out
+
+    def rows(self, v, x, *, start=0, stride=1, block=BLOCK):
+        """Regressor rows ``[R_0 .. R_(p-1), 1, x]`` of samples ``start, start + stride, ...``,
+        in blocks of at most ``block`` rows (a generator of views on one buffer)."""
+        v = np.ascontiguousarray(v, dtype=np.float64)
+        x = np.ascontiguousarray(x, dtype=np.float64)
+        depth = pk.DEFAULT_DEPTH
+        e = np.zeros(depth)
+        e[0] = self.lo
+        memory = (e, np.zeros((depth, self.size)), np.array([0.0, self.lo]))
+        buffer = np.empty((block, self.size + 2))
+        k = 0
+        while k < v.size:
+            k, count = pk.preisach_rows(
+                self.kind,
+                self.exps,
+                self.n_seg,
+                self.lo,
+                self.hi,
+                v,
+                x,
+                k,
+                start,
+                stride,
+                memory,
+                buffer,
+            )
+            if count:
+                yield buffer[:count]
+
+    def design(self, v, x=None, *, start=0, stride=1) -> np.ndarray:
+        """The regressors ``R`` as a dense ``(rows, size)`` matrix (for small records)."""
+        x = np.zeros(len(v)) if x is None else x
+        parts = [
+            block[:, : self.size].copy() for block in self.rows(v, x, start=start, stride=stride)
+        ]
+        return np.concatenate(parts) if parts else np.zeros((0, self.size))
+
+    def normal_equations(self, v, x, *, start=0, stride=1) -> np.ndarray:
+        """The augmented Gram matrix ``[R | 1 | x]^T [R | 1 | x]`` over the chosen rows."""
+        gram = np.zeros((self.size + 2, self.size + 2))
+        for block in self.rows(v, x, start=start, stride=stride):
+            pk.gram_update(block, block.shape[0], gram)
+        return np.triu(gram) + np.triu(gram, 1).T
+
+    def density_constraints(self) -> np.ndarray:
+        """Rows ``A`` with ``A c >= 0`` iff the density (and the reversible part) is >= 0.
+
+        Table: the masses themselves. Polynomial, in unit-square coordinates ``a, b``:
+        ``-d2X/(da db) >= 0`` on a triangular grid of :data:`DENSITY_GRID` points per axis
+        (diagonal included) and ``dX/da (v, v) >= 0`` on the diagonal; between the points
+        a polynomial of low degree cannot dip far below 0.
+        """
+        if self.kind == pk.BASIS_CELLS:
+            return np.eye(self.size)
+        g = np.linspace(0.0, 1.0, DENSITY_GRID)
+        ia, ib = np.tril_indices(g.size)
+        a, b = g[ia], g[ib]
+        i, j = self.exps[:, 0], self.exps[:, 1]
+        mixed = -(i * j) * _power(b[:, None], i - 1) * _power(a[:, None], j - 1)
+        reversible = j * _power(g[:, None], i + j - 1)
+        return np.vstack([mixed, reversible])
+
+    def smoothness_penalty(self) -> np.ndarray:
+        """``D^T D`` of first differences of the density between neighbouring cells, and of the
+        reversible part between neighbouring diagonal segments (zero for the polynomial)."""
+        if self.kind == pk.BASIS_POLYNOMIAL:
+            return np.zeros((self.size, self.size))
+        n = self.n_seg
+        index = {}
+        for s in range(n):
+            index[("d", s)] = s
+        m = n
+        for sa in range(1, n):
+            for sb in range(sa):
+                index[(sa, sb)] = m
+                m += 1
+        pairs = [(index[("d", s)], index[("d", s + 1)]) for s in range(n - 1)]
+        for sa in range(1, n):
+            for sb in range(sa):
+                if sa + 1 < n:
+                    pairs.append((index[(sa, sb)], index[(sa + 1, sb)]))
+                if sb + 1 < sa:
+                    pairs.append((index[(sa, sb)], index[(sa, sb + 1)]))
+        diff = np.zeros((len(pairs), self.size))
+        for r, (p, q) in enumerate(pairs):
+            diff[r, p], diff[r, q] = 1.0, -1.0
+        return diff.T @ diff
+
+    def to_model(self, coef):
+        """``(theta, table)`` of :class:`~hystcomp.Preisach` for the coefficients ``coef``."""
+        span = self.hi - self.lo
+        if self.kind == pk.BASIS_POLYNOMIAL:
+            fitted = {(int(i), int(j)): float(c) for (i, j), c in zip(self.exps, coef, strict=True)}
+            for k in range(1, self.degree + 1):
+                fitted[(k, 0)] = -sum(fitted[(k - j, j)] for j in range(1, k + 1))
+            exps = pk.monomial_exponents(self.degree)
+            return np.array([fitted[(i, j)] / span ** (i + j) for i, j in exps]), None
+        nodes = np.linspace(self.lo, self.hi, self.grid_size)
+        ia, ib = np.tril_indices(self.grid_size)
+        lower = np.zeros((self.grid_size, self.grid_size))
+        lower[ia, ib] = self.evaluate(nodes[ia], nodes[ib]) @ coef
+        return None, pk.antisymmetric_table(lower)
+
+
+def _power(base, exponent):
+    """``base ** exponent`` with ``0 ** 0 = 1`` and a zero where the exponent is negative."""
+    exponent = np.broadcast_to(exponent, np.broadcast_shapes(np.shape(base), np.shape(exponent)))
+    out = np.where(exponent >= 0, np.power(base, np.maximum(exponent, 0)), 0.0)
+    return out
+
+
+def fit_preisach_lsq(v, x, *, everett, degree, grid_size, voltage_range, start=None):
+    """Fit a Preisach model to a record by density-constrained least squares.
+
+    Parameters
+    ----------
+    v, x : ndarray
+        Validated input (V) and output (µm) of the same length.
+    everett : {"polynomial", "table"}
+        The representation of X.
+    degree, grid_size : int
+        Its size.
+    voltage_range : (float, float)
+        The Preisach plane (V), containing the record.
+    start : int, optional
+        First sample of the fit; default :func:`~hystcomp.identify.scoring.transient_end`.
+
+    Returns
+    -------
+    theta, table : ndarray or None
+        One of them, as :meth:`~hystcomp.Preisach.from_parameters` takes them.
+    offset : float
+        ``x_0`` in µm.
+    report : dict
+        ``first_used_sample``, ``n_rows``, ``stride``, ``density_min``.
+
+    Raises
+    ------
+    IdentificationError
+        If the record after the start-up transient does not move the input.
+    """
+    basis = EverettBasis(everett, degree=degree, grid_size=grid_size, voltage_range=voltage_range)
+    start = transient_end(v) if start is None else int(start)
+    used = v.size - start
+    lo, hi = voltage_range
+    if used < 2 or np.ptp(v[start:]) <= 1e-9 * (hi - lo):
+        raise IdentificationError(
+            "After the start-up transient (first sample used: "
+            f"{start}) the input does not move, so it traces no hysteresis. Record the "
+            "actuator while the voltage sweeps its range (any waveform: `hystcomp excite "
+            "preisach`, `hystcomp excite pi`, or a random one)."
+        )
+    max_rows = max(MIN_ROWS, int(GRAM_BUDGET / (basis.size + 2) ** 2))
+    stride = max(1, math.ceil(used / max_rows))
+    gram = basis.normal_equations(v, x, start=start, stride=stride)
+    penalty = basis.smoothness_penalty()
+    if np.any(penalty):
+        count = gram[-2, -2]
+        mean = gram[-2, : basis.size] / count
+        centred = np.diag(gram[: basis.size, : basis.size]) - count * mean**2
+        penalty *= SMOOTHING * max(float(centred.mean()), 0.0) / float(np.diag(penalty).mean())
+    coef, _ = solve_inequality_qp(gram, basis.density_constraints(), penalty=penalty)
+    theta, table = basis.to_model(coef[:-1])
+    report = {
+        "first_used_sample": int(start),
+        "n_rows": int(gram[-2, -2]),
+        "stride": int(stride),
+        "density_min": float((basis.density_constraints() @ coef[:-1]).min()),
+    }
+    return theta, table, float(coef[-1]), report
