@@ -18,6 +18,23 @@ max tracking errors (µm, over the periods after the first) and saves a figure.
 Run it with ``python examples/closed_loop_feedforward.py [--out DIR] [--quick]``; it needs
 ``pip install "hystcomp[control]"``. ``--quick`` (used by the tests) runs only 50 Hz, with a
 coarser identification.
+
+It printed (rms and max error in µm; seed 0)::
+
+     f (Hz)  method        rms (µm)  max (µm)
+          1  feedback         0.216     0.382
+          1  feedforward      0.857     1.693
+          1  both             0.045     0.163
+         10  feedback         2.022     2.908
+         10  feedforward      0.885     1.743
+         10  both             0.254     0.917
+         50  feedback         7.076     9.582
+         50  feedforward      1.200     2.715
+         50  both             0.801     2.426
+
+The feedforward cuts the loop's rms error 4.7x at 1 Hz, 8.0x at 10 Hz and 8.8x at 50 Hz: the
+loop alone lags a ramp by ``slope / (ki * gain)`` and its bandwidth is capped by the
+resonance, while with the feedforward it only has to correct the model's residual error.
 """
 
 from __future__ import annotations

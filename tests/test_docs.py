@@ -39,6 +39,14 @@ def test_readme_python_block_runs_as_written(tmp_path, monkeypatch):
     assert namespace["model"].fit_report_["rms_error_um"] >= 0.0
 
 
+def test_user_guide_first_python_block_runs(tmp_path, monkeypatch):
+    code = next(b for b in blocks(ROOT / "docs" / "guide.md", "python") if "import hystcomp" in b)
+    monkeypatch.chdir(tmp_path)
+    namespace: dict = {}
+    exec(compile(code, "docs/guide.md", "exec"), namespace)  # noqa: S102 - our own guide
+    assert (tmp_path / "model.json").is_file()
+
+
 @pytest.mark.skipif(shutil.which("cc") is None, reason="needs a C compiler (cc)")
 def test_tutorial_from_record_to_c_runs_block_by_block(tmp_path):
     (tmp_path / "tests").symlink_to(ROOT / "tests")
