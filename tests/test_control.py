@@ -112,3 +112,13 @@ def test_a_new_kind_plugs_in_with_one_function(monkeypatch):
 
     sys = hystcomp.to_control(Gain(), DT)
     np.testing.assert_array_equal(_response(sys, np.array([1.0, 2.0, 3.0])), [2.0, 4.0, 6.0])
+
+
+def test_the_twin_as_a_system_equals_twin_run_noise_included():
+    from hystcomp.plant import Twin
+
+    v = _signal(3000, seed=4)
+    sys = hystcomp.to_control(Twin(seed=5), DT)
+    np.testing.assert_allclose(_response(sys, v), Twin(seed=5).run(v), rtol=0, atol=1e-12)
+    with pytest.raises(InvalidParameterError, match="twin's sample time"):
+        hystcomp.to_control(Twin(), 1e-3)
