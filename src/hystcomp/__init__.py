@@ -4,6 +4,9 @@ Implements the Preisach, Prandtl-Ishlinskii (PI) and Modified Prandtl-Ishlinskii
 models and their inverse-based compensators of "Experimental model inverse-based hysteresis
 compensation on a piezoelectric actuator". Units: V, µm, s.
 
+The names below are imported on first use (PEP 562), so that ``import hystcomp`` and the
+command line's ``--help`` do not load numba and SciPy before anything is asked of them.
+
 >>> import hystcomp
 >>> model = hystcomp.presets.paper_mpi()
 >>> comp = model.inverse()
@@ -12,17 +15,30 @@ compensation on a piezoelectric actuator". Units: V, µm, s.
 True
 """
 
-from hystcomp import errors, presets
-from hystcomp.data import Record, read_record
-from hystcomp.io import load_model, save_model
-from hystcomp.models.compensator import Compensator, Stepper
-from hystcomp.models.mpi import ModifiedPrandtlIshlinskii
-from hystcomp.models.pi import PrandtlIshlinskii
-from hystcomp.models.preisach import Preisach
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING
 
 __version__ = "0.1.0"
 
-__all__ = [
+#: Public name -> (module, attribute in it; None for the module itself).
+_LAZY = {
+    "Compensator": ("hystcomp.models.compensator", "Compensator"),
+    "ModifiedPrandtlIshlinskii": ("hystcomp.models.mpi", "ModifiedPrandtlIshlinskii"),
+    "PrandtlIshlinskii": ("hystcomp.models.pi", "PrandtlIshlinskii"),
+    "Preisach": ("hystcomp.models.preisach", "Preisach"),
+    "Record": ("hystcomp.data", "Record"),
+    "Stepper": ("hystcomp.models.compensator", "Stepper"),
+    "errors": ("hystcomp.errors", None),
+    "load_model": ("hystcomp.io", "load_model"),
+    "presets": ("hystcomp.presets", None),
+    "read_record": ("hystcomp.data", "read_record"),
+    "save_model": ("hystcomp.io", "save_model"),
+    "to_control": ("hystcomp.control", "to_control"),
+}
+
+__all__ = [  # written out for static tools; tests/test_cli_lazy.py checks it against _LAZY
     "Compensator",
     "ModifiedPrandtlIshlinskii",
     "PrandtlIshlinskii",
@@ -35,4 +51,31 @@ __all__ = [
     "presets",
     "read_record",
     "save_model",
+    "to_control",
 ]
+
+if TYPE_CHECKING:  # what static tools see; at run time __getattr__ imports on first use
+    from hystcomp import errors, presets
+    from hystcomp.control import to_control
+    from hystcomp.data import Record, read_record
+    from hystcomp.io import load_model, save_model
+    from hystcomp.models.compensator import Compensator, Stepper
+    from hystcomp.models.mpi import ModifiedPrandtlIshlinskii
+    from hystcomp.models.pi import PrandtlIshlinskii
+    from hystcomp.models.preisach import Preisach
+
+
+def __getattr__(name: str):
+    try:
+        module, attribute = _LAZY[name]
+    except KeyError:
+        raise AttributeError(f"module 'hystcomp' has no attribute {name!r}") from None
+    value = importlib.import_module(module)
+    if attribute is not None:
+        value = getattr(value, attribute)
+    globals()[name] = value  # later look-ups do not come here again
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *__all__})

@@ -200,6 +200,11 @@ def _real_array(value, *, copy: bool) -> np.ndarray:
             probe = np.asarray(value)
             if probe.dtype.kind not in "iufO":
                 raise TypeError(f"values of dtype {probe.dtype}")
+            # an object array (e.g. a pandas text column) converts "1.5" silently: refuse text
+            if probe.dtype.kind == "O" and any(
+                isinstance(item, str | bytes | bool | np.bool_) for item in probe.flat
+            ):
+                raise TypeError("text or booleans among the values")
             if copy:
                 return np.array(probe, dtype=np.float64)
             return np.asarray(probe, dtype=np.float64)

@@ -30,12 +30,10 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-import scipy.io
 
 from hystcomp._formats import read_raw
 from hystcomp._validation import MAX_MAGNITUDE, as_path, as_signal, check_int, check_real
 from hystcomp.errors import DataFileError, InvalidParameterError, InvalidSignalError
-from hystcomp.io import atomic_path
 
 #: What each column holds, for messages.
 MEANINGS = {"t": "time in s", "v": "voltage in V", "x": "displacement in µm"}
@@ -94,6 +92,23 @@ class Record:
     def sample_rate(self) -> float:
         """Samples per second (from the median time step), Hz."""
         return rate_of(self.t)
+
+    def to_frame(self):
+        """The record as a ``pandas.DataFrame`` with columns ``t`` (s), ``v`` (V), ``x`` (µm).
+
+        pandas is optional (``pip install "hystcomp[pandas]"``); the frame holds copies, and
+        its columns go back into ``fit``, ``simulate`` or ``score`` as they are.
+        """
+        try:
+            import pandas as pd
+        except ImportError:
+            raise ImportError(
+                "Record.to_frame needs pandas, an optional dependency. Install it with: "
+                "pip install 'hystcomp[pandas]' (or pip install pandas)."
+            ) from None
+        frame = pd.DataFrame({"t": self.t.copy(), "v": self.v.copy(), "x": self.x.copy()})
+        frame.attrs["source"] = self.source
+        return frame
 
 
 def rate_of(t) -> float:
@@ -402,6 +417,8 @@ def write_table(path, table: dict) -> None:
     table : dict of str to array_like
         Column name to values, e.g. ``{"t": t, "v": v, "x": x}``.
     """
+    from hystcomp.io import atomic_path  # imported here: reading a record needs no model
+
     path = check_writable(path)
     suffix = path.suffix.lower()
     cols = _columns(table, "write_table")
@@ -418,5 +435,7 @@ def write_table(path, table: dict) -> None:
         if suffix == ".npz":
             np.savez(buffer, **cols)
         else:
+            import scipy.io  # imported here: only MAT output needs it
+
             scipy.io.savemat(buffer, {k: v.reshape(-1, 1) for k, v in cols.items()})
         tmp.write_bytes(buffer.getvalue())

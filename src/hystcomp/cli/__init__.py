@@ -9,6 +9,7 @@ standard error that names the problem and the fix, no traceback), 1 on an intern
 from __future__ import annotations
 
 import contextlib
+import importlib
 import os
 import sys
 
@@ -25,8 +26,80 @@ def _one_line(text: str) -> str:
     return " ".join(str(text).split())
 
 
+#: Subcommand -> (its module, the first line of its help). A module is imported only when its
+#: command runs or shows its own help, so that ``hystcomp --help``, a mistyped command and
+#: shell completion load neither numba nor SciPy (tests/test_cli_lazy.py checks that this
+#: table matches the commands).
+COMMANDS = {
+    "compare": (
+        "hystcomp.cli.compare",
+        "Identify the Preisach, PI and MPI models on the twin and compare the four methods.",
+    ),
+    "compensate": (
+        "hystcomp.cli.compensate",
+        "Voltage that makes the actuator of MODEL.json follow REFERENCE (columns t, x).",
+    ),
+    "excite": (
+        "hystcomp.cli.excite",
+        "Write the identification input for MODEL (pi, mpi or preisach).",
+    ),
+    "export-c": (
+        "hystcomp.cli.export_c",
+        "Write MODEL_FILE's compensator as C99 code: NAME.h and NAME.c in folder -o.",
+    ),
+    "identify": (
+        "hystcomp.cli.identify",
+        "Identify a hysteresis model from DATA (columns t, v, x) and write it as JSON.",
+    ),
+    "simulate": (
+        "hystcomp.cli.simulate",
+        "Run the model in MODEL.json on the voltage in INPUT (columns t, v).",
+    ),
+}
+
+
 class _Group(click.Group):
-    """A click group that turns bad usage and hystcomp's errors into one line and exit 2."""
+    """A click group that turns bad usage and hystcomp's errors into one line and exit 2.
+
+    Its subcommands are imported lazily from :data:`COMMANDS`; each module registers its
+    command on :data:`main` when imported.
+    """
+
+    def list_commands(self, ctx):
+        return sorted({*COMMANDS, *self.commands})
+
+    def get_command(self, ctx, cmd_name):
+        if cmd_name not in self.commands and cmd_name in COMMANDS:
+            importlib.import_module(COMMANDS[cmd_name][0])
+        return self.commands.get(cmd_name)
+
+    def _short_helps(self, limit: int) -> list[tuple[str, str]]:
+        """(name, short help) of every command, importing none that is not loaded yet."""
+        out = []
+        for name in self.list_commands(None):
+            command = self.commands.get(name)
+            if command is None:
+                stand_in = click.Command(name, help=COMMANDS[name][1])  # shortened as click does
+                out.append((name, stand_in.get_short_help_str(limit)))
+            elif not command.hidden:
+                out.append((name, command.get_short_help_str(limit)))
+        return out
+
+    def format_commands(self, ctx, formatter):
+        rows = self._short_helps(formatter.width - 6 - max(map(len, self.list_commands(ctx))))
+        if rows:
+            with formatter.section("Commands"):
+                formatter.write_dl(rows)
+
+    def shell_complete(self, ctx, incomplete):
+        from click.shell_completion import CompletionItem
+
+        items = [
+            CompletionItem(name, help=text)
+            for name, text in self._short_helps(45)
+            if name.startswith(incomplete)
+        ]
+        return items + click.Command.shell_complete(self, ctx, incomplete)
 
     def main(self, args=None, prog_name=None, complete_var=None, standalone_mode=True, **extra):
         try:
@@ -74,7 +147,3 @@ def main() -> None:
 
     Units: voltage in V, displacement in µm, time in s.
     """
-
-
-# The subcommands register themselves on main when imported.
-from hystcomp.cli import compare, compensate, excite, export_c, identify, simulate  # noqa: F401

@@ -11,10 +11,10 @@ import math
 import click
 
 from hystcomp._validation import MAX_MAGNITUDE
-from hystcomp.data import check_writable, parse_columns
 from hystcomp.errors import InvalidParameterError
-from hystcomp.io import check_output_path
-from hystcomp.models.preisach import INVERSE_METHODS
+
+# hystcomp.data, hystcomp.io and the models are imported where they are used: a command that
+# needs no kernel (``excite``) then loads neither numba nor SciPy's sparse solvers.
 
 #: Largest --operators / --deadzones (the paper uses 16; the fit's cost grows as n^2 per sample).
 MAX_OPERATORS = 1000
@@ -86,6 +86,8 @@ def voltage_range(ctx, param, value):
 
 def columns(ctx, param, value):
     """A callback: a column mapping such as ``v=1,x=5`` (see :func:`parse_columns`)."""
+    from hystcomp.data import parse_columns
+
     try:
         return parse_columns(value)
     except InvalidParameterError as exc:
@@ -131,17 +133,25 @@ def read_options(columns: dict | None, sample_rate: float | None) -> dict:
 
 def check_data_output(path, *, inputs=(), what: str = "output"):
     """Refuse, before any work, a data output that cannot be written or would overwrite an input."""
+    from hystcomp.data import check_writable
+    from hystcomp.io import check_output_path
+
     check_output_path(path, inputs=inputs, what=what)
     return check_writable(path)
 
 
-method_option = click.option(
-    "--method",
-    type=click.Choice(INVERSE_METHODS),
-    default=None,
-    help="Preisach models only: the inverse multiplicative structure (eq. 10) or the exact "
-    "inverse [multiplicative].",
-)
+def __getattr__(name: str):
+    if name == "method_option":  # built on first use: its choices come from the Preisach model
+        from hystcomp.models.preisach import INVERSE_METHODS
+
+        return click.option(
+            "--method",
+            type=click.Choice(INVERSE_METHODS),
+            default=None,
+            help="Preisach models only: the inverse multiplicative structure (eq. 10) or the "
+            "exact inverse [multiplicative].",
+        )
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 def method_options(model, model_file, method) -> dict:

@@ -5,7 +5,14 @@ The array-level functions that the models' ``fit`` methods delegate to:
 (eq. 19), both constrained least squares (:mod:`hystcomp.identify.lsq`).
 """
 
-from hystcomp.identify.mpi import MPIFit, fit_mpi
-from hystcomp.identify.pi import PIFit, fit_pi
+import importlib
 
 __all__ = ["MPIFit", "PIFit", "fit_mpi", "fit_pi"]
+_MODULES = {"MPIFit": "mpi", "fit_mpi": "mpi", "PIFit": "pi", "fit_pi": "pi"}
+
+
+def __getattr__(name: str):
+    # Imported on first use, so that the excitation signals load no kernel.
+    if name in _MODULES:
+        return getattr(importlib.import_module(f"hystcomp.identify.{_MODULES[name]}"), name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

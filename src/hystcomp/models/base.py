@@ -2,12 +2,20 @@
 
 from __future__ import annotations
 
+import inspect
 from typing import Any, ClassVar
 
 import numpy as np
 
 from hystcomp import operators
-from hystcomp._validation import as_vector, check_int, check_range, check_real, check_thresholds
+from hystcomp._validation import (
+    as_signal_pair,
+    as_vector,
+    check_int,
+    check_range,
+    check_real,
+    check_thresholds,
+)
 from hystcomp.errors import InvalidParameterError, NotFittedError
 from hystcomp.identify.pi import check_margin
 from hystcomp.models.compensator import ChainSystem, Compensator
@@ -20,13 +28,41 @@ class HysteresisModel(ChainSystem):
     """Base of the forward models: voltage (V) in, displacement (µm) out.
 
     Subclasses list their learned parameters in ``_learned`` (names without the trailing
-    underscore) and their hyperparameters in ``_hyper``; the learned attributes end in ``_``
-    as in scikit-learn. A model without learned parameters can only be fitted.
+    underscore); the learned attributes end in ``_`` as in scikit-learn. The hyperparameters
+    are the keyword parameters of the subclass's ``__init__``, which stores each unchanged
+    under its own name (validation waits for ``fit``): :meth:`get_params`, :meth:`set_params`,
+    the model file and ``repr`` read them from the signature, so a new hyperparameter is
+    written once. That is scikit-learn's estimator contract, without importing it:
+    ``sklearn.base.clone``, grid searches and pipelines work on these models, and
+    :meth:`score` is the coefficient of determination of the predicted displacement.
+    A model without learned parameters can only be fitted.
     """
 
     kind: ClassVar[str]
-    _hyper: ClassVar[tuple[str, ...]]
     _learned: ClassVar[tuple[str, ...]]
+
+    @classmethod
+    def _get_param_names(cls) -> tuple[str, ...]:
+        """The hyperparameter names: the parameters of ``__init__``, in their order."""
+        names = []
+        for param in inspect.signature(cls.__init__).parameters.values():
+            if param.name == "self":
+                continue
+            if param.kind in (param.VAR_POSITIONAL, param.VAR_KEYWORD):
+                raise TypeError(  # a programming error in a subclass, not a user's
+                    f"{cls.__name__}.__init__ must name its hyperparameters explicitly "
+                    f"(no *args or **kwargs); found {param}."
+                )
+            names.append(param.name)
+        return tuple(names)
+
+    @classmethod
+    def _param_defaults(cls) -> dict[str, Any]:
+        return {
+            name: param.default
+            for name, param in inspect.signature(cls.__init__).parameters.items()
+            if name != "self"
+        }
 
     def _check_fitted(self) -> None:
         if not hasattr(self, self._learned[0] + "_"):
@@ -37,9 +73,75 @@ class HysteresisModel(ChainSystem):
                 "hystcomp.load_model(path)."
             )
 
-    def get_params(self) -> dict[str, Any]:
-        """The hyperparameters given to ``__init__``."""
-        return {name: getattr(self, name) for name in self._hyper}
+    def get_params(self, deep: bool = True) -> dict[str, Any]:
+        """The hyperparameters, as given to ``__init__`` (scikit-learn's contract).
+
+        Parameters
+        ----------
+        deep : bool, default True
+            Accepted for scikit-learn; these models hold no nested estimators.
+
+        Returns
+        -------
+        dict
+            Name to value, in the order of ``__init__``'s signature.
+        """
+        return {name: getattr(self, name) for name in self._get_param_names()}
+
+    def set_params(self, **params) -> HysteresisModel:
+        """Set hyperparameters by name (checked in :meth:`fit`, as in scikit-learn).
+
+        Learned attributes stay as they are until the next :meth:`fit`.
+
+        Returns
+        -------
+        HysteresisModel
+            ``self``.
+
+        Raises
+        ------
+        InvalidParameterError
+            If a name is not a hyperparameter of this model.
+
+        Examples
+        --------
+        >>> from hystcomp import PrandtlIshlinskii
+        >>> PrandtlIshlinskii().set_params(n_operators=8)
+        PrandtlIshlinskii(n_operators=8, unfitted)
+        """
+        valid = self._get_param_names()
+        for name, value in params.items():
+            if name not in valid:
+                raise InvalidParameterError(
+                    f"{name!r} is not a hyperparameter of {type(self).__name__}. Valid "
+                    f"hyperparameters are: {', '.join(valid)}. Check the spelling."
+                )
+            setattr(self, name, value)
+        return self
+
+    def score(self, v, x) -> float:
+        """Coefficient of determination R² of the displacement predicted for ``v``.
+
+        ``1 - sum((x - x_hat)^2) / sum((x - mean(x))^2)`` with ``x_hat = simulate(v)``, as
+        scikit-learn's regressors score; 1 is a perfect prediction. Like
+        ``sklearn.metrics.r2_score``, a constant ``x`` scores 1.0 if predicted exactly,
+        else 0.0.
+
+        Parameters
+        ----------
+        v, x : array_like
+            Input voltage (V) and measured displacement (µm), one sample each per instant.
+
+        Returns
+        -------
+        float
+        """
+        v, x = as_signal_pair(v, x, ("v", "x"), f"{type(self).__name__}.score")
+        residual = float(np.sum((x - self.simulate(v)) ** 2))
+        total = float(np.sum((x - x.mean()) ** 2))
+        if total == 0.0:
+            return 1.0 if residual == 0.0 else 0.0
+        return 1.0 - residual / total
 
     def parameters(self) -> dict[str, Any]:
         """The learned parameters as plain Python values (lists and floats)."""
@@ -75,11 +177,27 @@ class HysteresisModel(ChainSystem):
             )
         model = cls.from_parameters(**data["parameters"])
         for name, value in data.get("hyperparameters", {}).items():
-            if name in cls._hyper:
+            if name in cls._get_param_names():
                 setattr(model, name, value)
         if "fit_report" in data:
             model.fit_report_ = dict(data["fit_report"])
         return model
+
+    _estimator_type = "regressor"  # what scikit-learn < 1.6 reads
+
+    def __sklearn_tags__(self):
+        """scikit-learn's description (>= 1.6): a regressor of 1-D signals.
+
+        Called only by scikit-learn, so importing it here adds no dependency.
+        """
+        from sklearn.utils import InputTags, RegressorTags, Tags, TargetTags
+
+        return Tags(
+            estimator_type="regressor",
+            target_tags=TargetTags(required=True, one_d_labels=True),
+            input_tags=InputTags(one_d_array=True, two_d_array=False),
+            regressor_tags=RegressorTags(),
+        )
 
     def _clamp_range(self, voltage_range, owner: str) -> tuple[float, float]:
         """The compensator's clamp: ``voltage_range_``, or a ``voltage_range`` inside it.
@@ -108,9 +226,24 @@ class HysteresisModel(ChainSystem):
         self.fit_report_ = fit_report
 
     def __repr__(self) -> str:
-        args = ", ".join(f"{k}={v!r}" for k, v in self.get_params().items())
-        state = "" if hasattr(self, self._learned[0] + "_") else ", unfitted"
-        return f"{type(self).__name__}({args}{state})"
+        """Only the hyperparameters that differ from their defaults, as scikit-learn shows."""
+        defaults = self._param_defaults()
+        args = [f"{k}={v!r}" for k, v in self.get_params().items() if _differs(v, defaults[k])]
+        if not hasattr(self, self._learned[0] + "_"):
+            args.append("unfitted")
+        return f"{type(self).__name__}({', '.join(args)})"
+
+
+def _differs(value, default) -> bool:
+    """Whether a hyperparameter differs from its default (for ``repr``)."""
+    if value is default:
+        return False
+    if type(value) is not type(default):
+        return True
+    try:
+        return not bool(value == default)
+    except (TypeError, ValueError):  # e.g. an array's ambiguous truth value
+        return True
 
 
 def set_common_parameters(model, owner, *, voltage_range, input_offset, output_offset):

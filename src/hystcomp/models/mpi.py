@@ -81,14 +81,6 @@ class ModifiedPrandtlIshlinskii(HysteresisModel):
     """
 
     kind = "mpi"
-    _hyper = (
-        "n_operators",
-        "n_deadzones",
-        "voltage_range",
-        "transient",
-        "margin",
-        "regularization",
-    )
     _learned = (
         "thresholds",
         "weights",

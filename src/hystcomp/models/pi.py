@@ -73,7 +73,6 @@ class PrandtlIshlinskii(HysteresisModel):
     """
 
     kind = "pi"
-    _hyper = ("n_operators", "voltage_range", "transient", "margin")
     _learned = (
         "thresholds",
         "weights",

@@ -104,15 +104,6 @@ class Preisach(HysteresisModel):
     """
 
     kind = "preisach"
-    _hyper = (
-        "degree",
-        "everett",
-        "grid_size",
-        "voltage_range",
-        "zero_diagonal",
-        "max_extrema",
-        "fit_method",
-    )
     _learned = ("voltage_range", "output_offset", "theta", "table")
 
     def __init__(

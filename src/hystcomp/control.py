@@ -1,0 +1,262 @@
+"""Models and compensators as python-control systems, for simulation and closed loops.
+
+:func:`to_control` wraps a hysteresis model (voltage V -> displacement µm) or a compensator
+(reference µm -> voltage V) as a discrete-time ``control.NonlinearIOSystem`` whose state
+is the object's packed state, stepped by the same kernel as ``simulate``; so
+``control.input_output_response`` reproduces ``simulate`` (to rounding, in practice bit for
+bit), and the system composes with python-control's linear controllers and plants in
+``control.interconnect``. Signals are named as in the rest of the package: a model has input
+``v`` and output ``x``, a compensator input ``x_ref`` and output ``v``, so a compensator and
+a model connect by name.
+
+python-control is an optional dependency (``pip install "hystcomp[control]"``), imported
+only when :func:`to_control` is called.
+
+The simulated axis (:class:`hystcomp.plant.Twin`) converts too (input ``v``, output ``x``,
+the noisy sensor reading), so a whole loop can be simulated with python-control.
+
+Another kind of object plugs in with one function that describes it, at sample time ``dt``,
+as a :class:`DiscreteSystem`, registered for its class with :func:`register`::
+
+    @register(MyDynamics)
+    def _dynamics(obj, dt):
+        return DiscreteSystem(state=obj.initial_state(dt), update=..., output=...,
+                              inputs=("v",), outputs=("x",))
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from hystcomp._validation import check_real
+from hystcomp.errors import InvalidParameterError, InvalidTypeError
+
+__all__ = ["DiscreteSystem", "register", "to_control"]
+
+
+@dataclass(frozen=True)
+class DiscreteSystem:
+    """A single-input, single-output discrete-time system as :func:`to_control` needs it.
+
+    Attributes
+    ----------
+    state : ndarray
+        The initial state ``s[0]`` (1-D float64).
+    update : callable
+        ``update(s, u) -> s_next``: the state after applying input ``u`` in state ``s``.
+    output : callable
+        ``output(s, u) -> y``: the output for input ``u`` in state ``s`` (direct feedthrough
+        allowed).
+    inputs, outputs : tuple of str
+        Signal names.
+    """
+
+    state: np.ndarray
+    update: Callable[[np.ndarray, float], np.ndarray]
+    output: Callable[[np.ndarray, float], float]
+    inputs: tuple[str, ...]
+    outputs: tuple[str, ...]
+
+
+Adapter = Callable[[object, float], DiscreteSystem]
+
+#: (class, function) pairs: how to describe an object of that class as a DiscreteSystem.
+_ADAPTERS: list[tuple[type, Adapter]] = []
+
+
+def register(cls: type):
+    """Decorator: ``function(obj, dt) -> DiscreteSystem`` describes the instances of ``cls``.
+
+    ``dt`` is the sample time in s that :func:`to_control` was given. A later registration
+    wins over an earlier one and over the built-in kinds.
+    """
+
+    def decorate(function):
+        _ADAPTERS.append((cls, function))
+        return function
+
+    return decorate
+
+
+def _stepped(stepper, inputs: tuple[str, ...], outputs: tuple[str, ...]) -> DiscreteSystem:
+    """A packed system (any :class:`~hystcomp.models.compensator.Stepper`) as a DiscreteSystem.
+
+    The state is the packed array's state part, from ``kernels.state_start`` to its end; one
+    step of the stepper's own kernel gives both the output and the next state.
+    """
+    start = stepper._start
+    work = stepper._p  # this private stepper is the scratch space of the two functions
+
+    def step(s: np.ndarray, u: np.ndarray) -> float:
+        work[start:] = s
+        return stepper.step(float(np.ravel(u)[0]))
+
+    def update(s, u):
+        step(s, u)
+        return work[start:].copy()
+
+    def output(s, u):
+        return step(s, u)
+
+    return DiscreteSystem(
+        state=np.array(stepper._initial[start:]),
+        update=update,
+        output=output,
+        inputs=inputs,
+        outputs=outputs,
+    )
+
+
+def _twin(twin, dt: float) -> DiscreteSystem:
+    """The simulated axis: the kernel of ``Twin.run``, the sensor noise drawn per sample.
+
+    The state is the axis's state, then a sample counter; the noise of sample ``k`` comes from
+    a generator seeded with the twin's seed, so a response is reproducible whatever python-
+    control evaluates. The sensor reads the axis before the sample's voltage acts, so the
+    output does not depend on the input (no algebraic loop in feedback).
+    """
+    from hystcomp.plant import _kernels as kernels
+
+    rate = twin.sample_rate
+    if abs(dt * rate - 1.0) > 1e-9:
+        raise InvalidParameterError(
+            f"The 'dt' parameter of to_control must be the twin's sample time 1/{rate:g} s "
+            f"= {1.0 / rate:g} s. Got {dt:g} s; build a Twin with another sample_rate instead."
+        )
+    params = twin.params
+    sigma = params.sensor_noise / params.sensor_gain
+    rng = np.random.default_rng(twin.seed)
+    noise = np.empty(0)
+
+    def noise_at(k: int) -> float:
+        nonlocal noise
+        while k >= noise.size:  # grows in order, so the draws do not depend on the calls
+            noise = np.concatenate([noise, rng.standard_normal(4096)])
+        return float(noise[k])
+
+    def update(s, u):
+        nxt = s.copy()
+        kernels.twin_step(twin._p, nxt[:-1], float(np.ravel(u)[0]))
+        nxt[-1] += 1.0
+        return nxt
+
+    def output(s, u):
+        # the reading before u acts: the input does not matter
+        x = kernels.twin_step(twin._p, s[:-1].copy(), float(np.ravel(u)[0]))
+        return x + params.sensor_offset + sigma * noise_at(int(s[-1]))
+
+    return DiscreteSystem(
+        state=np.append(twin._rest, 0.0),
+        update=update,
+        output=output,
+        inputs=("v",),
+        outputs=("x",),
+    )
+
+
+def _builtin_adapters() -> list[tuple[type, Adapter]]:
+    # Imported here so that importing this module loads no kernel.
+    from hystcomp.models.base import HysteresisModel
+    from hystcomp.models.compensator import Compensator
+    from hystcomp.plant import Twin
+
+    def _model(obj, dt) -> DiscreteSystem:
+        return _stepped(obj.stepper(), ("v",), ("x",))
+
+    def _compensator(obj, dt) -> DiscreteSystem:
+        return _stepped(obj.stepper(), ("x_ref",), ("v",))
+
+    return [(HysteresisModel, _model), (Compensator, _compensator), (Twin, _twin)]
+
+
+def _import_control():
+    try:
+        import control
+    except ImportError:
+        raise ImportError(
+            "hystcomp.to_control needs python-control, an optional dependency. Install it "
+            "with: pip install 'hystcomp[control]' (or pip install control)."
+        ) from None
+    return control
+
+
+def describe(obj, dt: float) -> DiscreteSystem:
+    """The :class:`DiscreteSystem` of ``obj`` at sample time ``dt`` (s), by its adapter."""
+    adapters = _builtin_adapters() + _ADAPTERS
+    for cls, function in reversed(adapters):  # the latest registration wins
+        if isinstance(obj, cls):
+            return function(obj, dt)
+    kinds = ", ".join(sorted({cls.__name__ for cls, _ in adapters}))
+    raise InvalidTypeError(
+        f"The 'obj' parameter of to_control must be a hysteresis model or a compensator "
+        f"(registered kinds: {kinds}). Got {type(obj).__name__}; build one with fit, "
+        "load_model or model.inverse()."
+    )
+
+
+def to_control(obj, dt, *, name=None, inputs=None, outputs=None):
+    """A discrete-time ``control.NonlinearIOSystem`` that runs a model or a compensator.
+
+    Parameters
+    ----------
+    obj : HysteresisModel, Compensator or Twin
+        A fitted model (input ``v`` in V, output ``x`` in µm), a compensator (input
+        ``x_ref`` in µm, output ``v`` in V, clamped to its voltage range as always), or the
+        simulated axis (input ``v``, output the sensor's reading ``x``), or an object of a
+        kind added with :func:`register`.
+    dt : float
+        Sample time in s (``1 / sample_rate``; the twin's is 5e-5). A compensator built with
+        a slew-rate limit should be given the ``sample_rate`` it was built for.
+    name : str, optional
+        System name for ``control.interconnect``.
+    inputs, outputs : str, optional
+        Other signal names than the defaults above.
+
+    Returns
+    -------
+    control.NonlinearIOSystem
+        One input, one output; its state is the object's packed state, starting at the
+        initial state (``sys.x0``), so ``control.input_output_response(sys, T, U, X0=sys.x0)``
+        equals ``obj.simulate(U)``.
+
+    Raises
+    ------
+    ImportError
+        If python-control is not installed (``pip install 'hystcomp[control]'``).
+    InvalidTypeError
+        If ``obj`` is of no registered kind.
+
+    Notes
+    -----
+    The state is as large as the packed state: two slots per operator of a chain, and
+    about twice ``max_extrema`` for a Preisach system (whose memory is bounded, see
+    :class:`~hystcomp.models.preisach.Preisach`); ``input_output_response`` keeps the
+    state of every sample, so for long Preisach runs prefer ``return_x=False``.
+
+    Examples
+    --------
+    >>> import numpy as np, control, hystcomp
+    >>> model = hystcomp.presets.paper_mpi()
+    >>> sys = hystcomp.to_control(model, 5e-5)
+    >>> v = np.array([0.0, 60.0, 120.0, 30.0])
+    >>> res = control.input_output_response(sys, 5e-5 * np.arange(4), v, X0=sys.x0)
+    >>> bool(np.allclose(res.outputs, model.simulate(v), rtol=0, atol=1e-12))
+    True
+    """
+    dt = check_real(dt, "dt", "to_control", positive=True)
+    system = describe(obj, dt)
+    control = _import_control()
+    sys = control.NonlinearIOSystem(
+        lambda t, s, u, params: system.update(s, u),
+        lambda t, s, u, params: np.array([system.output(s, u)]),
+        inputs=[inputs] if inputs else list(system.inputs),
+        outputs=[outputs] if outputs else list(system.outputs),
+        states=system.state.size,
+        dt=dt,
+        name=name,
+    )
+    sys.x0 = system.state.copy()
+    return sys

@@ -1,0 +1,76 @@
+"""The documentation runs as written: the README's Python block, the tutorial, the examples."""
+
+from __future__ import annotations
+
+import os
+import re
+import runpy
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def blocks(path: Path, language: str) -> list[str]:
+    """The fenced code blocks of ``language`` in a Markdown file, in order."""
+    text = path.read_text(encoding="utf-8")
+    return re.findall(rf"^```{language}\n(.*?)^```", text, flags=re.MULTILINE | re.DOTALL)
+
+
+def _env() -> dict:
+    env = dict(os.environ)
+    env["PATH"] = os.pathsep.join([str(Path(sys.executable).parent), env.get("PATH", "")])
+    env["MPLBACKEND"] = "Agg"
+    return env
+
+
+def test_readme_python_block_runs_as_written(tmp_path, monkeypatch):
+    (code,) = [b for b in blocks(ROOT / "README.md", "python") if "import hystcomp" in b]
+    monkeypatch.chdir(tmp_path)
+    namespace: dict = {}
+    exec(compile(code, "README.md", "exec"), namespace)  # noqa: S102 - our own README
+    assert (tmp_path / "model.json").is_file()
+    x_ref, v = namespace["x_ref"], namespace["v"]
+    assert v.shape == x_ref.shape
+    assert namespace["model"].fit_report_["rms_error_um"] >= 0.0
+
+
+def test_user_guide_first_python_block_runs(tmp_path, monkeypatch):
+    code = next(b for b in blocks(ROOT / "docs" / "guide.md", "python") if "import hystcomp" in b)
+    monkeypatch.chdir(tmp_path)
+    namespace: dict = {}
+    exec(compile(code, "docs/guide.md", "exec"), namespace)  # noqa: S102 - our own guide
+    assert (tmp_path / "model.json").is_file()
+
+
+@pytest.mark.skipif(shutil.which("cc") is None, reason="needs a C compiler (cc)")
+def test_tutorial_from_record_to_c_runs_block_by_block(tmp_path):
+    (tmp_path / "tests").symlink_to(ROOT / "tests")
+    steps = blocks(ROOT / "docs" / "tutorial.md", "bash")
+    assert len(steps) >= 6
+    for step in steps:
+        done = subprocess.run(
+            ["bash", "-euo", "pipefail", "-c", step],
+            cwd=tmp_path,
+            env=_env(),
+            capture_output=True,
+            text=True,
+            check=False,
+        )
+        assert done.returncode == 0, f"{step}\n{done.stdout}\n{done.stderr}"
+    assert (tmp_path / "firmware" / "stage_x").is_file()
+
+
+def test_closed_loop_example_quick(tmp_path, capsys):
+    module = runpy.run_path(str(ROOT / "examples" / "closed_loop_feedforward.py"))
+    results = module["main"](tmp_path, quick=True)
+    rows = results[50.0]
+    # the feedforward removes most of the loop's error at 50 Hz, and the loop adds to it
+    assert rows["both"][0] < 0.3 * rows["feedback"][0]
+    assert rows["both"][0] < rows["feedforward"][0]
+    assert (tmp_path / "closed_loop_feedforward.png").stat().st_size > 10_000
+    assert "feedforward cuts the loop's rms error" in capsys.readouterr().out

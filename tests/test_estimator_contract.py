@@ -1,0 +1,102 @@
+"""scikit-learn's estimator contract on the models, checked with scikit-learn itself."""
+
+from __future__ import annotations
+
+import inspect
+
+import numpy as np
+import pytest
+from sklearn.base import clone
+from sklearn.metrics import r2_score
+from sklearn.model_selection import GridSearchCV
+
+from hystcomp import ModifiedPrandtlIshlinskii, PrandtlIshlinskii, Preisach, presets
+from hystcomp.errors import InvalidParameterError
+from hystcomp.identify.excitation import triangle_sequence
+
+ESTIMATORS = [PrandtlIshlinskii, ModifiedPrandtlIshlinskii, Preisach]
+
+
+def _signature_names(cls):
+    return [p for p in inspect.signature(cls.__init__).parameters if p != "self"]
+
+
+@pytest.mark.parametrize("cls", ESTIMATORS)
+def test_get_params_is_the_init_signature_in_order(cls):
+    est = cls()
+    assert list(est.get_params()) == _signature_names(cls)
+    assert est.get_params(deep=True) == est.get_params(deep=False)
+    defaults = {name: p.default for name, p in inspect.signature(cls.__init__).parameters.items()}
+    for name, value in est.get_params().items():
+        assert value is defaults[name]  # stored unchanged
+
+
+@pytest.mark.parametrize("cls", ESTIMATORS)
+def test_sklearn_clone_gives_an_equal_unfitted_estimator(cls):
+    name = _signature_names(cls)[0]
+    value = {"n_operators": 7, "degree": 2}[name]
+    est = cls().set_params(**{name: value})
+    twin = clone(est)
+    assert twin is not est
+    assert type(twin) is cls
+    assert twin.get_params() == est.get_params()
+    assert twin.get_params()[name] == value
+
+
+def test_clone_of_a_fitted_model_is_unfitted():
+    est = presets.paper_mpi()
+    twin = clone(est)
+    assert repr(twin).endswith("unfitted)")
+    assert not hasattr(twin, "weights_")
+
+
+def test_set_params_returns_self_and_refuses_unknown_names():
+    est = PrandtlIshlinskii()
+    assert est.set_params(n_operators=5, margin=0.01) is est
+    assert est.n_operators == 5
+    assert est.margin == 0.01
+    with pytest.raises(InvalidParameterError, match=r"'n_operator' is not a hyperparameter.*"):
+        est.set_params(n_operator=3)
+    with pytest.raises(ValueError, match="n_operators, voltage_range"):
+        est.set_params(bogus=1)
+
+
+def test_hyperparameters_are_validated_in_fit_not_init():
+    est = PrandtlIshlinskii(n_operators=0)  # no error yet, as in scikit-learn
+    _, v = triangle_sequence([60.0, 120.0], sample_rate=500)
+    with pytest.raises(InvalidParameterError, match="'n_operators' parameter"):
+        est.fit(v, 0.3 * v)
+
+
+def test_repr_shows_only_what_differs_from_the_defaults():
+    assert repr(PrandtlIshlinskii()) == "PrandtlIshlinskii(unfitted)"
+    est = ModifiedPrandtlIshlinskii(n_deadzones=8, regularization=0.0)
+    assert repr(est) == "ModifiedPrandtlIshlinskii(n_deadzones=8, regularization=0.0, unfitted)"
+    est = ModifiedPrandtlIshlinskii(voltage_range=(0.0, 120.0))
+    assert repr(est) == "ModifiedPrandtlIshlinskii(voltage_range=(0.0, 120.0), unfitted)"
+    assert repr(Preisach(degree=3)) == "Preisach(unfitted)"
+    fitted = presets.paper_mpi()
+    assert "unfitted" not in repr(fitted)
+
+
+def test_score_is_r2_of_the_predicted_displacement():
+    model = presets.paper_mpi()
+    rng = np.random.default_rng(3)
+    _, v = triangle_sequence([40.0, 120.0, 80.0], sample_rate=400)
+    x_true = model.simulate(v)
+    x_noisy = x_true + rng.normal(0.0, 0.5, v.size)
+    assert model.score(v, x_true) == pytest.approx(1.0, abs=1e-15)
+    expected = r2_score(x_noisy, x_true)
+    assert model.score(v, x_noisy) == pytest.approx(expected, rel=1e-12)
+    assert 0.9 < expected < 1.0
+    # a constant record: 0.0 unless predicted exactly, as r2_score
+    assert model.score(v, np.full(v.size, 3.0)) == 0.0
+
+
+def test_grid_search_chooses_hyperparameters_through_the_contract():
+    true = presets.paper_mpi()
+    _, v = triangle_sequence([120.0, 60.0, 120.0, 90.0], sample_rate=300)  # halves span 0..120
+    x = true.simulate(v)
+    search = GridSearchCV(PrandtlIshlinskii(), {"n_operators": [2, 16]}, cv=2).fit(v, x)
+    assert search.best_params_ == {"n_operators": 16}
+    assert search.best_estimator_.score(v, x) > 0.99
