@@ -26,11 +26,12 @@ from hystcomp.io import MODEL_KINDS, atomic_paths, check_output_path, model_text
 DEFAULT_OPERATORS = 16
 
 #: What each --model builds, and which size options it takes.
-LABELS = {"pi": "PI", "mpi": "MPI", "preisach": "Preisach"}
+LABELS = {"pi": "PI", "mpi": "MPI", "preisach": "Preisach", "dynamics": "dynamics"}
 SIZE_OPTIONS = {
     "pi": ("operators",),
     "mpi": ("operators", "deadzones", "regularization"),
     "preisach": ("degree",),
+    "dynamics": (),
 }
 
 
@@ -176,6 +177,17 @@ def identify(
         check_output_path(plot, inputs=(data,), what="figure")
         if Path(plot).resolve() == Path(output).resolve():
             raise click.BadParameter("names the same file as -o.", param_hint="--plot")
+    if kind == "dynamics":  # linear dynamics: a record of 'hystcomp excite dynamics'
+        from hystcomp.cli._dynamics import identify_dynamics
+
+        given = {"--operators": operators, "--deadzones": deadzones, "--degree": degree}
+        given.update({"--regularization": regularization, "--transient": transient})
+        given.update({"--voltage-range": voltage_range, "--holdout": holdout})
+        for name, value in given.items():
+            if value is not None:
+                raise click.UsageError(f"{name} does not apply to --model dynamics.")
+        identify_dynamics(read_record(data, **read_options(columns, sample_rate)), output, plot)
+        return
     model = build_estimator(
         kind,
         operators=operators,

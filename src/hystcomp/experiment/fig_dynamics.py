@@ -1,0 +1,56 @@
+"""Figures of the linear dynamics: the Bode plot of an identified model, a step and hold."""
+
+from __future__ import annotations
+
+import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+
+
+def plot_bode(model, path, *, measured=None) -> None:
+    """Bode plot of ``model`` (magnitude in dB, phase in degrees) from 1 Hz to 0.45 fs.
+
+    ``measured`` is an optional ``(frequencies, response)`` pair drawn as dots; by default
+    nothing measured is drawn.
+    """
+    f = np.geomspace(1.0, 0.45 * model.sample_rate_, 600)
+    d = model.frequency_response(f)
+    fig = Figure(figsize=(6.4, 5.2))
+    FigureCanvasAgg(fig)
+    mag, phase = fig.subplots(2, 1, sharex=True)
+    mag.semilogx(f, 20 * np.log10(np.abs(d)), label="model D (unit steady-state gain)")
+    phase.semilogx(f, np.degrees(np.unwrap(np.angle(d))))
+    if measured is not None:
+        fm, g = measured
+        mag.semilogx(fm, 20 * np.log10(np.abs(g)), ".", ms=3, label="measured")
+        phase.semilogx(fm, np.degrees(np.unwrap(np.angle(g))), ".", ms=3)
+    mag.set_ylabel("magnitude (dB)")
+    phase.set_ylabel("phase (deg)")
+    phase.set_xlabel("frequency (Hz)")
+    mag.set_title(
+        f"Linear dynamics: {model.resonance_hz_:.4g} Hz, zeta {model.damping_ratio_:.3g}, "
+        f"creep {100 * model.creep_fraction(0.0):.2g} %"
+    )
+    mag.grid(True, which="both", alpha=0.3)
+    phase.grid(True, which="both", alpha=0.3)
+    mag.legend(loc="lower left")
+    fig.tight_layout()
+    fig.savefig(path)
+
+
+def plot_step(t, x_ref, runs: dict, path) -> None:
+    """Step-and-hold: the tracking error of each run (``{label: x}``) against time (log)."""
+    fig = Figure(figsize=(6.4, 4.0))
+    FigureCanvasAgg(fig)
+    ax = fig.subplots()
+    start = int(np.flatnonzero(np.diff(x_ref))[0]) + 1
+    for label, x in runs.items():
+        ax.semilogx(t[start + 1 :] - t[start], (x - x_ref)[start + 1 :], label=label)
+    ax.axhline(0.0, color="k", lw=0.5)
+    ax.set_xlabel("time after the step (s)")
+    ax.set_ylabel("tracking error (µm)")
+    ax.set_title("Step and hold on the simulated axis with creep")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(path)
