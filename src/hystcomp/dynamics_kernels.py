@@ -55,7 +55,10 @@ def inverse_step(p, u):
     acc = w * p[SCALE]
     for i in range(n_creep):
         acc -= p[c + i] * p[a + i] * p[lags + i]
-    y = min(max(acc / p[DIRECT], p[LOW]), p[HIGH])
+    y = acc / p[DIRECT]
+    if not math.isfinite(y):  # a huge finite reference overflowed: held downstream
+        return math.nan
+    y = min(max(y, p[LOW]), p[HIGH])
     for i in range(n_creep):
         ai = p[a + i]
         p[lags + i] = ai * p[lags + i] + (1.0 - ai) * y

@@ -50,7 +50,7 @@ from hystcomp._validation import as_signal, as_vector, check_int, check_real
 from hystcomp.errors import InvalidParameterError, NotFittedError
 
 #: Default low-pass of the inverse, as a multiple of the resonance (capped at 0.4 fs).
-BANDWIDTH_FACTOR = 3.0
+BANDWIDTH_FACTOR = 2.0
 #: Largest preview of the inverse in samples (half the low-pass length plus 2).
 MAX_PREVIEW = 64
 
