@@ -5,7 +5,7 @@ the resonance with its sampling zero reflected, ZPETC, times a linear-phase low-
 series with the exact inverse of the creep bank. Its parameters and state are one packed
 float64 array, as the chain's (:mod:`hystcomp.operators`)::
 
-    [N_FIR, N_CREEP, SCALE, DIRECT, LOW, HIGH, h_0 .. h_{N_FIR-1}, a_1 .. a_n, c_1 .. c_n,
+    [N_FIR, N_CREEP, SCALE, DIRECT, LOW, HIGH, BIAS, h_0 .. h_{N_FIR-1}, a_1 .. a_n, c_1 .. c_n,
      delay line (N_FIR samples, newest first), creep lag states (n)]
 
 The creep bank of the forward model is ``D_c[q] = (q + sum_i c_i lag_i) / SCALE`` with
@@ -15,7 +15,8 @@ root of any polynomial is computed, so creep poles a hair below 1 stay exact. Th
 is clamped to ``[LOW, HIGH]`` (the hysteresis model's displacement range), so that the
 hysteresis inverse downstream never takes a memory the actuator cannot follow; the creep
 lags follow the clamped output. Kernels trust
-their input.
+their input. The FIR's output is ``BIAS + sum_j h_j u[k - j]`` (a gain other than 1 at
+0 Hz, about a rest point, is a scaling of the taps and a bias).
 """
 
 from __future__ import annotations
@@ -24,8 +25,8 @@ import math
 
 from hystcomp.operators import _kernel, step_kernel
 
-N_FIR, N_CREEP, SCALE, DIRECT, LOW, HIGH = range(6)
-HEADER = 6
+N_FIR, N_CREEP, SCALE, DIRECT, LOW, HIGH, BIAS = range(7)
+HEADER = 7
 
 
 @_kernel
@@ -49,7 +50,7 @@ def inverse_step(p, u):
     for j in range(n_fir - 1, 0, -1):
         p[d + j] = p[d + j - 1]
     p[d] = u
-    w = 0.0
+    w = p[BIAS]
     for j in range(n_fir):
         w += p[h + j] * p[d + j]
     acc = w * p[SCALE]

@@ -48,7 +48,7 @@ def add_dynamics(template: CTemplate, inverse) -> CTemplate:
         f"/* inverse of the linear dynamics; x_ref is {inverse.preview} samples ahead */",
         "{",
         "    int j;",
-        "    double w = 0.0;",
+        f"    double w = {c_double(p[dk.BIAS])};",
         "    double y;",
         f"    for (j = {n_fir - 1}; j > 0; j--) {{",
         "        s->dyn_line[j] = s->dyn_line[j - 1];",
