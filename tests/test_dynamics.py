@@ -178,7 +178,8 @@ def test_output_clamped_and_slew_limited(compensator):
     x = _wild_reference(compensator)
     v = compensator.simulate(x)
     lo, hi = compensator.voltage_range
-    assert lo <= v.min() and v.max() <= hi
+    assert lo <= v.min()
+    assert v.max() <= hi
     assert np.abs(np.diff(v)).max() <= compensator.max_step * (1 + 1e-12)
     assert compensator.max_step == pytest.approx(2e5 / FS)
 
@@ -188,7 +189,8 @@ def test_nonfinite_reference_holds_the_voltage():
     s = comp.stepper()
     first = [s.step(u) for u in np.linspace(0.0, 10.0, 50)]
     held = s.step(np.nan)
-    assert held == first[-1] and s.nonfinite_count == 1
+    assert held == first[-1]
+    assert s.nonfinite_count == 1
     copy = s.copy()
     assert copy.step(10.0) == s.step(10.0)
 
@@ -249,7 +251,8 @@ def test_cli_round_trip(tmp_path):
          str(tmp_path / "dyn.json"), "--plot", str(tmp_path / "bode.png")],
     )  # fmt: skip
     assert result.exit_code == 0, result.output
-    assert "resonance: 7" in result.output and "fit, 20 .. " in result.output
+    assert "resonance: 7" in result.output
+    assert "fit, 20 .. " in result.output
     assert (tmp_path / "bode.png").stat().st_size > 1000
     hystcomp.save_model(hystcomp.presets.paper_mpi(), tmp_path / "mpi.json")
     t = np.arange(4000) / FS
@@ -266,9 +269,11 @@ def test_cli_round_trip(tmp_path):
     # a dynamics file as the model, and a model as --dynamics: exit 2, nothing written
     bad = run(main, ["compensate", str(tmp_path / "dyn.json"), str(tmp_path / "ref.csv"),
                      "-o", str(tmp_path / "bad.csv")])  # fmt: skip
-    assert bad.exit_code == 2 and "--dynamics" in bad.output
+    assert bad.exit_code == 2
+    assert "--dynamics" in bad.output
     bad = run(main, [*args, "--dynamics", str(tmp_path / "mpi.json"), "-o", str(tmp_path / "b")])
-    assert bad.exit_code == 2 and not (tmp_path / "b").exists()
+    assert bad.exit_code == 2
+    assert not (tmp_path / "b").exists()
     result = run(
         main,
         ["export-c", str(tmp_path / "mpi.json"), "--dynamics", str(tmp_path / "dyn.json"),
@@ -281,12 +286,14 @@ def test_cli_round_trip(tmp_path):
         ["export-c", str(tmp_path / "mpi.json"), "--dynamics", str(tmp_path / "dyn.json"),
          "--fs", "10000", "-o", str(tmp_path / "c2")],
     )  # fmt: skip
-    assert result.exit_code == 2 and "--fs" in result.output
+    assert result.exit_code == 2
+    assert "--fs" in result.output
 
 
 def test_excite_dynamics_layout():
     t, v = dynamics_excitation(sample_rate=10_000.0, voltage_range=(-10.0, 10.0))
     assert t[1] == pytest.approx(1e-4)
-    assert v[0] == -10.0 and v[round(0.3 * 10_000)] == 0.0
+    assert v[0] == -10.0
+    assert v[round(0.3 * 10_000)] == 0.0
     assert np.abs(v[-20_000:]).max() == pytest.approx(4.0)
     assert isinstance(hystcomp.presets.paper_mpi().inverse(dynamics=_stage()), DynamicCompensator)
