@@ -297,3 +297,12 @@ def test_excite_dynamics_layout():
     assert v[round(0.3 * 10_000)] == 0.0
     assert np.abs(v[-20_000:]).max() == pytest.approx(4.0)
     assert isinstance(hystcomp.presets.paper_mpi().inverse(dynamics=_stage()), DynamicCompensator)
+
+
+def test_twin_creep_rises_about_equally_per_decade():
+    twin = Twin(creep_twin(sensor_noise=0.0, damping_ratio=0.7))
+    v = np.r_[0.0, np.full(round(20.0 * FS), 60.0)]
+    x = twin.run(v)
+    at = {t: x[round(t * FS)] for t in (0.01, 0.1, 1.0, 10.0)}
+    per_decade = np.diff([at[t] for t in sorted(at)]) / x[-1]
+    assert np.all((0.003 < per_decade) & (per_decade < 0.006))  # 0.5 % a decade, +-40 %

@@ -51,9 +51,10 @@ Notes
   the paper's +0.9). Lighter damping makes the 50 Hz runs ring through whole periods.
 * Creep: a piezo stage held after a step keeps moving by a few percent, about equally per
   decade of time (``x(t) ~ x_0 (1 + gamma log10(t / t_0))``). Equal first-order lags with
-  one time constant per decade give exactly that between the shortest and the longest
-  time constant: with the default 1 ms .. 100 s and ``creep_gain = 0.03``, 0.5 % of the
-  final displacement per decade, 0.9 % of it still to come one second after a step.
+  one time constant per decade give nearly that between the shortest and the longest
+  time constant: with the default 1 ms .. 100 s and ``creep_gain = 0.03``, about 0.5 % of
+  the final displacement per decade; after a step to 60 V the displacement still rises by
+  1.0 % of its final value after 1 s, and by 1.1 % (0.18 µm) from 20 ms to 3 s.
   The paper's model of its rig (Fig. 2) has no creep, and the twin's default has none;
   ``hystcomp compare`` runs on :func:`creep_twin` (see :mod:`hystcomp.experiment.compare`).
 """
