@@ -49,7 +49,7 @@ def run() -> list[dict]:
                         "x",
                         f"<= {limit:g}",
                         ratio <= limit,
-                    )  # fmt: skip
+                    )
                 )
                 plain = dc.results[f][method].rms / c.results[1.0][method].rms
                 rows.append(_row(f"{stage}: {method} alone, rms {f:g} Hz / 1 Hz", plain))
@@ -61,7 +61,7 @@ def run() -> list[dict]:
                     "x",
                     "< 0.3",
                     step < 0.3,
-                )  # fmt: skip
+                )
             )
     start = time.perf_counter()
     run_comparison(CompareConfig(dynamics=False))
