@@ -79,8 +79,10 @@ def dynamics_excitation(
     Examples
     --------
     >>> t, v = dynamics_excitation()
-    >>> t.size, float(v.min()), round(float(v.max()), 6)
-    (124000, 0.0, 64.0)
+    >>> t.size, float(v.min()), float(v[round(1.0 * 20_000)])   # rest, then the step to 60 V
+    (124000, 0.0, 60.0)
+    >>> round(float(np.abs(v[-20_000:] - 60.0).max()), 9)          # +-4 V multisine
+    4.0
     """
     owner = "dynamics_excitation"
     fs = check_real(sample_rate, "sample_rate", owner, positive=True)

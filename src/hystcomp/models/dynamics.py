@@ -113,11 +113,11 @@ class LinearDynamics:
     >>> dyn = LinearDynamics.from_parameters(sample_rate=20_000.0, resonance_hz=780.0,
     ...     damping_ratio=0.05, creep_time_constants=[0.01, 0.1, 1.0],
     ...     creep_weights=[0.01, 0.01, 0.01])
-    >>> round(abs(dyn.frequency_response([0.0])[0]), 12)
+    >>> round(float(abs(dyn.frequency_response([0.0])[0])), 12)
     1.0
-    >>> x = dyn.simulate(np.r_[np.zeros(10), np.ones(40_000)])
-    >>> round(float(x[-1]), 3), round(float(x[200]), 3)   # after 2 s, and after 10 ms
-    (1.0, 0.981)
+    >>> x = dyn.simulate(np.r_[np.zeros(10), np.ones(100_000)])
+    >>> round(float(x[2010]), 3), round(float(x[-1]), 3)   # 0.1 s and 5 s after a unit step
+    (0.988, 1.0)
     """
 
     kind: ClassVar[str] = "dynamics"
