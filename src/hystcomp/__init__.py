@@ -16,6 +16,7 @@ from hystcomp import errors, presets
 from hystcomp.data import Record, read_record
 from hystcomp.io import load_model, save_model
 from hystcomp.models.compensator import Compensator, Stepper
+from hystcomp.models.dynamics import LinearDynamics
 from hystcomp.models.mpi import ModifiedPrandtlIshlinskii
 from hystcomp.models.pi import PrandtlIshlinskii
 from hystcomp.models.preisach import Preisach
@@ -24,6 +25,7 @@ __version__ = "0.1.0"
 
 __all__ = [
     "Compensator",
+    "LinearDynamics",
     "ModifiedPrandtlIshlinskii",
     "PrandtlIshlinskii",
     "Preisach",

@@ -167,6 +167,8 @@ def identify(
 
     PI and MPI: constrained least squares (eqs. 16-19) with invertible weights; the
     start-up transient, the input range (bipolar too) and a displacement offset are handled.
+    dynamics (beyond the paper): creep and first resonance from the answer to 'hystcomp
+    excite dynamics', for compensate/export-c --dynamics; --plot draws its Bode plot.
     """
     check_output_path(output, inputs=(data,), what="model file")
     if plot is not None:  # matplotlib is imported only when a figure is asked for
