@@ -9,15 +9,12 @@ import pytest
 from click.testing import CliRunner
 
 import hystcomp
+from hystcomp._lti import resonance_zoh
 from hystcomp.cli import main
 from hystcomp.data import read_table, write_table
 from hystcomp.errors import IdentificationError, InvalidParameterError, InvalidTypeError
-from hystcomp.identify.dynamics import dynamics_excitation, fit_dynamics
-from hystcomp.models.dynamics import (
-    DynamicCompensator,
-    LinearDynamics,
-    resonance_zoh,
-)
+from hystcomp.identify.dynamics import dynamics_excitation
+from hystcomp.models.dynamics import DynamicCompensator, LinearDynamics
 from hystcomp.plant import Twin, creep_twin
 from tests.conftest import random_walk
 from tests.test_codegen import CC, _compile, _run_c, needs_cc
@@ -44,7 +41,7 @@ def identified():
     _, v = dynamics_excitation()
     rng = np.random.default_rng(7)
     x = 0.3 * true.simulate(v, initial=0.0) + 0.003 * rng.standard_normal(v.size) - 5.0
-    return true, fit_dynamics(v, x, FS)
+    return true, LinearDynamics().fit(v, x, FS)
 
 
 def test_identification_recovers_the_frequency_response(identified):
@@ -133,7 +130,7 @@ def test_bad_parameters_are_refused():
     with pytest.raises(InvalidTypeError, match="LinearDynamics"):
         hystcomp.presets.paper_mpi().inverse(dynamics="dyn.json")
     with pytest.raises(IdentificationError, match="excite dynamics"):
-        fit_dynamics(np.r_[np.zeros(10), np.ones(100)], np.zeros(110), FS)
+        LinearDynamics().fit(np.r_[np.zeros(10), np.ones(100)], np.zeros(110), FS)
 
 
 # -- the compensator in series -----------------------------------------------------------
@@ -222,7 +219,7 @@ def test_targets_on_a_creep_stage():
 
     twin = Twin(creep_twin(resonance_hz=780.0, damping_ratio=0.05), seed=1)
     _, v = dynamics_excitation()
-    dyn = fit_dynamics(v, twin.run(v), FS)
+    dyn = LinearDynamics().fit(v, twin.run(v), FS)
     _, v = sinusoid_sequence(PI_AMPLITUDES, sample_rate=FS)
     model = hystcomp.Preisach(degree=3).fit(v, twin.run(v))
     comp = model.inverse(dynamics=dyn)

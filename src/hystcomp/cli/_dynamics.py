@@ -11,9 +11,7 @@ from hystcomp.models.dynamics import LinearDynamics
 
 def identify_dynamics(rec, output: str, plot: str | None) -> None:
     """Fit :class:`LinearDynamics` to ``rec``, print the fit, write the model (and figure)."""
-    from hystcomp.identify.dynamics import fit_dynamics
-
-    model = fit_dynamics(rec.v, rec.x, rec.sample_rate)
+    model = LinearDynamics().fit(rec.v, rec.x, rec.sample_rate)
     report = model.fit_report_
     lo, hi = report["fit_band_hz"]
     click.echo(f"linear dynamics (creep and first resonance) from {rec.source}")

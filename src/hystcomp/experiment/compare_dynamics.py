@@ -18,7 +18,8 @@ import numpy as np
 from hystcomp.data import Record
 from hystcomp.experiment.references import triangle_reference
 from hystcomp.experiment.tracking import TrackingResult, run_tracking
-from hystcomp.identify.dynamics import dynamics_excitation, fit_dynamics
+from hystcomp.identify.dynamics import dynamics_excitation
+from hystcomp.models.dynamics import LinearDynamics
 
 #: Frequencies of the rows with the dynamics (Hz): Table I's, and two faster.
 FAST_FREQUENCIES = (100.0, 200.0)
@@ -59,7 +60,7 @@ def run_dynamics(twin, models, compensators, amplitude, *, periods, frequencies)
     fs = twin.sample_rate
     t, v = dynamics_excitation(sample_rate=fs, voltage_range=twin.voltage_range)
     record = Record(t=t, v=v, x=twin.run(v), source="the twin")
-    dynamics = fit_dynamics(record.v, record.x, fs)
+    dynamics = LinearDynamics().fit(record.v, record.x, fs)
     with_dyn = {m: models[m].inverse(dynamics=dynamics) for m in WITH_DYNAMICS}
     results: dict[float, dict[str, TrackingResult]] = {}
     for f in (*frequencies, *FAST_FREQUENCIES):

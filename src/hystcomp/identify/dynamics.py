@@ -9,7 +9,7 @@ The fit, in four short stages (about 0.1 s for a 20 kHz record):
 
 1. The frequency response ``X(f) / V(f)`` at the multisine's lines, from the average of
    its periods after the first; the resonance ``(f_n, zeta)`` of
-   :class:`~hystcomp.models.dynamics.LinearDynamics` fitted to the lines above 20 Hz by
+   :class:`~hystcomp.LinearDynamics` fitted to the lines above 20 Hz by
    nonlinear least squares (``scipy.optimize.least_squares``), with the local gain of the
    hysteresis around the bias a free *complex* factor: the minor loops of a rate-independent
    hysteresis lag the input by the same phase at every frequency, and that lag belongs to
@@ -33,17 +33,28 @@ construction and costs no extra dependency.
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 
-from hystcomp._validation import as_signal_pair, check_real
-from hystcomp.errors import IdentificationError, InvalidParameterError
-from hystcomp.models.dynamics import (
-    LinearDynamics,
+from hystcomp._lti import (
+    creep_fraction,
     creep_response,
+    frequency_response,
+    output,
     resonance_response,
     resonance_zoh,
 )
+from hystcomp._validation import as_signal_pair, check_real
+from hystcomp.errors import IdentificationError, InvalidParameterError
+
+
+class DynamicsFit(NamedTuple):
+    """What :func:`fit_dynamics` found: the model's parameters and the fit report."""
+
+    parameters: dict
+    report: dict
+
 
 #: Layout of the excitation (s, V, Hz).
 REST = 0.2
@@ -125,8 +136,10 @@ def creep_grid(hold: float) -> np.ndarray:
     return np.geomspace(1e-3, hold, max(2, round(2 * decades) + 1))
 
 
-def fit_dynamics(v, x, sample_rate: float) -> LinearDynamics:
-    """Identify :class:`LinearDynamics` from the answer ``x`` (µm) to :func:`dynamics_excitation`.
+def fit_dynamics(v, x, sample_rate: float) -> DynamicsFit:
+    """Identify the linear dynamics from the answer ``x`` (µm) to :func:`dynamics_excitation`.
+
+    :meth:`hystcomp.LinearDynamics.fit` delegates here.
 
     Parameters
     ----------
@@ -137,8 +150,9 @@ def fit_dynamics(v, x, sample_rate: float) -> LinearDynamics:
 
     Returns
     -------
-    LinearDynamics
-        With ``fit_report_`` (see the module's notes).
+    DynamicsFit
+        The parameters of :meth:`~hystcomp.LinearDynamics.from_parameters` and the fit
+        report (see the module's notes).
 
     Raises
     ------
@@ -163,26 +177,18 @@ def fit_dynamics(v, x, sample_rate: float) -> LinearDynamics:
     weights, step_fit = _fit_creep(rise, fn, zeta, fs, lags)
     # the step's creep goes on through the multisine: take it out and fit again
     ramp = np.r_[np.zeros(step), np.ones(v.size - step)]
-    model = LinearDynamics.from_parameters(
-        sample_rate=fs,
-        resonance_hz=fn,
-        damping_ratio=zeta,
-        creep_time_constants=taus,
-        creep_weights=weights,
-    )
-    drift = step_fit * model.simulate(ramp, initial=0.0)
+    drift = step_fit * output(ramp, 0.0, fs, fn, zeta, lags, weights)
     measured = _frf(v, x - drift, multisine, n_period, periods, bins)
     fn, zeta = _fit_resonance(measured, lines, fs, lags, weights, guess=(fn, zeta))
     weights, step_fit = _fit_creep(rise, fn, zeta, fs, lags)
-    model = LinearDynamics.from_parameters(
-        sample_rate=fs,
-        resonance_hz=fn,
-        damping_ratio=zeta,
-        creep_time_constants=taus,
-        creep_weights=weights,
-    )
-    model.fit_report_ = _report(model, measured, lines, rise, step_fit, fs)
-    return model
+    parameters = {
+        "sample_rate": fs,
+        "resonance_hz": fn,
+        "damping_ratio": zeta,
+        "creep_time_constants": taus.tolist(),
+        "creep_weights": weights.tolist(),
+    }
+    return DynamicsFit(parameters, _report(parameters, lags, measured, lines, rise, step_fit))
 
 
 def _layout(v: np.ndarray, fs: float) -> tuple[int, int, int]:
@@ -269,25 +275,28 @@ def _fit_creep(rise, fn, zeta, fs, lags):
     return weights, float(coef.sum())
 
 
-def _report(model, measured, lines, rise, step_fit, fs) -> dict:
+def _report(parameters, lags, measured, lines, rise, step_fit) -> dict:
     """Fit % and largest magnitude error (dB) up to twice the resonance; step rms error."""
-    top = min(2.0 * model.resonance_hz_, lines.max())
+    fs, fn, zeta = (parameters[k] for k in ("sample_rate", "resonance_hz", "damping_ratio"))
+    weights = np.asarray(parameters["creep_weights"])
+    top = min(2.0 * fn, lines.max())
     use = (lines >= FIT_FROM_HZ) & (lines <= top)
-    m = model.frequency_response(lines[use])
+    m = frequency_response(lines[use], fs, fn, zeta, lags, weights)
     g = measured[use]
     gain = np.vdot(m, g) / np.vdot(m, m)
     fit = 100.0 * (1.0 - np.linalg.norm(gain * m - g) / np.linalg.norm(g - g.mean()))
     db = np.abs(20.0 * np.log10(np.abs(gain * m) / np.abs(g)))
     unit = np.r_[0.0, np.ones(rise.size - 1)]
-    step_model = step_fit * model.simulate(unit, initial=0.0)
+    step_model = step_fit * output(unit, 0.0, fs, fn, zeta, lags, weights)
     step_rms = float(np.sqrt(np.mean((step_model - rise) ** 2)))
+    after_1s = creep_fraction(1.0, parameters["creep_time_constants"], weights)
     return {
         "fit_percent": float(fit),
         "max_magnitude_error_db": float(db.max()),
         "fit_band_hz": [float(FIT_FROM_HZ), float(top)],
         "step_rms_um": step_rms,
         "step_height_um": float(step_fit),
-        "creep_after_1s_percent": 100.0 * model.creep_fraction(1.0),
+        "creep_after_1s_percent": 100.0 * after_1s,
         "local_gain_um_per_v": float(abs(gain)),
         "local_phase_deg": float(np.degrees(np.angle(gain))),
     }

@@ -38,17 +38,17 @@ lags the reference by ``preview`` samples).
 
 from __future__ import annotations
 
-import cmath
 import functools
 import math
 from typing import Any, ClassVar
 
 import numpy as np
 
+from hystcomp import _lti, operators
 from hystcomp import dynamics_kernels as dk
-from hystcomp import operators
 from hystcomp._validation import as_signal, as_vector, check_int, check_real
 from hystcomp.errors import InvalidParameterError, NotFittedError
+from hystcomp.identify.dynamics import fit_dynamics
 
 #: Default low-pass of the inverse, as a multiple of the resonance (capped at 0.4 fs).
 BANDWIDTH_FACTOR = 2.0
@@ -59,42 +59,11 @@ MATCH_HZ = 1.0
 MAX_PREVIEW = 64
 
 
-def resonance_zoh(resonance_hz: float, damping_ratio: float, sample_rate: float):
-    """``(b, a)`` of the zero-order-hold discretisation of ``wn^2 / (s^2 + 2 zeta wn s + wn^2)``.
-
-    ``R(z) = (b[0] z + b[1]) / (z^2 + a[1] z + a[2])``, ``a[0] = 1``, with unit gain at
-    ``z = 1``. The output at sample ``k`` is the position before the input of sample ``k``
-    acts, as on a sampled rig (and in the twin).
-
-    Examples
-    --------
-    >>> b, a = resonance_zoh(630.0, 0.1, 20_000.0)
-    >>> round(float(sum(b) / sum(a)), 12)
-    1.0
-    """
-    wn = 2.0 * math.pi * resonance_hz
-    ts = 1.0 / sample_rate
-    m = np.array([[0.0, 1.0], [-(wn**2), -2.0 * damping_ratio * wn]])
-    # exp(M Ts) of a 2x2 matrix in closed form: e^(s Ts) (cosh(q Ts) I + sinh(q Ts)/q (M - s I))
-    shift = -damping_ratio * wn
-    q = cmath.sqrt(shift**2 - wn**2)
-    sinhc = ts if abs(q * ts) < 1e-12 else cmath.sinh(q * ts) / q
-    ad = np.real(
-        math.exp(shift * ts) * (cmath.cosh(q * ts) * np.eye(2) + sinhc * (m - shift * np.eye(2)))
-    )
-    # Bd = M^-1 (Ad - I) B with B = (0, wn^2)
-    bd = np.linalg.solve(m, (ad - np.eye(2)) @ np.array([0.0, wn**2]))
-    b = np.array([bd[0], ad[0, 1] * bd[1] - ad[1, 1] * bd[0]])
-    a = np.array([1.0, -np.trace(ad), np.linalg.det(ad)])
-    return b, a
-
-
 class LinearDynamics:
     """Creep modes and the first resonance of an actuator, with unit steady-state gain.
 
-    Build it with :meth:`from_parameters`, identify it with
-    :func:`hystcomp.identify.dynamics.fit_dynamics` (``hystcomp identify --model
-    dynamics``) or load it with :func:`hystcomp.load_model`.
+    Build it with :meth:`from_parameters`, identify it with :meth:`fit`
+    (``hystcomp identify --model dynamics``) or load it with :func:`hystcomp.load_model`.
 
     Attributes
     ----------
@@ -162,55 +131,68 @@ class LinearDynamics:
         model.creep_weights_ = weights
         return model
 
+    def fit(self, v, x, sample_rate: float) -> LinearDynamics:
+        """Identify the model from the answer ``x`` (µm) to ``hystcomp excite dynamics``.
+
+        Delegates to :func:`hystcomp.identify.dynamics.fit_dynamics` (see there for the
+        method); ``v`` in V, ``sample_rate`` in Hz. Sets the parameters and
+        ``fit_report_``; returns ``self``.
+        """
+        result = fit_dynamics(v, x, sample_rate)
+        fitted = type(self).from_parameters(**result.parameters)
+        self.__dict__.update(fitted.__dict__)
+        self.fit_report_ = dict(result.report)
+        return self
+
     # -- the model -------------------------------------------------------------------------
 
     def _check_fitted(self) -> None:
         if not hasattr(self, "resonance_hz_"):
             raise NotFittedError(
                 "This LinearDynamics has no parameters yet. Identify it with "
-                "hystcomp.identify.dynamics.fit_dynamics, build it with "
+                "LinearDynamics().fit(v, x, sample_rate), build it with "
                 "LinearDynamics.from_parameters(...) or load one with hystcomp.load_model."
             )
 
     @property
     def creep_lags(self) -> np.ndarray:
         """``a_i = exp(-Ts / tau_i)``, the creep poles in discrete time."""
-        return np.exp(-1.0 / (self.sample_rate_ * self.creep_time_constants_))
+        return _lti.creep_lags(self.creep_time_constants_, self.sample_rate_)
 
     def resonance(self):
-        """``(b, a)`` of ``R(z)`` (see :func:`resonance_zoh`)."""
-        return resonance_zoh(self.resonance_hz_, self.damping_ratio_, self.sample_rate_)
+        """``(b, a)`` of ``R(z)`` (see :func:`hystcomp._lti.resonance_zoh`)."""
+        return _lti.resonance_zoh(self.resonance_hz_, self.damping_ratio_, self.sample_rate_)
 
     def frequency_response(self, frequencies) -> np.ndarray:
         """``D(exp(j 2 pi f Ts))`` at ``frequencies`` in Hz (complex, unit gain at 0 Hz)."""
         self._check_fitted()
-        f = np.asarray(frequencies, dtype=np.float64)
-        z1 = np.exp(-2j * np.pi * f / self.sample_rate_)  # z^-1
-        return creep_response(self.creep_lags, self.creep_weights_, z1) * resonance_response(
-            *self.resonance(), z1
+        return _lti.frequency_response(
+            frequencies,
+            self.sample_rate_,
+            self.resonance_hz_,
+            self.damping_ratio_,
+            self.creep_lags,
+            self.creep_weights_,
         )
 
     def simulate(self, u, *, initial: float | None = None) -> np.ndarray:
         """The output of ``D`` for the input ``u``, from rest at ``initial`` (``u[0]`` if None)."""
-        from scipy.signal import lfilter
-
         self._check_fitted()
         u = as_signal(u, "u")
         rest = float(u[0]) if initial is None else check_real(initial, "initial", "simulate")
-        q = u - rest
-        lags, weights = self.creep_lags, self.creep_weights_
-        creep = q.copy()
-        for a, c in zip(lags, weights, strict=True):
-            creep += c * lfilter([1.0 - a], [1.0, -a], q)
-        creep /= 1.0 + weights.sum()
-        b, a = self.resonance()
-        return rest + lfilter(np.r_[0.0, b], a, creep)
+        return _lti.output(
+            u,
+            rest,
+            self.sample_rate_,
+            self.resonance_hz_,
+            self.damping_ratio_,
+            self.creep_lags,
+            self.creep_weights_,
+        )
 
     def creep_fraction(self, seconds: float) -> float:
         """How far a step response still has to rise after ``seconds``, as a fraction of its end."""
-        weights = self.creep_weights_
-        tail = np.exp(-seconds / self.creep_time_constants_)
-        return float((weights * tail).sum() / (1.0 + weights.sum()))
+        return _lti.creep_fraction(seconds, self.creep_time_constants_, self.creep_weights_)
 
     # -- the inverse -----------------------------------------------------------------------
 
@@ -325,19 +307,6 @@ class LinearDynamics:
             f"{self.damping_ratio_:.4g}, creep={100 * self.creep_fraction(0.0):.3g} %, "
             f"sample_rate={self.sample_rate_:g})"
         )
-
-
-def creep_response(lags, weights, z1) -> np.ndarray:
-    """``C`` at ``z^-1 = z1`` (complex array)."""
-    out = np.ones_like(z1)
-    for a, c in zip(lags, weights, strict=True):
-        out = out + c * (1.0 - a) / (1.0 - a * z1)
-    return out / (1.0 + float(np.sum(weights)))
-
-
-def resonance_response(b, a, z1) -> np.ndarray:
-    """``R`` at ``z^-1 = z1``: ``(b0 z^-1 + b1 z^-2) / (1 + a1 z^-1 + a2 z^-2)``."""
-    return (b[0] * z1 + b[1] * z1**2) / (a[0] + a[1] * z1 + a[2] * z1**2)
 
 
 def inverse_fir(resonance, bandwidth_hz: float, sample_rate: float):
