@@ -108,11 +108,10 @@ def dynamics_excitation(
         )
     n_period = round(PERIOD * fs)
     lines = multisine_lines(fs)
-    k = np.arange(n_period)
     phases = -np.pi * np.arange(lines.size) * (np.arange(lines.size) + 1) / lines.size
-    period = np.zeros(n_period)
-    for line, phase in zip(lines, phases, strict=True):
-        period += np.cos(2.0 * np.pi * line * k / n_period + phase)
+    spectrum = np.zeros(n_period // 2 + 1, dtype=complex)  # one period is PERIOD s
+    spectrum[np.round(lines * PERIOD).astype(int)] = np.exp(1j * phases)
+    period = np.fft.irfft(spectrum, n_period)
     period *= amplitude / np.abs(period).max()
     v = np.concatenate(
         [
