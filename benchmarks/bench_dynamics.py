@@ -7,7 +7,7 @@ the rows are ratios measured in the same run:
 * rms of the 100 Hz (200 Hz) triangle over the 1 Hz rms of the same compensator, with the
   inverse of the dynamics (targets <= 1.5 and <= 2.5) and without it (for information);
 * mean |error| from 20 ms to 3 s after a step, with over without the dynamics (target
-  < 0.3);
+  < 0.3), and how far the error drifts over that time (the creep left), with over without;
 * the extra time of the dynamics part of ``compare`` (identification, 1..200 Hz runs, the
   step) as a fraction of the rest of the run (information: ``compare`` must stay fast).
 
@@ -63,6 +63,8 @@ def run() -> list[dict]:
                     step < 0.3,
                 )
             )
+            drift = abs(dc.step_drift[label]) / abs(dc.step_drift[method])
+            rows.append(_row(f"{stage}: {method}, step |drift| 20 ms..3 s with / without", drift))
     start = time.perf_counter()
     run_comparison(CompareConfig(dynamics=False))
     plain = time.perf_counter() - start

@@ -39,18 +39,31 @@ def plot_bode(model, path, *, measured=None) -> None:
 
 
 def plot_step(t, x_ref, runs: dict, path) -> None:
-    """Step-and-hold: the tracking error of each run (``{label: x}``) against time (log)."""
-    fig = Figure(figsize=(6.4, 4.0))
+    """Step and hold: the tracking error of each run (``{label: x}``) after the step.
+
+    Left, the first 10 ms (the resonance); right, 10 ms to the end on a log time axis,
+    zoomed on the creep.
+    """
+    fig = Figure(figsize=(9.0, 4.0))
     FigureCanvasAgg(fig)
-    ax = fig.subplots()
+    fast, slow = fig.subplots(1, 2)
     start = int(np.flatnonzero(np.diff(x_ref))[0]) + 1
+    after = t[start:] - t[start]
+    early = after <= 0.01
+    late = after >= 0.01
     for label, x in runs.items():
-        ax.semilogx(t[start + 1 :] - t[start], (x - x_ref)[start + 1 :], label=label)
-    ax.axhline(0.0, color="k", lw=0.5)
-    ax.set_xlabel("time after the step (s)")
-    ax.set_ylabel("tracking error (µm)")
-    ax.set_title("Step and hold on the simulated axis with creep")
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend()
+        e = (x - x_ref)[start:]
+        fast.plot(1e3 * after[early], e[early], label=label)
+        slow.semilogx(after[late], e[late], label=label)
+    for ax in (fast, slow):
+        ax.axhline(0.0, color="k", lw=0.5)
+        ax.grid(True, which="both", alpha=0.3)
+        ax.set_ylabel("tracking error (µm)")
+    fast.set_xlabel("time after the step (ms)")
+    slow.set_xlabel("time after the step (s)")
+    fast.set_title("the first 10 ms")
+    slow.set_title("creep: 10 ms to the end")
+    slow.legend()
+    fig.suptitle("Step and hold on the simulated axis with creep")
     fig.tight_layout()
     fig.savefig(path)
