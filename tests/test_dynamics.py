@@ -211,6 +211,18 @@ def test_c_matches_the_stepper(compensator, tmp_path):
     assert f"{compensator.preview} samples ahead" in header
 
 
+@needs_cc
+def test_c_without_creep_matches_the_stepper(tmp_path):
+    dyn = LinearDynamics.from_parameters(sample_rate=FS, resonance_hz=630.0, damping_ratio=0.1)
+    comp = hystcomp.presets.paper_mpi().inverse(dynamics=dyn)
+    x = _wild_reference(comp, n=3000)
+    drive = _compile(comp, tmp_path, "no_creep")
+    v_c, _ = _run_c(drive, x)
+    s = comp.stepper()
+    np.testing.assert_allclose(v_c, [s.step(u) for u in x], rtol=0, atol=1e-9)
+    assert comp.preview == 26  # ceil(1.5 fs / (2 f_n)) + 2: documented in docs/dynamics.md
+
+
 def test_targets_on_a_creep_stage():
     """780 Hz, zeta 0.05, 3 % creep: fast triangles near the 1 Hz error, creep removed."""
     from hystcomp.experiment.references import triangle_reference

@@ -121,8 +121,13 @@ class LinearDynamics:
                 f"({0.5 * model.sample_rate_:g} Hz). Got {model.resonance_hz_:g}; identify "
                 "from a record sampled faster."
             )
-        taus = as_vector(np.atleast_1d(creep_time_constants), "creep_time_constants", owner)
-        weights = as_vector(np.atleast_1d(creep_weights), "creep_weights", owner, length=taus.size)
+        if np.size(creep_time_constants) == 0 and np.size(creep_weights) == 0:  # no creep
+            taus = weights = np.zeros(0)
+        else:
+            taus = as_vector(np.atleast_1d(creep_time_constants), "creep_time_constants", owner)
+            weights = as_vector(
+                np.atleast_1d(creep_weights), "creep_weights", owner, length=taus.size
+            )
         if np.any(taus <= 0) or np.any(weights < 0):
             raise InvalidParameterError(
                 f"The creep of {owner} needs time constants > 0 s and weights >= 0. Got "
