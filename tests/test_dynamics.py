@@ -279,19 +279,31 @@ def test_cli_round_trip(tmp_path):
     out = tmp_path / "v.csv"
     result = run(main, [*args, "--dynamics", str(tmp_path / "dyn.json"), "-o", str(out)])
     assert result.exit_code == 0, result.output
+    assert "samples of look-ahead" in result.output
     v = read_table(out, ("v",))["v"]
     expected = hystcomp.presets.paper_mpi().inverse(
         dynamics=hystcomp.load_model(tmp_path / "dyn.json")
     )
     np.testing.assert_allclose(v, expected.simulate(15.0 + 10.0 * np.sin(2 * np.pi * 100 * t)))
-    # a dynamics file as the model, and a model as --dynamics: exit 2, nothing written
+    # a reference at another rate, a dynamics file as the model, a model as --dynamics:
+    # exit 2, nothing written
+    write_table(tmp_path / "slow.csv", {"t": 2 * t, "x": np.full(t.size, 10.0)})
+    slow = ["compensate", str(tmp_path / "mpi.json"), str(tmp_path / "slow.csv")]
+    bad = run(
+        main, [*slow, "--dynamics", str(tmp_path / "dyn.json"), "-o", str(tmp_path / "s.csv")]
+    )
+    assert bad.exit_code == 2
+    assert "10000 Hz" in bad.output
     bad = run(main, ["compensate", str(tmp_path / "dyn.json"), str(tmp_path / "ref.csv"),
                      "-o", str(tmp_path / "bad.csv")])  # fmt: skip
     assert bad.exit_code == 2
     assert "--dynamics" in bad.output
-    bad = run(main, [*args, "--dynamics", str(tmp_path / "mpi.json"), "-o", str(tmp_path / "b")])
+    bad = run(
+        main, [*args, "--dynamics", str(tmp_path / "mpi.json"), "-o", str(tmp_path / "b.csv")]
+    )
     assert bad.exit_code == 2
-    assert not (tmp_path / "b").exists()
+    assert "not linear dynamics" in bad.output
+    assert not (tmp_path / "b.csv").exists()
     result = run(
         main,
         ["export-c", str(tmp_path / "mpi.json"), "--dynamics", str(tmp_path / "dyn.json"),

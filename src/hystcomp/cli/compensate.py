@@ -114,3 +114,8 @@ def compensate(
         f"wrote {output}: {v.size} samples, v from {v.min():.4g} to {v.max():.4g} V "
         f"(clamped to {lo:.4g} .. {hi:.4g} V)"
     )
+    if dynamics_file is not None:
+        click.echo(
+            f"  with the inverse of the dynamics of {dynamics_file}: "
+            f"{compensator.preview} samples of look-ahead in the reference"
+        )
