@@ -17,7 +17,7 @@ from hystcomp.models.base import (
     set_plays,
 )
 from hystcomp.models.compensator import Compensator
-from hystcomp.models.dynamics import with_dynamics
+from hystcomp.models.dynamic_compensator import with_dynamics
 from hystcomp.models.inversion import (
     check_invertible,
 )

@@ -15,7 +15,7 @@ from hystcomp.errors import InvalidParameterError, InvalidTypeError
 from hystcomp.identify.preisach import MAX_DEGREE, identify_preisach
 from hystcomp.models.base import HysteresisModel, slew_to_step
 from hystcomp.models.compensator import Compensator, Stepper
-from hystcomp.models.dynamics import with_dynamics
+from hystcomp.models.dynamic_compensator import with_dynamics
 
 INVERSE_METHODS = ("multiplicative", "exact")
 
