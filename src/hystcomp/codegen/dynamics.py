@@ -4,7 +4,7 @@ The generated ``NAME_step`` first runs the reference through the inverse filter 
 :mod:`hystcomp.models.dynamics` (the FIR of the resonance inverse and low-pass, then the
 exact inverse of the creep bank, clamped to the model's displacement range), then the
 hysteresis compensator's own code on the filtered reference, exactly as
-:class:`~hystcomp.models.dynamics.DynamicStepper` does. The FIR looks ahead: the caller
+:class:`~hystcomp.models.dynamic_compensator.DynamicStepper` does. The FIR looks ahead: the caller
 passes the reference ``preview`` samples ahead of the sample the voltage is for.
 """
 

@@ -171,7 +171,7 @@ class PrandtlIshlinskii(HysteresisModel):
             Put an inverse of the actuator's linear dynamics (creep, first resonance) in
             series: ``v = H^-1[D^-1[x_ref]]`` (beyond the paper; see
             :mod:`hystcomp.models.dynamics`). Returns a
-            :class:`~hystcomp.models.dynamics.DynamicCompensator` then.
+            :class:`~hystcomp.models.dynamic_compensator.DynamicCompensator` then.
 
         Raises
         ------
