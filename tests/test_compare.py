@@ -26,7 +26,7 @@ def stand_in_models(record_pi, record_preisach, config=None):
 def comparison():
     lines = []
     result = run_comparison(CompareConfig.quick(), identify=stand_in_models, progress=lines.append)
-    assert len(lines) == 5  # records, identification, three frequencies
+    assert len(lines) == 6  # records, identification, three frequencies, dynamics
     return result
 
 
@@ -63,7 +63,8 @@ def test_outputs_are_written(comparison, tmp_path):
         rows = list(csv.DictReader(fh))
     assert list(rows[0]) == ["method", "hysteresis_pct", "saturation_zone_pct"]
     assert [r["method"] for r in rows] == list(METHODS)
-    for name in names - {"table1.csv", "hysteresis.csv", "report.md"}:
+    assert {"dynamics.csv", "step_creep.png"} <= names  # beyond the paper
+    for name in names - {"table1.csv", "hysteresis.csv", "report.md", "dynamics.csv"}:
         assert (out / name).read_bytes()[:8] == PNG
     report = (out / "report.md").read_text()
     assert "| 1 | uncompensated | " in report
@@ -97,7 +98,8 @@ def test_real_quick_comparison():
         by_method = c.results[f]
         rms = {m: by_method[m].rms for m in METHODS}
         assert rms["preisach"] < rms["uncompensated"] / 2  # the twin suits the Preisach model
-        assert max(rms["pi"], rms["mpi"]) < rms["uncompensated"] / 1.5
+        # 1.4: with the twin's 3 % creep the PI model gains 1.5x at 50 Hz, not more
+        assert max(rms["pi"], rms["mpi"]) < rms["uncompensated"] / 1.4
         if f < 50:  # the asymmetric model beats the symmetric one (the paper's point)
             assert rms["mpi"] < rms["pi"]
 

@@ -25,6 +25,7 @@ __version__ = "0.1.0"
 #: Public name -> (module, attribute in it; None for the module itself).
 _LAZY = {
     "Compensator": ("hystcomp.models.compensator", "Compensator"),
+    "LinearDynamics": ("hystcomp.models.dynamics", "LinearDynamics"),
     "ModifiedPrandtlIshlinskii": ("hystcomp.models.mpi", "ModifiedPrandtlIshlinskii"),
     "PrandtlIshlinskii": ("hystcomp.models.pi", "PrandtlIshlinskii"),
     "Preisach": ("hystcomp.models.preisach", "Preisach"),
@@ -40,6 +41,7 @@ _LAZY = {
 
 __all__ = [  # written out for static tools; tests/test_cli_lazy.py checks it against _LAZY
     "Compensator",
+    "LinearDynamics",
     "ModifiedPrandtlIshlinskii",
     "PrandtlIshlinskii",
     "Preisach",
@@ -60,6 +62,7 @@ if TYPE_CHECKING:  # what static tools see; at run time __getattr__ imports on f
     from hystcomp.data import Record, read_record
     from hystcomp.io import load_model, save_model
     from hystcomp.models.compensator import Compensator, Stepper
+    from hystcomp.models.dynamics import LinearDynamics
     from hystcomp.models.mpi import ModifiedPrandtlIshlinskii
     from hystcomp.models.pi import PrandtlIshlinskii
     from hystcomp.models.preisach import Preisach

@@ -30,6 +30,7 @@ from hystcomp.errors import (
     OutputPathError,
 )
 from hystcomp.models.base import HysteresisModel
+from hystcomp.models.dynamics import LinearDynamics
 from hystcomp.models.mpi import ModifiedPrandtlIshlinskii
 from hystcomp.models.pi import PrandtlIshlinskii
 from hystcomp.models.preisach import Preisach
@@ -44,6 +45,7 @@ MODEL_KINDS: dict[str, type[HysteresisModel]] = {
     PrandtlIshlinskii.kind: PrandtlIshlinskii,
     ModifiedPrandtlIshlinskii.kind: ModifiedPrandtlIshlinskii,
     Preisach.kind: Preisach,
+    LinearDynamics.kind: LinearDynamics,  # the linear dynamics (creep, resonance)
 }
 
 

@@ -34,7 +34,10 @@ def compare(out_dir: Path, seed: int, periods: int | None, quick: bool) -> None:
 
     Runs the paper's identification signals on the simulated axis, identifies the models,
     tracks triangles at 1, 10 and 50 Hz with each method, prints Table I and writes the
-    tables, figures and a report into OUT. Units: µm, V, s.
+    tables, figures and a report into OUT. Beyond the paper, it also identifies the axis's
+    linear dynamics and tracks 1 to 200 Hz triangles and a step with the MPI and Preisach
+    compensators in series with their inverse (dynamics.csv, step_creep.png). The axis has
+    3 % creep. Units: µm, V, s.
     """
     from hystcomp.experiment.compare import CompareConfig, run_comparison
     from hystcomp.experiment.report import format_table, prepare_output_dir, write_outputs

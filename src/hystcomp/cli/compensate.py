@@ -6,6 +6,7 @@ import click
 import numpy as np
 
 from hystcomp.cli import main
+from hystcomp.cli._dynamics import dynamics_for, load_dynamics, refuse_dynamics_as_model
 from hystcomp.cli._options import (
     check_data_output,
     columns_option,
@@ -71,8 +72,24 @@ def inverse_options(model, table, *, slew_rate, narrow_range) -> dict:
     "narrow it) [the model's range].",
 )
 @method_option
+@click.option(
+    "--dynamics",
+    "dynamics_file",
+    default=None,
+    metavar="DYN.json",
+    help="Also invert the linear dynamics of this file (hystcomp identify --model "
+    "dynamics): v = H^-1[D^-1[x_ref]], looking ahead in the reference (beyond the paper).",
+)
 def compensate(
-    model_file, reference_file, output, columns, sample_rate, slew_rate, narrow_range, method
+    model_file,
+    reference_file,
+    output,
+    columns,
+    sample_rate,
+    slew_rate,
+    narrow_range,
+    method,
+    dynamics_file,
 ):
     """Voltage that makes the actuator of MODEL.json follow REFERENCE (columns t, x).
 
@@ -80,11 +97,15 @@ def compensate(
     --method exact, the exact inverse), clamped to the model's voltage range (or a narrower
     --voltage-range). Writes t (s), v (V) and x_ref (µm).
     """
-    check_data_output(output, inputs=(model_file, reference_file), what="voltage file")
+    inputs = (model_file, reference_file) + ((dynamics_file,) if dynamics_file else ())
+    check_data_output(output, inputs=inputs, what="voltage file")
     model = load_model(model_file)
+    refuse_dynamics_as_model(model, model_file)
     chosen = method_options(model, model_file, method)
     table = read_table(reference_file, ("x",), **read_options(columns, sample_rate))
     options = inverse_options(model, table, slew_rate=slew_rate, narrow_range=narrow_range)
+    if dynamics_file is not None:
+        options["dynamics"] = dynamics_for(load_dynamics(dynamics_file), table)
     compensator = model.inverse(**options, **chosen)
     v = compensator.simulate(table["x"])
     write_table(output, {"t": table["t"], "v": v, "x_ref": table["x"]})
@@ -93,3 +114,8 @@ def compensate(
         f"wrote {output}: {v.size} samples, v from {v.min():.4g} to {v.max():.4g} V "
         f"(clamped to {lo:.4g} .. {hi:.4g} V)"
     )
+    if dynamics_file is not None:
+        click.echo(
+            f"  with the inverse of the dynamics of {dynamics_file}: "
+            f"{compensator.preview} samples of look-ahead in the reference"
+        )

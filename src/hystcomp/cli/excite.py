@@ -25,7 +25,7 @@ SIGNALS = {
 
 
 @main.command("excite")
-@click.argument("model", type=click.Choice(sorted(SIGNALS)))
+@click.argument("model", type=click.Choice(sorted([*SIGNALS, "dynamics"])))
 @output_option(required=False, what="signal; CSV on standard output if omitted")
 @click.option(
     "--fs",
@@ -61,17 +61,24 @@ def excite(model, output, sample_rate, voltage_range, frequency):
 
     pi, mpi: triangles of 30, 60, 90, 120 V at 1 Hz (Section IV-A); preisach: sinusoids of
     5, 10, ..., 120 V at 1 Hz (Section III-A). Each starts and ends at the lower end of the
-    range. Columns: t (s), v (V).
+    range. dynamics (beyond the paper): a step to mid-range held 3 s (creep), then three
+    1 s periods of a +-4 V multisine of 1 Hz .. 5 kHz around it (--frequency unused).
+    Columns: t (s), v (V).
     """
     if output is not None:
         check_data_output(output, what="signal file")
-    shape, amplitudes = SIGNALS[model]
-    t, v = shape(
-        scaled_amplitudes(amplitudes, voltage_range=voltage_range),
-        frequency=frequency,
-        sample_rate=sample_rate,
-        v_min=voltage_range[0],
-    )
+    if model == "dynamics":
+        from hystcomp.identify.dynamics import dynamics_excitation
+
+        t, v = dynamics_excitation(sample_rate=sample_rate, voltage_range=voltage_range)
+    else:
+        shape, amplitudes = SIGNALS[model]
+        t, v = shape(
+            scaled_amplitudes(amplitudes, voltage_range=voltage_range),
+            frequency=frequency,
+            sample_rate=sample_rate,
+            v_min=voltage_range[0],
+        )
     if output is None:
         click.echo(format_csv({"t": t, "v": v}), nl=False)
     else:

@@ -7,6 +7,7 @@ from pathlib import Path
 import click
 
 from hystcomp.cli import main
+from hystcomp.cli._dynamics import load_dynamics, refuse_dynamics_as_model
 from hystcomp.cli._options import method_option, method_options
 from hystcomp.codegen import DEFAULT_PREFIX, export_c
 from hystcomp.io import load_model
@@ -45,7 +46,15 @@ from hystcomp.io import load_model
     help="Sample rate at which NAME_step is called; sets the slew step per sample.",
 )
 @method_option
-def export_c_command(model_file, directory, prefix, slew_rate, sample_rate, method):
+@click.option(
+    "--dynamics",
+    "dynamics_file",
+    default=None,
+    metavar="DYN.json",
+    help="Also invert the linear dynamics of this file (beyond the paper); NAME_step then "
+    "takes the reference a fixed number of samples ahead (see the header).",
+)
+def export_c_command(model_file, directory, prefix, slew_rate, sample_rate, method, dynamics_file):
     """Write MODEL_FILE's compensator as C99 code: NAME.h and NAME.c in folder -o.
 
     The code has the identified parameters baked in, clamps its output to the model's
@@ -57,7 +66,17 @@ def export_c_command(model_file, directory, prefix, slew_rate, sample_rate, meth
       double NAME_step(NAME_state *s, double x_ref);   /* um in, V out */
     """
     model = load_model(model_file)
+    refuse_dynamics_as_model(model, model_file)
     options = {"slew_rate": slew_rate, "sample_rate": sample_rate}
+    if dynamics_file is not None:
+        dynamics = load_dynamics(dynamics_file)
+        if abs(dynamics.sample_rate_ - sample_rate) > 1e-6 * sample_rate:
+            raise click.BadParameter(
+                f"is {sample_rate:g} Hz but {dynamics_file} was identified at "
+                f"{dynamics.sample_rate_:g} Hz; the code must run at the dynamics' rate.",
+                param_hint="'--fs'",
+            )
+        options["dynamics"] = dynamics
     compensator = model.inverse(**options, **method_options(model, model_file, method))
     header, source = export_c(
         compensator, directory, prefix=prefix, source=str(model_file), sample_rate=sample_rate

@@ -27,11 +27,12 @@ from hystcomp.io import MODEL_KINDS, atomic_paths, check_output_path, model_text
 DEFAULT_OPERATORS = 16
 
 #: What each --model builds, and which size options it takes.
-LABELS = {"pi": "PI", "mpi": "MPI", "preisach": "Preisach"}
+LABELS = {"pi": "PI", "mpi": "MPI", "preisach": "Preisach", "dynamics": "dynamics"}
 SIZE_OPTIONS = {
     "pi": ("operators",),
     "mpi": ("operators", "deadzones", "regularization"),
     "preisach": ("degree", "fit", "everett", "grid"),
+    "dynamics": (),
 }
 #: Largest --grid (the least-squares table fit has about grid^2 / 2 unknowns).
 MAX_GRID = MAX_LSQ_GRID
@@ -226,7 +227,8 @@ def identify(
     PI and MPI: constrained least squares (eqs. 16-19) with invertible weights; the
     start-up transient, the input range (bipolar too) and a displacement offset are handled.
     Preisach: the paper's fit to reversal curves (Section III-A) or least squares over any
-    record (--fit).
+    record (--fit). dynamics (beyond the paper): creep and first resonance from the answer to
+    'hystcomp excite dynamics', for compensate/export-c --dynamics; --plot draws its Bode plot.
     """
     check_output_path(output, inputs=(data,), what="model file")
     if plot is not None:  # matplotlib is imported only when a figure is asked for
@@ -237,6 +239,17 @@ def identify(
         check_output_path(plot, inputs=(data,), what="figure")
         if Path(plot).resolve() == Path(output).resolve():
             raise click.BadParameter("names the same file as -o.", param_hint="--plot")
+    if kind == "dynamics":  # linear dynamics: a record of 'hystcomp excite dynamics'
+        from hystcomp.cli._dynamics import identify_dynamics
+
+        given = {"--operators": operators, "--deadzones": deadzones, "--degree": degree}
+        given.update({"--regularization": regularization, "--transient": transient})
+        given.update({"--voltage-range": voltage_range, "--holdout": holdout})
+        for name, value in given.items():
+            if value is not None:
+                raise click.UsageError(f"{name} does not apply to --model dynamics.")
+        identify_dynamics(read_record(data, **read_options(columns, sample_rate)), output, plot)
+        return
     model = build_estimator(
         kind,
         operators=operators,

@@ -62,7 +62,12 @@ def generate_c(
             f"Got a compensator of kind {kind!r}."
         )
     check_prefix(prefix)
-    template = TEMPLATES[kind](compensator)
+    inner = getattr(compensator, "hysteresis", compensator)  # a DynamicCompensator's
+    template = TEMPLATES[kind](inner)
+    if inner is not compensator:
+        from hystcomp.codegen.dynamics import add_dynamics
+
+        template = add_dynamics(template, compensator.dynamics_inverse)
     return render(template, prefix, source=source, sample_rate=sample_rate)
 
 

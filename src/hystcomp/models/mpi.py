@@ -18,6 +18,7 @@ from hystcomp.models.base import (
     set_plays,
 )
 from hystcomp.models.compensator import Compensator
+from hystcomp.models.dynamic_compensator import with_dynamics
 from hystcomp.models.inversion import (
     check_invertible,
     invert_superposition,
@@ -214,12 +215,15 @@ class ModifiedPrandtlIshlinskii(HysteresisModel):
             out_offset=self.output_offset_,
         )
 
-    def inverse(self, *, slew_rate=None, sample_rate=20_000.0, voltage_range=None) -> Compensator:
+    def inverse(
+        self, *, slew_rate=None, sample_rate=20_000.0, voltage_range=None, dynamics=None
+    ) -> Compensator:
         """The analytic inverse MPI, eq. (23): ``v = v_0 + H^-1[S^-1[x - x_0]]``, clamped.
 
         ``S^-1`` is a dead-zone superposition and ``H^-1`` a PI model, both from eqs. 24-25
         (and eq. 26 for the initial states). ``slew_rate`` (V/s), ``sample_rate`` (Hz) and
-        ``voltage_range`` (a narrower clamp, V) are as in :meth:`PrandtlIshlinskii.inverse`.
+        ``voltage_range`` (a narrower clamp, V) and ``dynamics`` (an inverse of the linear
+        dynamics in series) are as in :meth:`PrandtlIshlinskii.inverse`.
 
         Raises
         ------
@@ -230,13 +234,14 @@ class ModifiedPrandtlIshlinskii(HysteresisModel):
         owner = type(self).__name__
         check_invertible(self.weights_, f"The hysteresis operator H of this {owner} model")
         check_invertible(self.deadzone_weights_, f"The saturation operator S of this {owner} model")
-        return inverse_play_compensator(
+        compensator = inverse_play_compensator(
             self,
             slew_rate=slew_rate,
             sample_rate=sample_rate,
             voltage_range=voltage_range,
             pre=invert_superposition(self.deadzone_thresholds_, self.deadzone_weights_),
         )
+        return compensator if dynamics is None else with_dynamics(self, compensator, dynamics)
 
     @staticmethod
     def forward_deadzones(inverse_thresholds, inverse_weights) -> tuple[np.ndarray, np.ndarray]:

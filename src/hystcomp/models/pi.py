@@ -17,6 +17,7 @@ from hystcomp.models.base import (
     set_plays,
 )
 from hystcomp.models.compensator import Compensator
+from hystcomp.models.dynamic_compensator import with_dynamics
 from hystcomp.models.inversion import (
     check_invertible,
 )
@@ -152,7 +153,9 @@ class PrandtlIshlinskii(HysteresisModel):
             out_offset=self.output_offset_,
         )
 
-    def inverse(self, *, slew_rate=None, sample_rate=20_000.0, voltage_range=None) -> Compensator:
+    def inverse(
+        self, *, slew_rate=None, sample_rate=20_000.0, voltage_range=None, dynamics=None
+    ) -> Compensator:
         """The analytic inverse PI (eqs. 24-26) as a compensator clamped to the voltage range.
 
         Parameters
@@ -163,6 +166,11 @@ class PrandtlIshlinskii(HysteresisModel):
             Sample rate in Hz at which the compensator runs; sets the per-sample slew step.
         voltage_range : (float, float), optional
             A narrower output clamp in V, inside ``voltage_range_`` (never wider).
+        dynamics : LinearDynamics, optional
+            Put an inverse of the actuator's linear dynamics (creep, first resonance) in
+            series: ``v = H^-1[D^-1[x_ref]]`` (beyond the paper; see
+            :mod:`hystcomp.models.dynamics`). Returns a
+            :class:`~hystcomp.models.dynamic_compensator.DynamicCompensator` then.
 
         Raises
         ------
@@ -172,6 +180,7 @@ class PrandtlIshlinskii(HysteresisModel):
         self._check_fitted()
         owner = type(self).__name__
         check_invertible(self.weights_, f"This {owner} model")
-        return inverse_play_compensator(
+        compensator = inverse_play_compensator(
             self, slew_rate=slew_rate, sample_rate=sample_rate, voltage_range=voltage_range
         )
+        return compensator if dynamics is None else with_dynamics(self, compensator, dynamics)

@@ -15,6 +15,7 @@ from hystcomp.errors import InvalidParameterError, InvalidTypeError
 from hystcomp.identify.preisach import MAX_DEGREE, identify_preisach
 from hystcomp.models.base import HysteresisModel, slew_to_step
 from hystcomp.models.compensator import Compensator, Stepper
+from hystcomp.models.dynamic_compensator import with_dynamics
 
 INVERSE_METHODS = ("multiplicative", "exact")
 
@@ -272,6 +273,7 @@ class Preisach(HysteresisModel):
         slew_rate=None,
         sample_rate=20_000.0,
         voltage_range=None,
+        dynamics=None,
     ) -> PreisachCompensator:
         """A compensator (reference µm -> voltage V) clamped to ``voltage_range_``.
 
@@ -294,7 +296,21 @@ class Preisach(HysteresisModel):
             Sample rate in Hz at which the compensator runs; sets the per-sample slew step.
         voltage_range : (float, float), optional
             A narrower output clamp in V, inside ``voltage_range_`` (never wider).
+        dynamics : LinearDynamics, optional
+            Put an inverse of the actuator's linear dynamics (creep, first resonance) in
+            series: ``v = H^-1[D^-1[x_ref]]`` (beyond the paper; see
+            :mod:`hystcomp.models.dynamics`). Returns a
+            :class:`~hystcomp.models.dynamic_compensator.DynamicCompensator` then.
         """
+        if dynamics is not None:
+            compensator = self.inverse(
+                method=method,
+                rho=rho,
+                slew_rate=slew_rate,
+                sample_rate=sample_rate,
+                voltage_range=voltage_range,
+            )
+            return with_dynamics(self, compensator, dynamics)
         self._check_fitted()
         owner = type(self).__name__
         clamp = self._clamp_range(voltage_range, f"{owner}.inverse")

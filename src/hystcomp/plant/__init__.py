@@ -6,7 +6,7 @@
 0.0
 """
 
-from hystcomp.plant.parameters import TwinParameters
+from hystcomp.plant.parameters import TwinParameters, creep_twin
 from hystcomp.plant.twin import Twin, TwinStepper
 
-__all__ = ["Twin", "TwinParameters", "TwinStepper"]
+__all__ = ["Twin", "TwinParameters", "TwinStepper", "creep_twin"]

@@ -1,0 +1,80 @@
+"""Accuracy and cost of the inverse of the linear dynamics (beyond the paper).
+
+On the compare twin (630 Hz, zeta 0.1, 3 % creep) and on a stage with a 780 Hz mode,
+zeta 0.05 and 3 % creep, the whole ``compare`` experiment is run with its dynamics part;
+the rows are ratios measured in the same run:
+
+* rms of the 100 Hz (200 Hz) triangle over the 1 Hz rms of the same compensator, with the
+  inverse of the dynamics (targets <= 1.5 and <= 2.5) and without it (for information);
+* mean |error| from 20 ms to 3 s after a step, with over without the dynamics (target
+  < 0.3), and how far the error drifts over that time (the creep left), with over without;
+* the extra time of the dynamics part of ``compare`` (identification, 1..200 Hz runs, the
+  step) as a fraction of the rest of the run (information: ``compare`` must stay fast).
+
+Run alone with ``python benchmarks/bench_dynamics.py``.
+"""
+
+from __future__ import annotations
+
+import time
+
+from hystcomp.experiment.compare import CompareConfig, run_comparison
+from hystcomp.plant import creep_twin
+
+STAGES = {
+    "compare twin (630 Hz, zeta 0.1, 3 % creep)": creep_twin(),
+    "stage 780 Hz, zeta 0.05, 3 % creep": creep_twin(resonance_hz=780.0, damping_ratio=0.05),
+}
+
+
+def _row(name, value, unit="x", target=None, ok=None):
+    return {"name": name, "value": float(value), "unit": unit, "target": target, "ok": ok}
+
+
+def run() -> list[dict]:
+    """Measure and return one row per figure: name, value, unit, target, ok."""
+    rows = []
+    for stage, params in STAGES.items():
+        c = run_comparison(CompareConfig(twin=params))
+        dc = c.dynamics
+        for method in ("preisach", "mpi"):
+            label = f"{method} + dynamics"
+            base = dc.results[1.0][label].rms
+            for f, limit in ((100.0, 1.5), (200.0, 2.5)):
+                ratio = dc.results[f][label].rms / base
+                rows.append(
+                    _row(
+                        f"{stage}: {label}, rms {f:g} Hz / 1 Hz",
+                        ratio,
+                        "x",
+                        f"<= {limit:g}",
+                        ratio <= limit,
+                    )
+                )
+                plain = dc.results[f][method].rms / c.results[1.0][method].rms
+                rows.append(_row(f"{stage}: {method} alone, rms {f:g} Hz / 1 Hz", plain))
+            step = dc.step_error[label] / dc.step_error[method]
+            rows.append(
+                _row(
+                    f"{stage}: {method}, step mean |error| with / without dynamics",
+                    step,
+                    "x",
+                    "< 0.3",
+                    step < 0.3,
+                )
+            )
+            drift = abs(dc.step_drift[label]) / abs(dc.step_drift[method])
+            rows.append(_row(f"{stage}: {method}, step |drift| 20 ms..3 s with / without", drift))
+    start = time.perf_counter()
+    run_comparison(CompareConfig(dynamics=False))
+    plain = time.perf_counter() - start
+    start = time.perf_counter()
+    run_comparison(CompareConfig())
+    full = time.perf_counter() - start
+    rows.append(_row("compare: extra time of the dynamics part / the rest", (full - plain) / plain))
+    return rows
+
+
+if __name__ == "__main__":
+    for row in run():
+        print(f"{row['name']}: {row['value']:.4g} {row['unit']} (target {row['target']})")

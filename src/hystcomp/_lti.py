@@ -1,0 +1,88 @@
+"""Linear time-invariant helpers of the dynamics model: discretisation, responses, output.
+
+Plain NumPy/SciPy, below both the model (:mod:`hystcomp.models.dynamics`) and its
+identification (:mod:`hystcomp.identify.dynamics`), which share them.
+"""
+
+from __future__ import annotations
+
+import cmath
+import math
+
+import numpy as np
+
+
+def resonance_zoh(resonance_hz: float, damping_ratio: float, sample_rate: float):
+    """``(b, a)`` of the zero-order-hold discretisation of ``wn^2 / (s^2 + 2 zeta wn s + wn^2)``.
+
+    ``R(z) = (b[0] z + b[1]) / (z^2 + a[1] z + a[2])``, ``a[0] = 1``, with unit gain at
+    ``z = 1``. The output at sample ``k`` is the position before the input of sample ``k``
+    acts, as on a sampled rig (and in the twin).
+
+    Examples
+    --------
+    >>> b, a = resonance_zoh(630.0, 0.1, 20_000.0)
+    >>> round(float(sum(b) / sum(a)), 12)
+    1.0
+    """
+    wn = 2.0 * math.pi * resonance_hz
+    ts = 1.0 / sample_rate
+    m = np.array([[0.0, 1.0], [-(wn**2), -2.0 * damping_ratio * wn]])
+    # exp(M Ts) of a 2x2 matrix in closed form: e^(s Ts) (cosh(q Ts) I + sinh(q Ts)/q (M - s I))
+    shift = -damping_ratio * wn
+    q = cmath.sqrt(shift**2 - wn**2)
+    sinhc = ts if abs(q * ts) < 1e-12 else cmath.sinh(q * ts) / q
+    ad = np.real(
+        math.exp(shift * ts) * (cmath.cosh(q * ts) * np.eye(2) + sinhc * (m - shift * np.eye(2)))
+    )
+    # Bd = M^-1 (Ad - I) B with B = (0, wn^2)
+    bd = np.linalg.solve(m, (ad - np.eye(2)) @ np.array([0.0, wn**2]))
+    b = np.array([bd[0], ad[0, 1] * bd[1] - ad[1, 1] * bd[0]])
+    a = np.array([1.0, -np.trace(ad), np.linalg.det(ad)])
+    return b, a
+
+
+def creep_response(lags, weights, z1) -> np.ndarray:
+    """``C`` at ``z^-1 = z1`` (complex array)."""
+    out = np.ones_like(z1)
+    for a, c in zip(lags, weights, strict=True):
+        out = out + c * (1.0 - a) / (1.0 - a * z1)
+    return out / (1.0 + float(np.sum(weights)))
+
+
+def resonance_response(b, a, z1) -> np.ndarray:
+    """``R`` at ``z^-1 = z1``: ``(b0 z^-1 + b1 z^-2) / (1 + a1 z^-1 + a2 z^-2)``."""
+    return (b[0] * z1 + b[1] * z1**2) / (a[0] + a[1] * z1 + a[2] * z1**2)
+
+
+def creep_lags(time_constants, sample_rate: float) -> np.ndarray:
+    """``a_i = exp(-Ts / tau_i)``, the creep poles in discrete time."""
+    return np.exp(-1.0 / (sample_rate * np.asarray(time_constants, dtype=np.float64)))
+
+
+def frequency_response(frequencies, sample_rate, resonance_hz, damping_ratio, lags, weights):
+    """``D(exp(j 2 pi f Ts))`` of the model (see :mod:`hystcomp.models.dynamics`)."""
+    f = np.asarray(frequencies, dtype=np.float64)
+    z1 = np.exp(-2j * np.pi * f / sample_rate)  # z^-1
+    b, a = resonance_zoh(resonance_hz, damping_ratio, sample_rate)
+    return creep_response(lags, weights, z1) * resonance_response(b, a, z1)
+
+
+def output(u, rest, sample_rate, resonance_hz, damping_ratio, lags, weights) -> np.ndarray:
+    """``D[u]`` from rest at ``rest``: the creep bank, then the resonance."""
+    from scipy.signal import lfilter
+
+    q = np.asarray(u, dtype=np.float64) - rest
+    creep = q.copy()
+    for a, c in zip(lags, weights, strict=True):
+        creep += c * lfilter([1.0 - a], [1.0, -a], q)
+    creep /= 1.0 + float(np.sum(weights))
+    b, a = resonance_zoh(resonance_hz, damping_ratio, sample_rate)
+    return rest + lfilter(np.r_[0.0, b], a, creep)
+
+
+def creep_fraction(seconds, time_constants, weights) -> float:
+    """How far a step response still has to rise after ``seconds``, as a fraction of its end."""
+    weights = np.asarray(weights, dtype=np.float64)
+    tail = np.exp(-seconds / np.asarray(time_constants, dtype=np.float64))
+    return float((weights * tail).sum() / (1.0 + weights.sum()))

@@ -1,0 +1,83 @@
+"""The command-line side of the linear dynamics: identify, report, plot, load for compensation."""
+
+from __future__ import annotations
+
+import click
+
+from hystcomp.errors import ModelFileError
+from hystcomp.io import atomic_paths, load_model, model_text
+from hystcomp.models.dynamics import LinearDynamics
+
+
+def identify_dynamics(rec, output: str, plot: str | None) -> None:
+    """Fit :class:`LinearDynamics` to ``rec``, print the fit, write the model (and figure)."""
+    model = LinearDynamics().fit(rec.v, rec.x, rec.sample_rate)
+    report = model.fit_report_
+    lo, hi = report["fit_band_hz"]
+    click.echo(f"linear dynamics (creep and first resonance) from {rec.source}")
+    click.echo(
+        f"  record:    {len(rec)} samples at {rec.sample_rate:.6g} Hz "
+        f"({rec.t[-1] - rec.t[0]:.4g} s)"
+    )
+    click.echo(
+        f"  resonance: {model.resonance_hz_:.5g} Hz, damping ratio {model.damping_ratio_:.3g}"
+    )
+    click.echo(
+        f"  creep:     {100 * model.creep_fraction(0.0):.3g} % of the final displacement, "
+        f"{100 * model.creep_fraction(1.0):.3g} % of it after 1 s "
+        f"({model.creep_time_constants_.size} modes, "
+        f"{model.creep_time_constants_[0]:.3g} .. {model.creep_time_constants_[-1]:.3g} s)"
+    )
+    click.echo(
+        f"  fit, {lo:.4g} .. {hi:.4g} Hz: {report['fit_percent']:.3g} % "
+        f"(frequency response), largest magnitude error {report['max_magnitude_error_db']:.3g} dB"
+    )
+    click.echo(
+        f"  step:      rms error {report['step_rms_um']:.4g} µm on a step of "
+        f"{report['step_height_um']:.4g} µm"
+    )
+    text = model_text(model)
+    outputs = [output] if plot is None else [output, plot]
+    with atomic_paths(*outputs) as (tmp_model, *tmp_plot):
+        tmp_model.write_text(text, encoding="utf-8")
+        if plot is not None:
+            from hystcomp.experiment.fig_dynamics import plot_bode
+
+            plot_bode(model, tmp_plot[0])
+    for path in outputs[::-1]:
+        click.echo(f"  wrote {path}")
+
+
+def load_dynamics(path) -> LinearDynamics:
+    """A dynamics model file, or a one-line error naming the option."""
+    model = load_model(path)
+    if not isinstance(model, LinearDynamics):
+        raise ModelFileError(
+            f"--dynamics {str(path)!r} holds a {model.kind!r} model, not linear dynamics; "
+            "give the file written by 'hystcomp identify DATA --model dynamics'."
+        )
+    return model
+
+
+def refuse_dynamics_as_model(model, path) -> None:
+    """A dynamics file given where a hysteresis model belongs: one line saying so."""
+    if isinstance(model, LinearDynamics):
+        raise ModelFileError(
+            f"{str(path)!r} holds linear dynamics, not a hysteresis model; give a PI, MPI or "
+            "Preisach model file and pass this one as --dynamics."
+        )
+
+
+def dynamics_for(dynamics: LinearDynamics, table) -> LinearDynamics:
+    """``dynamics``, checked against the reference's sample rate (it is discrete-time)."""
+    import numpy as np
+
+    steps = np.diff(table["t"])
+    fs = 1.0 / float(np.median(steps)) if steps.size else dynamics.sample_rate_
+    if abs(fs - dynamics.sample_rate_) > 1e-6 * dynamics.sample_rate_:
+        raise ModelFileError(
+            f"The dynamics model was identified at {dynamics.sample_rate_:g} Hz but the "
+            f"reference is sampled at {fs:.6g} Hz; resample the reference or identify the "
+            "dynamics at the reference's rate."
+        )
+    return dynamics

@@ -1,0 +1,102 @@
+"""C99 of the inverse of the linear dynamics, put in front of any compensator template.
+
+The generated ``NAME_step`` first runs the reference through the inverse filter of
+:mod:`hystcomp.models.dynamics` (the FIR of the resonance inverse and low-pass, then the
+exact inverse of the creep bank, clamped to the model's displacement range), then the
+hysteresis compensator's own code on the filtered reference, exactly as
+:class:`~hystcomp.models.dynamic_compensator.DynamicStepper` does. The FIR looks ahead: the caller
+passes the reference ``preview`` samples ahead of the sample the voltage is for.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from hystcomp import dynamics_kernels as dk
+from hystcomp.codegen.c99 import CTemplate, c_double, c_table
+
+
+def add_dynamics(template: CTemplate, inverse) -> CTemplate:
+    """``template`` with the inverse filter ``inverse`` (a DynamicsInverse) before its step."""
+    p = inverse.packed
+    n_fir, n_creep = int(p[dk.N_FIR]), int(p[dk.N_CREEP])
+    taps = p[dk.HEADER : dk.HEADER + n_fir]
+    lags = p[dk.HEADER + n_fir : dk.HEADER + n_fir + n_creep]
+    weights = p[dk.HEADER + n_fir + n_creep : dk.HEADER + n_fir + 2 * n_creep]
+    low, high = inverse.output_range
+    template.summary = [
+        *template.summary,
+        (
+            f"Inverse of the linear dynamics in front (beyond the paper): {n_fir} FIR taps, "
+            f"{n_creep} creep modes."
+        ),
+        f"  PREVIEW: call NAME_step with the reference {inverse.preview} samples ahead of the",
+        "  sample its voltage is for (fed the reference of now, the stage lags it by that).",
+    ]
+    template.state_fields += [f"double dyn_line[{n_fir}]; /* reference delay line, um */"]
+    template.tables.append(c_table("{p}_dyn_h", taps, "FIR taps: resonance inverse (ZPETC)"))
+    rest = c_double(inverse.rest)
+    template.reset_body += [
+        "{",
+        "    int j;",
+        f"    for (j = 0; j < {n_fir}; j++) {{",
+        f"        s->dyn_line[j] = {rest};",
+        "    }",
+    ]
+    body = [
+        "",
+        f"/* inverse of the linear dynamics; x_ref is {inverse.preview} samples ahead */",
+        "{",
+        "    int j;",
+        f"    double w = {c_double(p[dk.BIAS])};",
+        "    double y;",
+        f"    for (j = {n_fir - 1}; j > 0; j--) {{",
+        "        s->dyn_line[j] = s->dyn_line[j - 1];",
+        "    }",
+        "    s->dyn_line[0] = x_ref;",
+        f"    for (j = 0; j < {n_fir}; j++) {{",
+        "        w += {p}_dyn_h[j] * s->dyn_line[j];",
+        "    }",
+    ]
+    if n_creep:
+        template.state_fields.append(f"double dyn_lag[{n_creep}]; /* creep lag states, um */")
+        template.tables += [
+            c_table("{p}_dyn_a", lags, "creep lag factors a_i = exp(-Ts/tau_i)"),
+            c_table("{p}_dyn_c", weights, "creep weights c_i"),
+        ]
+        template.reset_body += [
+            f"    for (j = 0; j < {n_creep}; j++) {{",
+            f"        s->dyn_lag[j] = {rest};",
+            "    }",
+        ]
+        body += [
+            "    {",
+            f"        double acc = w * {c_double(p[dk.SCALE])};",
+            f"        for (j = 0; j < {n_creep}; j++) {{",
+            "            acc -= {p}_dyn_c[j] * {p}_dyn_a[j] * s->dyn_lag[j];",
+            "        }",
+            f"        y = acc / {c_double(p[dk.DIRECT])};",
+            "    }",
+        ]
+    else:
+        body.append(f"    y = w * {c_double(p[dk.SCALE])} / {c_double(p[dk.DIRECT])};")
+    body += [
+        "    if (!isfinite(y)) { /* a huge finite x_ref overflowed: hold the output */",
+        "        s->nonfinite_count++;",
+        "        return s->last;",
+        "    }",
+    ]
+    if np.isfinite(low):
+        body += [f"    if (y < {c_double(low)}) {{", f"        y = {c_double(low)};", "    }"]
+    if np.isfinite(high):
+        body += [f"    if (y > {c_double(high)}) {{", f"        y = {c_double(high)};", "    }"]
+    if n_creep:
+        body += [
+            f"    for (j = 0; j < {n_creep}; j++) {{",
+            "        s->dyn_lag[j] = {p}_dyn_a[j] * s->dyn_lag[j] + (1.0 - {p}_dyn_a[j]) * y;",
+            "    }",
+        ]
+    body += ["    x_ref = y;", "}", ""]
+    template.reset_body.append("}")
+    template.step_body = body + template.step_body
+    return template

@@ -1,0 +1,73 @@
+"""Compiled kernel of the inverse of the linear dynamics: one step, and a batch loop over it.
+
+The inverse filter (see :mod:`hystcomp.models.dynamics`) is a FIR stage (the inverse of
+the resonance with its sampling zero reflected, ZPETC, times a linear-phase low-pass) in
+series with the exact inverse of the creep bank. Its parameters and state are one packed
+float64 array, as the chain's (:mod:`hystcomp.operators`)::
+
+    [N_FIR, N_CREEP, SCALE, DIRECT, LOW, HIGH, BIAS, h_0 .. h_{N_FIR-1}, a_1 .. a_n, c_1 .. c_n,
+     delay line (N_FIR samples, newest first), creep lag states (n)]
+
+The creep bank of the forward model is ``D_c[q] = (q + sum_i c_i lag_i) / SCALE`` with
+``lag_i[k] = a_i lag_i[k-1] + (1 - a_i) q[k]`` and ``SCALE = 1 + sum_i c_i``. Its inverse
+solves that equation for ``q[k]`` each sample (``DIRECT = 1 + sum_i c_i (1 - a_i)``): no
+root of any polynomial is computed, so creep poles a hair below 1 stay exact. The output
+is clamped to ``[LOW, HIGH]`` (the hysteresis model's displacement range), so that the
+hysteresis inverse downstream never takes a memory the actuator cannot follow; the creep
+lags follow the clamped output. Kernels trust
+their input. The FIR's output is ``BIAS + sum_j h_j u[k - j]`` (a gain other than 1 at
+0 Hz, about a rest point, is a scaling of the taps and a bias).
+"""
+
+from __future__ import annotations
+
+import math
+
+from hystcomp.operators import _kernel, step_kernel
+
+N_FIR, N_CREEP, SCALE, DIRECT, LOW, HIGH, BIAS = range(7)
+HEADER = 7
+
+
+@_kernel
+def state_start(p):
+    """Index of the first state slot (the newest sample of the delay line)."""
+    return HEADER + int(p[N_FIR]) + 2 * int(p[N_CREEP])
+
+
+@step_kernel
+def inverse_step(p, u):
+    """One reference sample ``u`` (µm) through the inverse filter; NaN (state kept) if not finite."""
+    if not math.isfinite(u):
+        return math.nan
+    n_fir = int(p[N_FIR])
+    n_creep = int(p[N_CREEP])
+    h = HEADER
+    a = h + n_fir
+    c = a + n_creep
+    d = c + n_creep
+    lags = d + n_fir
+    for j in range(n_fir - 1, 0, -1):
+        p[d + j] = p[d + j - 1]
+    p[d] = u
+    w = p[BIAS]
+    for j in range(n_fir):
+        w += p[h + j] * p[d + j]
+    acc = w * p[SCALE]
+    for i in range(n_creep):
+        acc -= p[c + i] * p[a + i] * p[lags + i]
+    y = acc / p[DIRECT]
+    if not math.isfinite(y):  # a huge finite reference overflowed: held downstream
+        return math.nan
+    y = min(max(y, p[LOW]), p[HIGH])
+    for i in range(n_creep):
+        ai = p[a + i]
+        p[lags + i] = ai * p[lags + i] + (1.0 - ai) * y
+    return y
+
+
+@_kernel
+def inverse_run(p, u, out):
+    """Run :func:`inverse_step` over every sample of ``u`` (state kept in ``p``)."""
+    for k in range(u.size):
+        out[k] = inverse_step(p, u[k])

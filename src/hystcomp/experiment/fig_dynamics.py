@@ -1,0 +1,69 @@
+"""Figures of the linear dynamics: the Bode plot of an identified model, a step and hold."""
+
+from __future__ import annotations
+
+import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+
+
+def plot_bode(model, path, *, measured=None) -> None:
+    """Bode plot of ``model`` (magnitude in dB, phase in degrees) from 1 Hz to 0.45 fs.
+
+    ``measured`` is an optional ``(frequencies, response)`` pair drawn as dots; by default
+    nothing measured is drawn.
+    """
+    f = np.geomspace(1.0, 0.45 * model.sample_rate_, 600)
+    d = model.frequency_response(f)
+    fig = Figure(figsize=(6.4, 5.2))
+    FigureCanvasAgg(fig)
+    mag, phase = fig.subplots(2, 1, sharex=True)
+    mag.semilogx(f, 20 * np.log10(np.abs(d)), label="model D (unit steady-state gain)")
+    phase.semilogx(f, np.degrees(np.unwrap(np.angle(d))))
+    if measured is not None:
+        fm, g = measured
+        mag.semilogx(fm, 20 * np.log10(np.abs(g)), ".", ms=3, label="measured")
+        phase.semilogx(fm, np.degrees(np.unwrap(np.angle(g))), ".", ms=3)
+    mag.set_ylabel("magnitude (dB)")
+    phase.set_ylabel("phase (deg)")
+    phase.set_xlabel("frequency (Hz)")
+    mag.set_title(
+        f"Linear dynamics: {model.resonance_hz_:.4g} Hz, zeta {model.damping_ratio_:.3g}, "
+        f"creep {100 * model.creep_fraction(0.0):.2g} %"
+    )
+    mag.grid(True, which="both", alpha=0.3)
+    phase.grid(True, which="both", alpha=0.3)
+    mag.legend(loc="lower left")
+    fig.tight_layout()
+    fig.savefig(path)
+
+
+def plot_step(t, x_ref, runs: dict, path) -> None:
+    """Step and hold: the tracking error of each run (``{label: x}``) after the step.
+
+    Left, the first 10 ms (the resonance); right, 10 ms to the end on a log time axis,
+    zoomed on the creep.
+    """
+    fig = Figure(figsize=(9.0, 4.0))
+    FigureCanvasAgg(fig)
+    fast, slow = fig.subplots(1, 2)
+    start = int(np.flatnonzero(np.diff(x_ref))[0]) + 1
+    after = t[start:] - t[start]
+    early = after <= 0.01
+    late = after >= 0.01
+    for label, x in runs.items():
+        e = (x - x_ref)[start:]
+        fast.plot(1e3 * after[early], e[early], label=label)
+        slow.semilogx(after[late], e[late], label=label)
+    for ax in (fast, slow):
+        ax.axhline(0.0, color="k", lw=0.5)
+        ax.grid(True, which="both", alpha=0.3)
+        ax.set_ylabel("tracking error (µm)")
+    fast.set_xlabel("time after the step (ms)")
+    slow.set_xlabel("time after the step (s)")
+    fast.set_title("the first 10 ms")
+    slow.set_title("creep: 10 ms to the end")
+    slow.legend()
+    fig.suptitle("Step and hold on the simulated axis with creep")
+    fig.tight_layout()
+    fig.savefig(path)

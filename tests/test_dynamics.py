@@ -1,0 +1,338 @@
+"""The linear dynamics (creep, resonance): identification, stable inverse, composition, C."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+import hystcomp
+from hystcomp._lti import resonance_zoh
+from hystcomp.cli import main
+from hystcomp.data import read_table, write_table
+from hystcomp.errors import IdentificationError, InvalidParameterError, InvalidTypeError
+from hystcomp.identify.dynamics import dynamics_excitation
+from hystcomp.models.dynamics import DynamicCompensator, LinearDynamics
+from hystcomp.plant import Twin, creep_twin
+from tests.conftest import random_walk
+from tests.test_codegen import CC, _compile, _run_c, needs_cc
+
+FS = 20_000.0
+
+
+def _stage(**changes):
+    """A known linear stage: 780 Hz, zeta 0.05, 3 % creep on a grid unlike the fit's."""
+    params = {
+        "sample_rate": FS,
+        "resonance_hz": 780.0,
+        "damping_ratio": 0.05,
+        "creep_time_constants": [0.004, 0.04, 0.4, 2.0],
+        "creep_weights": [0.0075] * 4,
+    }
+    return LinearDynamics.from_parameters(**{**params, **changes})
+
+
+@pytest.fixture(scope="module")
+def identified():
+    """The known stage identified from its noisy answer (gain 0.3 µm/V) to the excitation."""
+    true = _stage()
+    _, v = dynamics_excitation()
+    rng = np.random.default_rng(7)
+    x = 0.3 * true.simulate(v, initial=0.0) + 0.003 * rng.standard_normal(v.size) - 5.0
+    return true, LinearDynamics().fit(v, x, FS)
+
+
+def test_identification_recovers_the_frequency_response(identified):
+    true, fit = identified
+    f = np.geomspace(1.0, 2.0 * 780.0, 200)
+    error = np.abs(fit.frequency_response(f) / true.frequency_response(f) - 1.0)
+    assert error.max() < 0.03  # 3 % of the response, 1 Hz to twice the resonance
+    assert fit.resonance_hz_ == pytest.approx(780.0, rel=0.005)
+    assert fit.damping_ratio_ == pytest.approx(0.05, rel=0.05)
+    assert fit.fit_report_["fit_percent"] > 97.0
+
+
+def test_identification_recovers_the_creep_after_a_step(identified):
+    true, fit = identified
+    for seconds in (0.01, 0.1, 1.0):
+        assert fit.creep_fraction(seconds) == pytest.approx(true.creep_fraction(seconds), abs=0.002)
+
+
+def test_unit_steady_state_gain(identified):
+    _, fit = identified
+    assert abs(fit.frequency_response([0.0])[0]) == pytest.approx(1.0, abs=1e-12)
+    step = fit.simulate(np.r_[0.0, np.ones(400_000)], initial=0.0)
+    assert step[-1] == pytest.approx(1.0, abs=1e-3)
+
+
+def test_resonance_zoh_is_the_exact_discretisation():
+    from scipy.linalg import expm
+
+    for fn, zeta in [(630.0, 0.1), (780.0, 0.05), (300.0, 1.0), (300.0, 2.0)]:
+        wn = 2 * np.pi * fn
+        m = np.zeros((3, 3))
+        m[0, 1] = 1.0
+        m[1, :] = [-(wn**2), -2 * zeta * wn, wn**2]
+        d = expm(m / FS)
+        b, a = resonance_zoh(fn, zeta, FS)
+        np.testing.assert_allclose(a, [1.0, -np.trace(d[:2, :2]), np.linalg.det(d[:2, :2])])
+        np.testing.assert_allclose(b.sum() / a.sum(), 1.0, rtol=1e-12)
+
+
+@pytest.mark.parametrize("f", [1.0, 10.0, 100.0, 200.0])
+def test_inverse_then_forward_is_the_identity_in_band(f):
+    dyn = _stage()
+    inverse = dyn.inverse(rest=3.0)
+    t = np.arange(round(2.0 * FS)) / FS
+    x = 3.0 + 5.0 * np.sin(2 * np.pi * f * t)
+    y = inverse.simulate(x)
+    back = dyn.simulate(y, initial=3.0)
+    inner = slice(round(0.1 * FS), -2 * inverse.preview)
+    assert np.abs(back - x)[inner].max() < 0.005 * 5.0  # 0.5 % of the amplitude
+
+
+def test_inverse_is_stable_for_any_resonance_and_creep():
+    rng = np.random.default_rng(3)
+    for _ in range(20):
+        dyn = _stage(
+            resonance_hz=rng.uniform(50.0, 9000.0),
+            damping_ratio=rng.uniform(0.005, 3.0),
+            creep_time_constants=[0.001, 0.01, 0.05, 0.2],
+            creep_weights=rng.uniform(0.0, 0.5, 4),
+        )
+        y = dyn.inverse().simulate(np.r_[np.zeros(50), np.ones(40_000)])
+        assert np.all(np.isfinite(y))
+        assert abs(y[-1] - 1.0) < 0.05  # it settles: no growing mode
+        assert np.abs(y).max() < 1e3
+
+
+def test_model_file_round_trip(identified, tmp_path):
+    _, fit = identified
+    hystcomp.save_model(fit, tmp_path / "dyn.json")
+    doc = json.loads((tmp_path / "dyn.json").read_text())
+    assert (doc["format"], doc["version"], doc["kind"]) == ("hystcomp-model", 1, "dynamics")
+    back = hystcomp.load_model(tmp_path / "dyn.json")
+    assert isinstance(back, LinearDynamics)
+    f = np.array([0.0, 10.0, 780.0, 3000.0])
+    np.testing.assert_array_equal(back.frequency_response(f), fit.frequency_response(f))
+    assert back.fit_report_ == fit.fit_report_
+
+
+def test_bad_parameters_are_refused():
+    with pytest.raises(InvalidParameterError, match="resonance_hz"):
+        _stage(resonance_hz=12_000.0)
+    with pytest.raises(InvalidParameterError, match="weights >= 0"):
+        _stage(creep_weights=[0.01, -0.01, 0.0, 0.0])
+    with pytest.raises(InvalidParameterError, match="bandwidth_hz"):
+        _stage().inverse(bandwidth_hz=10_000.0)
+    with pytest.raises(InvalidTypeError, match="LinearDynamics"):
+        hystcomp.presets.paper_mpi().inverse(dynamics="dyn.json")
+    with pytest.raises(IdentificationError, match="excite dynamics"):
+        LinearDynamics().fit(np.r_[np.zeros(10), np.ones(100)], np.zeros(110), FS)
+
+
+# -- the compensator in series -----------------------------------------------------------
+
+
+@pytest.fixture(params=["mpi", "preisach"])
+def compensator(request):
+    if request.param == "mpi":
+        model = hystcomp.presets.paper_mpi()
+    else:
+        twin = Twin(creep_twin(sensor_noise=0.0))
+        from hystcomp.identify.excitation import PI_AMPLITUDES, sinusoid_sequence
+
+        _, v = sinusoid_sequence(PI_AMPLITUDES, sample_rate=FS)
+        model = hystcomp.Preisach(degree=3).fit(v, twin.run(v))
+    return model.inverse(dynamics=_stage(), slew_rate=2e5)
+
+
+def _wild_reference(comp, n=8000):
+    rng = np.random.default_rng(11)
+    lo, hi = comp.dynamics_inverse.output_range
+    span = hi - lo
+    return random_walk(rng, n, lo - 0.3 * span, hi + 0.3 * span, span / 30)
+
+
+def test_stepper_equals_batch(compensator):
+    x = _wild_reference(compensator)
+    batch = compensator.simulate(x)
+    s = compensator.stepper()
+    d = compensator.preview
+    s.prime(x[:d])
+    streamed = np.array([s.step(u) for u in np.r_[x[d:], np.full(d, x[-1])]])
+    np.testing.assert_allclose(streamed, batch, rtol=0, atol=1e-9)
+    s.reset()
+    s.prime(x[:d])
+    np.testing.assert_allclose(
+        s.step_block(np.r_[x[d:], np.full(d, x[-1])]), batch, rtol=0, atol=1e-9
+    )
+
+
+def test_output_clamped_and_slew_limited(compensator):
+    x = _wild_reference(compensator)
+    v = compensator.simulate(x)
+    lo, hi = compensator.voltage_range
+    assert lo <= v.min()
+    assert v.max() <= hi
+    assert np.abs(np.diff(v)).max() <= compensator.max_step * (1 + 1e-12)
+    assert compensator.max_step == pytest.approx(2e5 / FS)
+
+
+def test_nonfinite_reference_holds_the_voltage():
+    comp = hystcomp.presets.paper_mpi().inverse(dynamics=_stage())
+    s = comp.stepper()
+    first = [s.step(u) for u in np.linspace(0.0, 10.0, 50)]
+    held = s.step(np.nan)
+    assert held == first[-1]
+    assert s.nonfinite_count == 1
+    copy = s.copy()
+    assert copy.step(10.0) == s.step(10.0)
+
+
+@needs_cc
+@pytest.mark.skipif(CC is None, reason="no C compiler")
+def test_c_matches_the_stepper(compensator, tmp_path):
+    x = _wild_reference(compensator, n=6000)
+    x[[100, 4100, 5000, 5001]] = [np.nan, np.nan, np.inf, -np.inf]
+    drive = _compile(compensator, tmp_path, "stage_x")
+    v_c, held = _run_c(drive, x, reset_at=4000)
+    s = compensator.stepper()
+    v_py = []
+    for k, u in enumerate(x):
+        if k == 4000:
+            s.reset()
+        v_py.append(s.step(u))
+    np.testing.assert_allclose(v_c, v_py, rtol=0, atol=1e-9)
+    assert held == 3
+    header = (tmp_path / "stage_x.h").read_text()
+    assert f"{compensator.preview} samples ahead" in header
+
+
+@needs_cc
+def test_c_without_creep_matches_the_stepper(tmp_path):
+    dyn = LinearDynamics.from_parameters(sample_rate=FS, resonance_hz=630.0, damping_ratio=0.1)
+    comp = hystcomp.presets.paper_mpi().inverse(dynamics=dyn)
+    x = _wild_reference(comp, n=3000)
+    drive = _compile(comp, tmp_path, "no_creep")
+    v_c, _ = _run_c(drive, x)
+    s = comp.stepper()
+    np.testing.assert_allclose(v_c, [s.step(u) for u in x], rtol=0, atol=1e-9)
+    assert comp.preview == 26  # ceil(1.5 fs / (2 f_n)) + 2: documented in docs/dynamics.md
+
+
+def test_targets_on_a_creep_stage():
+    """780 Hz, zeta 0.05, 3 % creep: fast triangles near the 1 Hz error, creep removed."""
+    from hystcomp.experiment.references import triangle_reference
+    from hystcomp.experiment.tracking import run_tracking
+    from hystcomp.identify.excitation import PI_AMPLITUDES, sinusoid_sequence
+
+    twin = Twin(creep_twin(resonance_hz=780.0, damping_ratio=0.05), seed=1)
+    _, v = dynamics_excitation()
+    dyn = LinearDynamics().fit(v, twin.run(v), FS)
+    _, v = sinusoid_sequence(PI_AMPLITUDES, sample_rate=FS)
+    model = hystcomp.Preisach(degree=3).fit(v, twin.run(v))
+    comp = model.inverse(dynamics=dyn)
+    rms = {}
+    for f in (1.0, 100.0, 200.0):
+        periods = 2 if f == 1.0 else 6
+        _, x_ref = triangle_reference(30.0, f, periods=periods, sample_rate=FS)
+        rms[f] = run_tracking(comp, twin, x_ref, frequency=f).rms
+    assert rms[100.0] <= 1.5 * rms[1.0]
+    assert rms[200.0] <= 2.5 * rms[1.0]
+    # after a step, the creep drift from 20 ms to 3 s is (nearly) gone
+    n0, hold = round(0.1 * FS), round(3.0 * FS)
+    x_ref = np.r_[np.zeros(n0), np.full(hold, 15.0)]
+    drift = {}
+    for name, c in (("plain", model.inverse()), ("dynamics", comp)):
+        e = (twin.run(c.simulate(x_ref)) - x_ref)[n0 + round(0.02 * FS) :]
+        drift[name] = np.mean(e[-200:]) - np.mean(e[:200])
+    assert abs(drift["plain"]) > 0.1  # the stage creeps: 0.15 µm on a 15 µm step
+    assert abs(drift["dynamics"]) < 0.3 * abs(drift["plain"])
+
+
+# -- command line --------------------------------------------------------------------------
+
+
+def test_cli_round_trip(tmp_path):
+    run = CliRunner().invoke
+    assert run(main, ["excite", "dynamics", "-o", str(tmp_path / "exc.csv")]).exit_code == 0
+    signal = read_table(tmp_path / "exc.csv", ("v",))
+    twin = Twin(creep_twin(resonance_hz=780.0, damping_ratio=0.05), seed=2)
+    record = {"t": signal["t"], "v": signal["v"], "x": twin.run(signal["v"])}
+    write_table(tmp_path / "rec.csv", record)
+    result = run(
+        main,
+        ["identify", str(tmp_path / "rec.csv"), "--model", "dynamics", "-o",
+         str(tmp_path / "dyn.json"), "--plot", str(tmp_path / "bode.png")],
+    )  # fmt: skip
+    assert result.exit_code == 0, result.output
+    assert "resonance: 7" in result.output
+    assert "fit, 20 .. " in result.output
+    assert (tmp_path / "bode.png").stat().st_size > 1000
+    hystcomp.save_model(hystcomp.presets.paper_mpi(), tmp_path / "mpi.json")
+    t = np.arange(4000) / FS
+    write_table(tmp_path / "ref.csv", {"t": t, "x": 15.0 + 10.0 * np.sin(2 * np.pi * 100 * t)})
+    args = ["compensate", str(tmp_path / "mpi.json"), str(tmp_path / "ref.csv")]
+    out = tmp_path / "v.csv"
+    result = run(main, [*args, "--dynamics", str(tmp_path / "dyn.json"), "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    assert "samples of look-ahead" in result.output
+    v = read_table(out, ("v",))["v"]
+    expected = hystcomp.presets.paper_mpi().inverse(
+        dynamics=hystcomp.load_model(tmp_path / "dyn.json")
+    )
+    np.testing.assert_allclose(v, expected.simulate(15.0 + 10.0 * np.sin(2 * np.pi * 100 * t)))
+    # a reference at another rate, a dynamics file as the model, a model as --dynamics:
+    # exit 2, nothing written
+    write_table(tmp_path / "slow.csv", {"t": 2 * t, "x": np.full(t.size, 10.0)})
+    slow = ["compensate", str(tmp_path / "mpi.json"), str(tmp_path / "slow.csv")]
+    bad = run(
+        main, [*slow, "--dynamics", str(tmp_path / "dyn.json"), "-o", str(tmp_path / "s.csv")]
+    )
+    assert bad.exit_code == 2
+    assert "10000 Hz" in bad.output
+    bad = run(main, ["compensate", str(tmp_path / "dyn.json"), str(tmp_path / "ref.csv"),
+                     "-o", str(tmp_path / "bad.csv")])  # fmt: skip
+    assert bad.exit_code == 2
+    assert "--dynamics" in bad.output
+    bad = run(
+        main, [*args, "--dynamics", str(tmp_path / "mpi.json"), "-o", str(tmp_path / "b.csv")]
+    )
+    assert bad.exit_code == 2
+    assert "not linear dynamics" in bad.output
+    assert not (tmp_path / "b.csv").exists()
+    result = run(
+        main,
+        ["export-c", str(tmp_path / "mpi.json"), "--dynamics", str(tmp_path / "dyn.json"),
+         "-o", str(tmp_path / "c")],
+    )  # fmt: skip
+    assert result.exit_code == 0, result.output
+    assert "samples ahead" in (tmp_path / "c" / "hystcomp_compensator.h").read_text()
+    result = run(
+        main,
+        ["export-c", str(tmp_path / "mpi.json"), "--dynamics", str(tmp_path / "dyn.json"),
+         "--fs", "10000", "-o", str(tmp_path / "c2")],
+    )  # fmt: skip
+    assert result.exit_code == 2
+    assert "--fs" in result.output
+
+
+def test_excite_dynamics_layout():
+    t, v = dynamics_excitation(sample_rate=10_000.0, voltage_range=(-10.0, 10.0))
+    assert t[1] == pytest.approx(1e-4)
+    assert v[0] == -10.0
+    assert v[round(0.3 * 10_000)] == 0.0
+    assert np.abs(v[-20_000:]).max() == pytest.approx(4.0)
+    assert isinstance(hystcomp.presets.paper_mpi().inverse(dynamics=_stage()), DynamicCompensator)
+
+
+def test_twin_creep_rises_about_equally_per_decade():
+    twin = Twin(creep_twin(sensor_noise=0.0, damping_ratio=0.7))
+    v = np.r_[0.0, np.full(round(20.0 * FS), 60.0)]
+    x = twin.run(v)
+    at = {t: x[round(t * FS)] for t in (0.01, 0.1, 1.0, 10.0)}
+    per_decade = np.diff([at[t] for t in sorted(at)]) / x[-1]
+    assert np.all((0.003 < per_decade) & (per_decade < 0.006))  # 0.5 % a decade, +-40 %
