@@ -54,7 +54,13 @@ import numpy as np
 from hystcomp._validation import as_vector, check_int, check_real
 from hystcomp.errors import InvalidParameterError
 from hystcomp.identify.lsq import RIDGE, constrained_lsq, normal_equations
-from hystcomp.identify.pi import DEFAULT_MARGIN, check_margin, paper_thresholds, prepare_record
+from hystcomp.identify.pi import (
+    DEFAULT_MARGIN,
+    check_constraints,
+    check_margin,
+    paper_thresholds,
+    prepare_record,
+)
 
 #: Candidate values of ``regularization`` for a choice: none, then one per decade.
 REGULARIZATION_GRID = (0.0, 1e-4, 1e-3, 1e-2, 1e-1)
@@ -138,6 +144,7 @@ def fit_mpi(
     transient=None,
     margin=DEFAULT_MARGIN,
     regularization=0.0,
+    constraints="physical",
 ) -> MPIFit:
     """Identify an MPI model (eq. 15) from a measured record, by eq. (19) with constraints.
 
@@ -173,6 +180,7 @@ def fit_mpi(
         transient=transient,
         margin=margin,
         regularizations=(regularization,),
+        constraints=constraints,
     )
     return fit
 
@@ -186,6 +194,7 @@ def fit_mpi_path(
     transient=None,
     margin=DEFAULT_MARGIN,
     regularizations=REGULARIZATION_GRID,
+    constraints="physical",
 ) -> list[MPIFit]:
     """:func:`fit_mpi` for several values of ``regularization`` at the cost of about one.
 
@@ -208,6 +217,7 @@ def fit_mpi_path(
     n = check_int(n_operators, "n_operators", owner)
     m = check_int(n_deadzones, "n_deadzones", owner)
     margin = check_margin(margin, owner)
+    constraints = check_constraints(constraints, owner)
     penalties = [check_regularization(value, owner) for value in regularizations]
     if not penalties:
         raise InvalidParameterError(
@@ -227,6 +237,7 @@ def fit_mpi_path(
         sol = constrained_lsq(
             gram,
             blocks=[(0, n, margin * rec.slope), (n, n + m - 1, margin - 1.0)],
+            floors=[(1, n, 0.0)] if constraints == "physical" else (),
             scales=np.r_[np.full(n, rec.input_span), np.full(m - 1, z_span)],
             ridge=RIDGE + np.r_[np.zeros(n), np.full(m - 1, penalty)],
         )

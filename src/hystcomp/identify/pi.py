@@ -106,6 +106,21 @@ def check_margin(margin, owner: str) -> float:
     return margin
 
 
+#: The constraint sets of the PI/MPI fits: the default, and eq. (12)/(19) as printed.
+CONSTRAINTS = ("physical", "paper")
+
+
+def check_constraints(constraints, owner: str) -> str:
+    """The ``constraints`` option: ``"physical"`` or ``"paper"``."""
+    if constraints not in CONSTRAINTS:
+        raise InvalidParameterError(
+            f"The 'constraints' parameter of {owner} must be one of {CONSTRAINTS} "
+            f"('physical': non-negative play weights, the default; 'paper': the partial-sum "
+            f"constraints of eqs. 12/19 only). Got {constraints!r} instead."
+        )
+    return constraints
+
+
 @dataclass(frozen=True)
 class PIFit:
     """Parameters of a PI model identified by :func:`fit_pi` (eq. 12).
@@ -134,7 +149,9 @@ class PIFit:
     first_sample: int
 
 
-def fit_pi(v, x, *, n_operators=16, transient=None, margin=DEFAULT_MARGIN) -> PIFit:
+def fit_pi(
+    v, x, *, n_operators=16, transient=None, margin=DEFAULT_MARGIN, constraints="physical"
+) -> PIFit:
     """Identify a classical PI model (eq. 12) from a measured record by constrained least squares.
 
     Minimises ``sum_k (x_0 + sum_i w_i play_{r_i}(v - v_0)[k] - x[k])^2`` over the samples
@@ -175,10 +192,12 @@ def fit_pi(v, x, *, n_operators=16, transient=None, margin=DEFAULT_MARGIN) -> PI
     r = paper_thresholds(n, rec.input_span)
     y0 = np.full(n, rec.u[0])
     x_ref = float(rec.x[rec.start :].min())
+    constraints = check_constraints(constraints, owner)
     gram = normal_equations(rec.u, r, y0, rec.x - x_ref, np.empty(0), rec.start)
     sol = constrained_lsq(
         gram,
         blocks=[(0, n, margin * rec.slope)],
+        floors=[(1, n, 0.0)] if constraints == "physical" else (),
         scales=np.full(n, rec.input_span),
     )
     return PIFit(

@@ -7,6 +7,7 @@ import numpy as np
 from hystcomp import operators
 from hystcomp._validation import check_int
 from hystcomp.identify.pi import fit_pi, paper_thresholds
+from hystcomp.identify.compensation import compensation_error
 from hystcomp.identify.scoring import error_report
 from hystcomp.models.base import (
     HysteresisModel,
@@ -73,7 +74,7 @@ class PrandtlIshlinskii(HysteresisModel):
     """
 
     kind = "pi"
-    _hyper = ("n_operators", "voltage_range", "transient", "margin")
+    _hyper = ("n_operators", "voltage_range", "transient", "margin", "constraints")
     _learned = (
         "thresholds",
         "weights",
@@ -83,11 +84,20 @@ class PrandtlIshlinskii(HysteresisModel):
         "output_offset",
     )
 
-    def __init__(self, *, n_operators=16, voltage_range=None, transient=None, margin=1e-3):
+    def __init__(
+        self,
+        *,
+        n_operators=16,
+        voltage_range=None,
+        transient=None,
+        margin=1e-3,
+        constraints="physical",
+    ):
         self.n_operators = n_operators
         self.voltage_range = voltage_range
         self.transient = transient
         self.margin = margin
+        self.constraints = constraints
 
     def fit(self, v, x) -> PrandtlIshlinskii:
         """Identify the model from a measured record (Section IV-A, eqs. 12, 16, 18).
@@ -109,7 +119,14 @@ class PrandtlIshlinskii(HysteresisModel):
         owner = type(self).__name__
         n = check_int(self.n_operators, "n_operators", owner)
         check_fit_options(self, owner)
-        fit = fit_pi(v, x, n_operators=n, transient=self.transient, margin=self.margin)
+        fit = fit_pi(
+            v,
+            x,
+            n_operators=n,
+            transient=self.transient,
+            margin=self.margin,
+            constraints=self.constraints,
+        )
         fitted = self.from_parameters(
             thresholds=fit.thresholds,
             weights=fit.weights,
@@ -118,7 +135,11 @@ class PrandtlIshlinskii(HysteresisModel):
             input_offset=fit.input_offset,
             output_offset=fit.output_offset,
         )
-        self._adopt(fitted, error_report(x, fitted.simulate(v), fit.first_sample))
+        report = error_report(x, fitted.simulate(v), fit.first_sample)
+        est = compensation_error(fitted, v, x, start=fit.first_sample)
+        report["tracking_rms_um"] = est["tracking_rms_um"]
+        report["baseline_tracking_rms_um"] = est["baseline_rms_um"]
+        self._adopt(fitted, report)
         return self
 
     @classmethod
