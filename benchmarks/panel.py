@@ -31,6 +31,7 @@ Usage::
 from __future__ import annotations
 
 import dataclasses
+import itertools
 
 import numba
 import numpy as np
@@ -232,7 +233,7 @@ def random_turning_points(sample_rate: float, *, seed: int = 7, n_points: int = 
     rng = np.random.default_rng(seed)
     points = np.r_[0.0, rng.uniform(0.0, V_MAX, n_points), 0.0]
     pieces = []
-    for lo, hi in zip(points[:-1], points[1:], strict=True):
+    for lo, hi in itertools.pairwise(points):
         n = max(2, round(abs(hi - lo) / 120.0 * sample_rate))
         pieces.append(np.linspace(lo, hi, n, endpoint=False))
     return np.r_[np.concatenate(pieces), 0.0]
@@ -256,7 +257,8 @@ def tracking_rms(act: Actuator, compensator, x_ref: np.ndarray, period: int) -> 
     """Rms tracking error (µm) over the periods after the first."""
     v = compensator.simulate(x_ref)
     lo, hi = act.voltage_range
-    assert v.min() >= lo - 1e-9 and v.max() <= hi + 1e-9
+    assert v.min() >= lo - 1e-9
+    assert v.max() <= hi + 1e-9
     x = act.run(v)
     window = slice(period, period * (x_ref.size // period))
     return float(np.sqrt(np.mean((x[window] - x_ref[window]) ** 2)))

@@ -5,6 +5,8 @@ All signals start at the lower end of the voltage range, with the piezo at rest 
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 
 from hystcomp._validation import as_vector, check_range, check_real
@@ -137,7 +139,7 @@ def rich_turning_points(*, v_min: float = 0.0, v_max: float = 120.0, seed: int =
             level = float(np.clip(level + sign * amplitude, v_min, v_max))
             points.append(level)
             sign = -sign
-    points += list(rng.uniform(v_min, v_max, 32)) + [v_max, v_min]
+    points += [*list(rng.uniform(v_min, v_max, 32)), v_max, v_min]
     return np.asarray(points, dtype=np.float64)
 
 
@@ -180,7 +182,7 @@ def rich_sequence(
             f"{MAX_SAMPLES} samples. Raise the rate or lower the sample rate."
         )
     pieces = []
-    for lo, hi in zip(points[:-1], points[1:], strict=True):
+    for lo, hi in itertools.pairwise(points):
         n = max(1, int(np.ceil(abs(hi - lo) / step)))
         pieces.append(lo + (hi - lo) * np.arange(n) / n)
     v = np.r_[np.concatenate(pieces), points[-1]]

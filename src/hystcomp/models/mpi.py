@@ -7,8 +7,8 @@ import numpy as np
 from hystcomp import operators
 from hystcomp._validation import as_vector, check_int, check_thresholds
 from hystcomp.errors import InvalidParameterError
-from hystcomp.identify.mpi import REGULARIZATION_GRID, check_regularization, fit_mpi_path
 from hystcomp.identify.compensation import compensation_error
+from hystcomp.identify.mpi import REGULARIZATION_GRID, check_regularization, fit_mpi_path
 from hystcomp.identify.scoring import error_report
 from hystcomp.models.base import (
     HysteresisModel,

@@ -6,8 +6,8 @@ import numpy as np
 
 from hystcomp import operators
 from hystcomp._validation import check_int
-from hystcomp.identify.pi import fit_pi, paper_thresholds
 from hystcomp.identify.compensation import compensation_error
+from hystcomp.identify.pi import fit_pi, paper_thresholds
 from hystcomp.identify.scoring import error_report
 from hystcomp.models.base import (
     HysteresisModel,
