@@ -19,6 +19,7 @@ from hystcomp.cli._options import (
 )
 from hystcomp.data import read_record
 from hystcomp.errors import IdentificationError
+from hystcomp.identify.compensation import compensation_error
 from hystcomp.identify.preisach import MAX_DEGREE
 from hystcomp.identify.scoring import error_report, holdout_report, straight_line, transient_end
 from hystcomp.io import MODEL_KINDS, atomic_paths, check_output_path, model_text
@@ -28,14 +29,21 @@ DEFAULT_OPERATORS = 16
 #: What each --model builds, and which size options it takes.
 LABELS = {"pi": "PI", "mpi": "MPI", "preisach": "Preisach"}
 SIZE_OPTIONS = {
-    "pi": ("operators",),
-    "mpi": ("operators", "deadzones", "regularization"),
+    "pi": ("operators", "constraints"),
+    "mpi": ("operators", "deadzones", "regularization", "constraints"),
     "preisach": ("degree",),
 }
 
 
 def build_estimator(
-    kind: str, *, operators, deadzones, voltage_range, regularization=None, degree=None
+    kind: str,
+    *,
+    operators,
+    deadzones,
+    voltage_range,
+    regularization=None,
+    degree=None,
+    constraints=None,
 ):
     """An unfitted model of ``kind`` from the registry :data:`hystcomp.io.MODEL_KINDS`."""
     cls = MODEL_KINDS.get(kind)
@@ -49,6 +57,7 @@ def build_estimator(
         "deadzones": deadzones,
         "regularization": regularization,
         "degree": degree,
+        "constraints": constraints,
     }
     for name, value in given.items():
         if value is not None and name not in SIZE_OPTIONS[kind]:
@@ -62,6 +71,8 @@ def build_estimator(
         params["regularization"] = regularization
     if degree is not None:
         params["degree"] = degree
+    if constraints is not None:
+        params["constraints"] = constraints
     return cls(**params)
 
 
@@ -114,7 +125,15 @@ def _sizes(model) -> str:
     metavar="LAMBDA|auto",
     callback=_regularization,
     help="Penalty on the inverse dead-zone weights, mpi [auto: the value of 0, 1e-4 .. 1e-1 "
-    "whose model best reproduces the record; 0 is eq. 19 as printed].",
+    "whose compensator is predicted to track best; 0 is eq. 19 as printed].",
+)
+@click.option(
+    "--constraints",
+    type=click.Choice(["physical", "paper"]),
+    default=None,
+    help="pi, mpi: 'physical' [default]: play weights beyond the first are non-negative, so "
+    "the loops widen with amplitude and the inverse has no steep slopes; 'paper': only the "
+    "partial-sum constraints of eq. 12 / eq. 19 as printed.",
 )
 @columns_option
 @fs_option
@@ -154,6 +173,7 @@ def identify(
     deadzones,
     degree,
     regularization,
+    constraints,
     columns,
     sample_rate,
     transient,
@@ -166,6 +186,13 @@ def identify(
 
     PI and MPI: constrained least squares (eqs. 16-19) with invertible weights; the
     start-up transient, the input range (bipolar too) and a displacement offset are handled.
+    By default the play weights beyond the first are non-negative (--constraints physical);
+    --constraints paper --regularization 0 is eq. 19 as printed.
+
+    Besides the fit error, prints an estimate of the compensator's tracking error in µm
+    rms (the inverse run on the measured displacement, its voltage error times the record's
+    gain) beside the same estimate for a straight line, and warns when the compensator is
+    predicted to do no better than the line, or when a hold-out leaves the fitted range.
     """
     check_output_path(output, inputs=(data,), what="model file")
     if plot is not None:  # matplotlib is imported only when a figure is asked for
@@ -183,6 +210,7 @@ def identify(
         voltage_range=voltage_range,
         regularization=regularization,
         degree=degree,
+        constraints=constraints,
     )
     rec = read_record(data, **read_options(columns, sample_rate))
     n = len(rec)
@@ -217,13 +245,26 @@ def identify(
     if model.get_params().get("regularization") == "auto":
         chosen = model.fit_report_["regularization"]
         click.echo(
-            f"  regularization: {chosen:g} (auto: the smallest fit error of 0, 1e-4 .. 1e-1)"
+            f"  regularization: {chosen:g} (auto: the best predicted tracking of 0, 1e-4 .. 1e-1)"
         )
     click.echo(
         f"  fit error: rms {report['rms_error_um']:.4g} µm "
         f"({report['rms_error_percent']:.3g} % of {report['displacement_range_um']:.4g} µm), "
         f"max {report['max_error_um']:.4g} µm ({report['max_error_percent']:.3g} %)"
     )
+    est = compensation_error(model, v, x, start=start)
+    click.echo(
+        f"  compensation (estimated): tracking rms {est['tracking_rms_um']:.4g} µm, straight "
+        f"line v = x/k_lin {est['baseline_rms_um']:.4g} µm ({est['ratio']:.2g}x)"
+    )
+    if not est["ratio"] < 1.0:
+        click.echo(
+            f"hystcomp: warning: the {label} compensator is predicted to track no better than "
+            f"a straight line ({est['tracking_rms_um']:.3g} vs {est['baseline_rms_um']:.3g} µm "
+            "rms); record a signal with turning points across the range (hystcomp excite "
+            "rich) or try another model.",
+            err=True,
+        )
     if holdout is not None:
         held = holdout_report(model, rec.v, rec.x, n_fit, start)
         click.echo(
@@ -231,6 +272,15 @@ def identify(
             f"{held['model_rms_um']:.4g} µm, straight line rms {held['line_rms_um']:.4g} µm: "
             f"{held['improvement']:.3g}x better"
         )
+        lo, hi = float(v.min()), float(v.max())
+        held_v = rec.v[n_fit:]
+        if held_v.min() < lo or held_v.max() > hi:
+            click.echo(
+                f"hystcomp: warning: the hold-out drives {held_v.min():.4g} .. "
+                f"{held_v.max():.4g} V, beyond the fitted range {lo:.4g} .. {hi:.4g} V; the "
+                "model extrapolates there. Hold out a part that stays inside the range.",
+                err=True,
+            )
     # Everything is computed; now write all outputs at once (a failure writes none of them).
     text = model_text(model)
     outputs = [output] if plot is None else [output, plot]
