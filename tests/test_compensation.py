@@ -12,9 +12,9 @@ from hystcomp import presets
 from hystcomp.cli import main
 from hystcomp.data import read_record, read_table, write_table
 from hystcomp.errors import InvalidParameterError
-from hystcomp.identify.compensation import compensation_error, thin
+from hystcomp.identify.compensation import compensation_error
 from hystcomp.identify.excitation import rich_sequence, triangle_sequence
-from hystcomp.identify.scoring import holdout_report, transient_end
+from hystcomp.identify.scoring import holdout_report, thin, transient_end
 from hystcomp.plant import Twin
 
 REAL_RECORD = Path(__file__).parent / "data" / "piezo-micromanipulator" / "Model_Vi_Do.dat"

@@ -16,9 +16,9 @@ residual ``x - a v - b``: the two numbers are comparable, and a model is predict
 only if its estimate is below the line's.
 
 It works for any model with ``inverse()`` (an object with ``simulate``) and is cheap: a
-long record is thinned first (:func:`thin`; the models are rate-independent, so keeping
+long record is thinned first (the models are rate-independent, so keeping
 every turning point and a regular subset of the samples between them changes nothing for
-them). On the panel of ``benchmarks/bench_accuracy.py`` it ranks candidate fits as the
+them; :func:`~hystcomp.identify.scoring.thin`). On the panel of ``benchmarks/bench_accuracy.py`` it ranks candidate fits as the
 measured tracking error does (Spearman rank correlation in that benchmark).
 """
 
@@ -28,35 +28,52 @@ import numpy as np
 
 from hystcomp._validation import as_signal_pair, check_int
 from hystcomp.errors import IdentificationError
-from hystcomp.identify.scoring import straight_line
+from hystcomp.identify.scoring import straight_line, thin
 
 #: Records longer than this are thinned before the inverse is run on them.
 MAX_SCORED_SAMPLES = 100_000
 
 
-def thin(v, start: int = 0, max_samples: int = MAX_SCORED_SAMPLES) -> np.ndarray:
-    """Indices of at most about ``max_samples`` samples: every turning point, and a regular grid.
+def tracking_scorer(v, x, *, start: int = 0, max_samples=MAX_SCORED_SAMPLES):
+    """A function ``score(model) -> dict`` that gives :func:`compensation_error` for one record.
 
-    A rate-independent model's output at the kept samples is unchanged when the others are
-    dropped, as long as every turning point of the input is kept (between two turning points
-    the input is monotone, and a play or relay only moves further the same way). Samples
-    before ``start`` are kept only as their turning points (to set the model's state).
-
-    Examples
-    --------
-    >>> thin(np.array([0.0, 1.0, 2.0, 3.0, 2.0, 1.0, 2.0]), max_samples=2).tolist()
-    [0, 3, 5, 6]
+    The record is validated, its straight line fitted and thinned once, so that scoring many
+    candidate models of the same record costs one inverse run of the thinned record each.
     """
-    v = np.asarray(v, dtype=np.float64)
-    n = v.size
-    if n <= max_samples:
-        return np.arange(n)
-    dv = np.diff(v)
-    sign = np.sign(dv)
-    turning = np.flatnonzero(sign[1:] * sign[:-1] < 0) + 1
-    step = max(1, (n - start) // max_samples)
-    grid = np.arange(start, n, step)
-    return np.unique(np.r_[0, turning, grid, n - 1])
+    owner = "compensation_error"
+    v, x = as_signal_pair(v, x, ("v", "x"), owner, min_samples=2)
+    start = check_int(start, "start", owner, minimum=0)
+    max_samples = check_int(max_samples, "max_samples", owner, minimum=2)
+    if start >= v.size - 1:
+        raise IdentificationError(
+            f"{owner}: 'start' ({start}) leaves fewer than 2 of the {v.size} samples to score."
+        )
+    a, b = straight_line(v[start:], x[start:])
+    if not a > 0:
+        raise IdentificationError(
+            f"{owner}: the record's straight-line gain is {a:g} µm/V; the displacement must "
+            "rise with the voltage. Check the sign and the columns of the record."
+        )
+    keep = thin(v, start, max_samples)
+    v_k, x_k = v[keep], np.ascontiguousarray(x[keep])
+    scored = keep >= start
+    v_s = v_k[scored]
+    line = x_k[scored] - a * v_s - b
+    line_rms = float(np.sqrt(np.mean(line**2)))
+
+    def score(model) -> dict:
+        v_hat = np.asarray(model.inverse().simulate(x_k), dtype=np.float64)
+        err = a * (v_hat[scored] - v_s)
+        model_rms = float(np.sqrt(np.mean(err**2)))
+        return {
+            "tracking_rms_um": model_rms,
+            "baseline_rms_um": line_rms,
+            "ratio": model_rms / line_rms if line_rms > 0 else float("inf"),
+            "gain_um_per_v": a,
+            "n_scored": int(v_s.size),
+        }
+
+    return score
 
 
 def compensation_error(model, v, x, *, start: int = 0, max_samples=MAX_SCORED_SAMPLES) -> dict:
@@ -71,7 +88,8 @@ def compensation_error(model, v, x, *, start: int = 0, max_samples=MAX_SCORED_SA
     start : int, default 0
         First sample scored (after a start-up transient); the inverse runs from sample 0.
     max_samples : int, default 100000
-        Thin longer records to about this many samples (:func:`thin`).
+        Thin longer records to about this many samples
+        (:func:`~hystcomp.identify.scoring.thin`).
 
     Returns
     -------
@@ -91,32 +109,4 @@ def compensation_error(model, v, x, *, start: int = 0, max_samples=MAX_SCORED_SA
     >>> bool(est["tracking_rms_um"] < 1e-6 < est["baseline_rms_um"])
     True
     """
-    owner = "compensation_error"
-    v, x = as_signal_pair(v, x, ("v", "x"), owner, min_samples=2)
-    start = check_int(start, "start", owner, minimum=0)
-    max_samples = check_int(max_samples, "max_samples", owner, minimum=2)
-    if start >= v.size - 1:
-        raise IdentificationError(
-            f"{owner}: 'start' ({start}) leaves fewer than 2 of the {v.size} samples to score."
-        )
-    a, b = straight_line(v[start:], x[start:])
-    if not a > 0:
-        raise IdentificationError(
-            f"{owner}: the record's straight-line gain is {a:g} µm/V; the displacement must "
-            "rise with the voltage. Check the sign and the columns of the record."
-        )
-    keep = thin(v, start, max_samples)
-    v_k, x_k = v[keep], x[keep]
-    scored = keep >= start
-    v_hat = np.asarray(model.inverse().simulate(x_k), dtype=np.float64)
-    err = a * (v_hat[scored] - v_k[scored])
-    line = x_k[scored] - a * v_k[scored] - b
-    model_rms = float(np.sqrt(np.mean(err**2)))
-    line_rms = float(np.sqrt(np.mean(line**2)))
-    return {
-        "tracking_rms_um": model_rms,
-        "baseline_rms_um": line_rms,
-        "ratio": model_rms / line_rms if line_rms > 0 else float("inf"),
-        "gain_um_per_v": a,
-        "n_scored": int(np.count_nonzero(scored)),
-    }
+    return tracking_scorer(v, x, start=start, max_samples=max_samples)(model)

@@ -60,6 +60,7 @@ from hystcomp.identify.pi import (
     check_margin,
     paper_thresholds,
     prepare_record,
+    thinned,
 )
 
 #: Candidate values of ``regularization`` for a choice: none, then one per decade.
@@ -231,7 +232,8 @@ def fit_mpi_path(
     z = rec.x - x0
     z_span = float(z[rec.start :].max())
     rs = paper_thresholds(m, z_span)  # eq. (17)
-    gram = normal_equations(rec.u, r, y0, z, rs[1:], rec.start)
+    keep, first = thinned(rec)
+    gram = normal_equations(rec.u[keep], r, y0, z[keep], rs[1:], first)
     fits = []
     for penalty in penalties:
         sol = constrained_lsq(

@@ -23,7 +23,7 @@ import numpy as np
 from hystcomp._validation import as_signal, check_int, check_real
 from hystcomp.errors import IdentificationError, InvalidParameterError, InvalidSignalError
 from hystcomp.identify.lsq import constrained_lsq, normal_equations
-from hystcomp.identify.scoring import check_transient
+from hystcomp.identify.scoring import check_transient, thin
 
 DEFAULT_MARGIN = 1e-3
 
@@ -93,6 +93,18 @@ def prepare_record(v, x, *, n_weights: int, transient, owner: str) -> PreparedRe
             "of the displacement (a negative sensor gain) or check the columns."
         )
     return PreparedRecord(v, x, v0, u, start, span, x_span / span)
+
+
+def thinned(rec: PreparedRecord) -> tuple[np.ndarray, int]:
+    """Samples of a long record that a fit needs (:func:`~hystcomp.identify.scoring.thin`).
+
+    Records longer than :data:`~hystcomp.identify.scoring.MAX_SAMPLES` are fitted on every
+    turning point and a regular subset of the samples: the play outputs there are exact
+    (rate independence), and the cost weights the record as the whole does. Returns the
+    indices kept and the position of the first sample in the cost among them.
+    """
+    keep = thin(rec.u, rec.start)
+    return keep, int(np.searchsorted(keep, rec.start))
 
 
 def check_margin(margin, owner: str) -> float:
@@ -193,7 +205,8 @@ def fit_pi(
     y0 = np.full(n, rec.u[0])
     x_ref = float(rec.x[rec.start :].min())
     constraints = check_constraints(constraints, owner)
-    gram = normal_equations(rec.u, r, y0, rec.x - x_ref, np.empty(0), rec.start)
+    keep, first = thinned(rec)
+    gram = normal_equations(rec.u[keep], r, y0, rec.x[keep] - x_ref, np.empty(0), first)
     sol = constrained_lsq(
         gram,
         blocks=[(0, n, margin * rec.slope)],

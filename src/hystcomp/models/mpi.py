@@ -7,7 +7,7 @@ import numpy as np
 from hystcomp import operators
 from hystcomp._validation import as_vector, check_int, check_thresholds
 from hystcomp.errors import InvalidParameterError
-from hystcomp.identify.compensation import compensation_error
+from hystcomp.identify.compensation import tracking_scorer
 from hystcomp.identify.mpi import REGULARIZATION_GRID, check_regularization, fit_mpi_path
 from hystcomp.identify.scoring import error_report
 from hystcomp.models.base import (
@@ -23,15 +23,6 @@ from hystcomp.models.inversion import (
     check_invertible,
     invert_superposition,
 )
-
-
-def _estimate(model, v, x, start: int) -> dict:
-    """The fit report's compensation estimate (:func:`~hystcomp.identify.compensation.compensation_error`)."""
-    est = compensation_error(model, v, x, start=start)
-    return {
-        "tracking_rms_um": est["tracking_rms_um"],
-        "baseline_tracking_rms_um": est["baseline_rms_um"],
-    }
 
 
 class ModifiedPrandtlIshlinskii(HysteresisModel):
@@ -163,6 +154,7 @@ class ModifiedPrandtlIshlinskii(HysteresisModel):
             constraints=self.constraints,
         )
         voltage_range = fit_voltage_range(self.voltage_range, v, owner)
+        score = tracking_scorer(v, x, start=fits[0].first_sample)
         best = None
         for penalty, fit in zip(penalties, fits, strict=True):
             rs, ws = self.forward_deadzones(
@@ -178,12 +170,15 @@ class ModifiedPrandtlIshlinskii(HysteresisModel):
                 input_offset=fit.input_offset,
                 output_offset=fit.output_offset,
             )
-            report = error_report(x, candidate.simulate(v), fit.first_sample)
-            report["regularization"] = penalty
-            report.update(_estimate(candidate, v, x, fit.first_sample))
-            if best is None or report["tracking_rms_um"] < best[1]["tracking_rms_um"]:
-                best = (candidate, report)
-        self._adopt(*best)
+            est = score(candidate)
+            if best is None or est["tracking_rms_um"] < best[2]["tracking_rms_um"]:
+                best = (candidate, penalty, est)
+        model, penalty, est = best
+        report = error_report(x, model.simulate(v), fits[0].first_sample)
+        report["regularization"] = penalty
+        report["tracking_rms_um"] = est["tracking_rms_um"]
+        report["baseline_tracking_rms_um"] = est["baseline_rms_um"]
+        self._adopt(model, report)
         return self
 
     def _penalties(self, owner: str) -> tuple[float, ...]:
