@@ -49,10 +49,16 @@ class ModifiedPrandtlIshlinskii(HysteresisModel):
         deviation from the paper for records of actuators that are not exactly MPI systems
         (see :mod:`hystcomp.identify.mpi`). ``"auto"`` fits every value of
         :data:`~hystcomp.identify.mpi.REGULARIZATION_GRID` (0 included) and keeps the model
-        whose *output* best reproduces the record: eq. (19) minimises an equation error
-        inside the model, not the error of ``x``, and on a real actuator the two disagree.
-        With a second record of the actuator, choose it there instead with
+        whose compensator has the smallest *estimated tracking error*
+        (:func:`hystcomp.identify.compensation.compensation_error`), not the smallest fit
+        error: a model that reproduces its record best can still have an inverse with steep
+        slopes. With a second record of the actuator, choose it by prediction there with
         :func:`hystcomp.identify.validation.choose_regularization`.
+    constraints : {"physical", "paper"}, default "physical"
+        ``"physical"``: play weights beyond the first are non-negative and ``S`` stays
+        monotone (see :mod:`hystcomp.identify.mpi`); ``"paper"``: the partial-sum
+        constraints of eq. (19) only. ``constraints="paper", regularization=0`` is the
+        paper's fit exactly.
 
     Attributes
     ----------
@@ -65,8 +71,10 @@ class ModifiedPrandtlIshlinskii(HysteresisModel):
     voltage_range_, input_offset_, output_offset_
         As in :class:`~hystcomp.models.pi.PrandtlIshlinskii`.
     fit_report_ : dict
-        After :meth:`fit`: errors of the model on the record, and the ``regularization``
-        it was fitted with (the chosen value if ``"auto"``).
+        After :meth:`fit`: errors of the model on the record, the ``regularization`` it was
+        fitted with (the chosen value if ``"auto"``), ``tracking_rms_um`` (the estimated
+        tracking error of its compensator, µm rms) and ``baseline_tracking_rms_um`` (the same
+        for a straight line ``v = x / k_lin``).
 
     Examples
     --------

@@ -46,6 +46,11 @@ class PrandtlIshlinskii(HysteresisModel):
     margin : float, default 1e-3
         Invertibility margin of the fit: every partial sum of the weights is at least
         ``margin`` times the record's mean slope (see :func:`hystcomp.identify.pi.fit_pi`).
+    constraints : {"physical", "paper"}, default "physical"
+        ``"physical"``: the weights beyond the first are also non-negative, so the loops
+        widen with amplitude and the inverse has no steep slopes (a deviation from the
+        paper, see :mod:`hystcomp.identify.pi`); ``"paper"``: the partial-sum constraints
+        of eq. (12) only.
 
     Attributes
     ----------
@@ -61,7 +66,10 @@ class PrandtlIshlinskii(HysteresisModel):
         ``v_0`` in V and ``x_0`` in µm.
     fit_report_ : dict
         After :meth:`fit`: errors of the model on the record
-        (:func:`hystcomp.identify.scoring.error_report`).
+        (:func:`hystcomp.identify.scoring.error_report`), ``tracking_rms_um`` (the estimated
+        tracking error of its compensator, µm rms,
+        :func:`hystcomp.identify.compensation.compensation_error`) and
+        ``baseline_tracking_rms_um`` (the same for a straight line ``v = x / k_lin``).
 
     Examples
     --------
