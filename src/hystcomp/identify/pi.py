@@ -19,8 +19,8 @@ system the partial-sum constraint alone lets the weights alternate in sign: the 
 pairs of nearly cancelling plays to follow the mismatch, the loading curve gets nearly flat
 stretches and the inverse huge slopes there. ``constraints="physical"`` also keeps every
 weight beyond the first non-negative (``w_i >= 0``, ``i >= 1``): the initial loading curve
-is then convex without wiggles (its slope only grows), the loop width grows with amplitude as a piezo's does, and the
-inverse's slopes stay below ``1 / w_0``. On the panel of ``benchmarks/bench_accuracy.py``
+is then convex without wiggles (its slope only grows), the loop width grows with amplitude
+as a piezo's does, and the inverse's slopes stay below ``1 / w_0``. On the panel of ``benchmarks/bench_accuracy.py``
 (five actuators of none of the families, four excitations) it brings the worst 1 Hz
 tracking of a PI compensator from 1.06x to 0.63x the uncompensated error (the paper's
 triangles: 1.06x to 0.52x on an asymmetric Bouc-Wen stage, 0.56x to 0.38x on the twin).
