@@ -71,6 +71,7 @@ from hystcomp.identify.pi import (
     check_constraints,
     check_margin,
     paper_thresholds,
+    play_thresholds,
     prepare_record,
     thinned,
 )
@@ -241,7 +242,7 @@ def fit_mpi_path(
             "Got an empty sequence instead."
         )
     rec = prepare_record(v, x, n_weights=n + m, transient=transient, owner=owner)
-    r = paper_thresholds(n, rec.input_span)
+    r = play_thresholds(n, rec.input_span, constraints)
     y0 = np.full(n, rec.u[0])
     x0 = float(rec.x[rec.start :].min())
     z = rec.x - x0
