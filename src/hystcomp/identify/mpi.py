@@ -94,6 +94,10 @@ class MPIFit:
         ``w'_S``, unitless, with ``w'_S0 = 1``.
     input_offset, output_offset : float
         ``v_0`` in V (with the bias absorbed, see :func:`absorb_bias`) and ``x_0`` in µm.
+    samples : ndarray
+        Indices of the samples the fit ran over: all of them, or for a record longer than
+        :data:`~hystcomp.identify.scoring.MAX_SAMPLES` its turning points and a regular
+        subset (:func:`~hystcomp.identify.scoring.thin`).
     first_sample : int
         First sample of the record in the cost.
     """
@@ -106,6 +110,7 @@ class MPIFit:
     input_offset: float
     output_offset: float
     first_sample: int
+    samples: np.ndarray | None = None
 
 
 def check_regularization(regularization, owner: str) -> float:
@@ -271,6 +276,7 @@ def fit_mpi_path(
                 input_offset=input_offset,
                 output_offset=x0,
                 first_sample=rec.start,
+                samples=keep,
             )
         )
     return fits

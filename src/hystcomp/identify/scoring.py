@@ -48,7 +48,7 @@ def transient_end(v) -> int:
     v = as_signal(v, "v", min_samples=1)
     lo, hi = v.min(), v.max()
     tol = END_TOLERANCE * (hi - lo)
-    return int(np.flatnonzero((v <= lo + tol) | (v >= hi - tol))[0])
+    return int(np.argmax((v <= lo + tol) | (v >= hi - tol)))
 
 
 def check_transient(transient, v: np.ndarray, owner: str, *, min_used: int) -> int:

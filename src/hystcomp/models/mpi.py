@@ -17,6 +17,7 @@ from hystcomp.models.base import (
     inverse_play_compensator,
     set_common_parameters,
     set_plays,
+    thinned_record,
 )
 from hystcomp.models.compensator import Compensator
 from hystcomp.models.inversion import (
@@ -162,7 +163,9 @@ class ModifiedPrandtlIshlinskii(HysteresisModel):
             constraints=self.constraints,
         )
         voltage_range = fit_voltage_range(self.voltage_range, v, owner)
-        score = tracking_scorer(v, x, start=fits[0].first_sample)
+        # scored on the samples the fit used (a long record is thinned, see fit_mpi_path)
+        v_k, x_k, first = thinned_record(v, x, fits[0])
+        score = tracking_scorer(v_k, x_k, start=first)
         best = None
         for penalty, fit in zip(penalties, fits, strict=True):
             rs, ws = self.forward_deadzones(
@@ -182,7 +185,7 @@ class ModifiedPrandtlIshlinskii(HysteresisModel):
             if best is None or est["tracking_rms_um"] < best[2]["tracking_rms_um"]:
                 best = (candidate, penalty, est)
         model, penalty, est = best
-        report = error_report(x, model.simulate(v), fits[0].first_sample)
+        report = error_report(x_k, model.simulate(v_k), first)
         report["regularization"] = penalty
         report["tracking_rms_um"] = est["tracking_rms_um"]
         report["baseline_tracking_rms_um"] = est["baseline_rms_um"]

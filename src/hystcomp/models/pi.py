@@ -16,6 +16,7 @@ from hystcomp.models.base import (
     inverse_play_compensator,
     set_common_parameters,
     set_plays,
+    thinned_record,
 )
 from hystcomp.models.compensator import Compensator
 from hystcomp.models.inversion import (
@@ -143,8 +144,9 @@ class PrandtlIshlinskii(HysteresisModel):
             input_offset=fit.input_offset,
             output_offset=fit.output_offset,
         )
-        report = error_report(x, fitted.simulate(v), fit.first_sample)
-        est = compensation_error(fitted, v, x, start=fit.first_sample)
+        v_k, x_k, first = thinned_record(v, x, fit)
+        report = error_report(x_k, fitted.simulate(v_k), first)
+        est = compensation_error(fitted, v_k, x_k, start=first)
         report["tracking_rms_um"] = est["tracking_rms_um"]
         report["baseline_tracking_rms_um"] = est["baseline_rms_um"]
         self._adopt(fitted, report)
