@@ -16,10 +16,14 @@ residual ``x - a v - b``: the two numbers are comparable, and a model is predict
 only if its estimate is below the line's.
 
 It works for any model with ``inverse()`` (an object with ``simulate``) and is cheap: a
-long record is thinned first (the models are rate-independent, so keeping
-every turning point and a regular subset of the samples between them changes nothing for
-them; :func:`~hystcomp.identify.scoring.thin`). On the panel of ``benchmarks/bench_accuracy.py`` it ranks candidate fits as the
-measured tracking error does (Spearman rank correlation in that benchmark).
+long record is thinned first (the models are rate-independent, so keeping every turning
+point and a regular subset of the samples between them changes nothing for them;
+:func:`~hystcomp.identify.scoring.thin`). On the panel of ``benchmarks/bench_accuracy.py``
+(5 actuators of none of the model families, 4 excitations) it ranks the candidate PI and
+MPI fits of a record as their measured 1 Hz tracking does with a median Spearman rank
+correlation of 0.80 (the fit error: 0.86); it is weakest on a Preisach actuator with
+output saturation, where a voltage error at the saturated top counts more than the
+tracking error it causes.
 """
 
 from __future__ import annotations
