@@ -38,6 +38,7 @@ import numpy as np
 
 from hystcomp._validation import as_signal, check_int, check_real
 from hystcomp.errors import IdentificationError, InvalidParameterError, InvalidSignalError
+from hystcomp.identify import scoring
 from hystcomp.identify.lsq import constrained_lsq, normal_equations
 from hystcomp.identify.scoring import check_transient, thin
 
@@ -146,7 +147,7 @@ def thinned(rec: PreparedRecord) -> tuple[np.ndarray, int]:
         (rate independence), and the cost weights the record as the whole does. Returns the
         indices kept and the position of the first sample in the cost among them.
     """
-    keep = thin(rec.u, rec.start)
+    keep = thin(rec.u, rec.start, scoring.MAX_SAMPLES)
     return keep, int(np.searchsorted(keep, rec.start))
 
 
