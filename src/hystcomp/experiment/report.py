@@ -194,7 +194,8 @@ def report_markdown(comparison, figure_notes: dict[str, str | None]) -> str:
             "",
             (
                 "The default fit keeps the play weights beyond the first non-negative (the loop "
-                "widens with amplitude, as on a piezo) and chooses the MPI regularisation by the "
+                "widens with amplitude, as on a piezo), spreads the play thresholds over half the "
+                "input span (where plays can move) and chooses the MPI regularisation by the "
                 'predicted tracking error; the paper\'s fit (constraints="paper", '
                 "regularization=0) only keeps every partial sum positive, so on an actuator of "
                 "none of the model families its weights may alternate in sign and its inverse "
@@ -334,5 +335,5 @@ def _mpi_note(model) -> str:
         f"penalty on the inverse dead-zone weights (regularization {value:g}), the value of "
         "0, 1e-4 .. 1e-1 whose compensator is predicted to track best "
         "(hystcomp.identify.compensation). Eq. 19 as printed overfits a twin that is not an "
-        "MPI system (see the table of the paper's fit above)."
+        "MPI system (see the section on the paper's fit below)."
     )
