@@ -31,7 +31,7 @@ monotone (every partial sum of ``w'_S`` above the margin) and smooth (the penalt
 its changes of slope). No sign is imposed on ``w'_S`` itself: a piezo's loading curve is
 often convex at low voltage and saturating at high voltage, so ``S`` must be able to bend
 both ways. On the panel of ``benchmarks/bench_accuracy.py`` the worst 1 Hz tracking of an
-MPI compensator from the paper's triangles goes from 1.53x (eq. 19 as printed) to 0.52x
+MPI compensator from the paper's triangles goes from 1.53x (eq. 19 as printed) to 0.48x
 the uncompensated error.
 
 Regularisation (a deviation from the paper; ``regularization=0`` is eq. 19 as printed). On a record of an

@@ -22,8 +22,9 @@ weight beyond the first non-negative (``w_i >= 0``, ``i >= 1``): the initial loa
 is then convex without wiggles (its slope only grows), the loop width grows with amplitude
 as a piezo's does, and the inverse's slopes stay below ``1 / w_0``. On the panel of ``benchmarks/bench_accuracy.py``
 (five actuators of none of the families, four excitations) it brings the worst 1 Hz
-tracking of a PI compensator from 1.06x to 0.63x the uncompensated error (the paper's
-triangles: 1.06x to 0.52x on an asymmetric Bouc-Wen stage, 0.56x to 0.38x on the twin).
+tracking of a PI compensator from 1.06x to 0.62x the uncompensated error (the paper's
+triangles: 1.06x to 0.46x on an asymmetric Bouc-Wen stage, 0.56x to 0.37x on the twin;
+with the thresholds below).
 The physical fit also spreads its thresholds over half the input span, where the plays
 can move (:func:`play_thresholds`). Records longer than
 :data:`~hystcomp.identify.scoring.MAX_SAMPLES` are fitted on every
@@ -67,8 +68,8 @@ def play_thresholds(n_operators: int, span: float, constraints: str) -> np.ndarr
     regressors are constant, see :func:`~hystcomp.identify.lsq.constrained_lsq`). The
     physical fit spreads the same number of plays over ``r_i = i / (n+1) U / 2`` instead,
     where the record has data: on the panel of ``benchmarks/bench_accuracy.py`` that lowers
-    the 1 Hz tracking error in most cells (the worst PI cell from 0.52x to 0.46x, the worst
-    MPI cell from the paper's triangles from 0.52x to 0.48x).
+    the 1 Hz tracking error in most cells (from the paper's triangles on the Bouc-Wen stage:
+    PI from 0.52x to 0.46x, MPI from 0.52x to 0.48x).
 
     Examples
     --------
