@@ -11,6 +11,7 @@ from hystcomp.identify.excitation import (
     DEFAULT_SAMPLE_RATE,
     PI_AMPLITUDES,
     PREISACH_AMPLITUDES,
+    rich_sequence,
     scaled_amplitudes,
     sinusoid_sequence,
     triangle_sequence,
@@ -25,7 +26,7 @@ SIGNALS = {
 
 
 @main.command("excite")
-@click.argument("model", type=click.Choice(sorted([*SIGNALS, "dynamics"])))
+@click.argument("model", type=click.Choice([*sorted(SIGNALS), "rich", "dynamics"]))
 @output_option(required=False, what="signal; CSV on standard output if omitted")
 @click.option(
     "--fs",
@@ -57,27 +58,34 @@ SIGNALS = {
     help="Period rate.",
 )
 def excite(model, output, sample_rate, voltage_range, frequency):
-    """Write the identification input for MODEL (pi, mpi or preisach).
+    """Write the identification input for MODEL (pi, mpi, preisach or rich).
 
     pi, mpi: triangles of 30, 60, 90, 120 V at 1 Hz (Section IV-A); preisach: sinusoids of
-    5, 10, ..., 120 V at 1 Hz (Section III-A). Each starts and ends at the lower end of the
-    range. dynamics (beyond the paper): a step to mid-range held 3 s (creep), then three
-    1 s periods of a +-4 V multisine of 1 Hz .. 5 kHz around it (--frequency unused).
-    Columns: t (s), v (V).
+    5, 10, ..., 120 V at 1 Hz (Section III-A); rich (not in the paper, one record for all
+    three models): ramps at the slope of the 1 Hz major triangle (times --frequency) between
+    turning points at many levels, decaying loops from each end of the range then random
+    ones (about 14 s). Each starts and ends at the lower end of the range. dynamics (beyond
+    the paper): a step to mid-range held 3 s (creep), then three 1 s periods of a +-4 V
+    multisine of 1 Hz .. 5 kHz around it (--frequency unused). Columns: t (s), v (V).
     """
     if output is not None:
         check_data_output(output, what="signal file")
+    lo, hi = voltage_range
     if model == "dynamics":
         from hystcomp.identify.dynamics import dynamics_excitation
 
         t, v = dynamics_excitation(sample_rate=sample_rate, voltage_range=voltage_range)
+    elif model == "rich":
+        t, v = rich_sequence(
+            rate=2.0 * (hi - lo) * frequency, sample_rate=sample_rate, v_min=lo, v_max=hi
+        )
     else:
         shape, amplitudes = SIGNALS[model]
         t, v = shape(
             scaled_amplitudes(amplitudes, voltage_range=voltage_range),
             frequency=frequency,
             sample_rate=sample_rate,
-            v_min=voltage_range[0],
+            v_min=lo,
         )
     if output is None:
         click.echo(format_csv({"t": t, "v": v}), nl=False)

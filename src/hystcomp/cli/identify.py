@@ -19,6 +19,7 @@ from hystcomp.cli._options import (
 )
 from hystcomp.data import read_record
 from hystcomp.errors import IdentificationError
+from hystcomp.identify.compensation import compensation_error
 from hystcomp.identify.preisach import EVERETT_KINDS, FIT_METHODS, MAX_DEGREE
 from hystcomp.identify.preisach_lsq import MAX_LSQ_GRID
 from hystcomp.identify.scoring import error_report, holdout_report, straight_line, transient_end
@@ -29,8 +30,8 @@ DEFAULT_OPERATORS = 16
 #: What each --model builds, and which size options it takes.
 LABELS = {"pi": "PI", "mpi": "MPI", "preisach": "Preisach", "dynamics": "dynamics"}
 SIZE_OPTIONS = {
-    "pi": ("operators",),
-    "mpi": ("operators", "deadzones", "regularization"),
+    "pi": ("operators", "constraints"),
+    "mpi": ("operators", "deadzones", "regularization", "constraints"),
     "preisach": ("degree", "fit", "everett", "grid"),
     "dynamics": (),
 }
@@ -49,6 +50,7 @@ def build_estimator(
     fit=None,
     everett=None,
     grid=None,
+    constraints=None,
 ):
     """An unfitted model of ``kind`` from the registry :data:`hystcomp.io.MODEL_KINDS`."""
     cls = MODEL_KINDS.get(kind)
@@ -65,6 +67,7 @@ def build_estimator(
         "fit": fit,
         "everett": everett,
         "grid": grid,
+        "constraints": constraints,
     }
     for name, value in given.items():
         if value is not None and name not in SIZE_OPTIONS[kind]:
@@ -80,6 +83,8 @@ def build_estimator(
         params["degree"] = degree
     if kind == "preisach":
         params.update(_everett_params(fit, everett, degree, grid))
+    if constraints is not None:
+        params["constraints"] = constraints
     return cls(**params)
 
 
@@ -171,7 +176,16 @@ def _sizes(model) -> str:
     metavar="LAMBDA|auto",
     callback=_regularization,
     help="Penalty on the inverse dead-zone weights, mpi [auto: the value of 0, 1e-4 .. 1e-1 "
-    "whose model best reproduces the record; 0 is eq. 19 as printed].",
+    "whose compensator is predicted to track best; 0 is eq. 19 as printed].",
+)
+@click.option(
+    "--constraints",
+    type=click.Choice(["physical", "paper"]),
+    default=None,
+    help="pi, mpi: 'physical' [default]: play weights beyond the first are non-negative, so "
+    "the loops widen with amplitude and the inverse has no steep slopes, and the play "
+    "thresholds span half the input range, where plays can move; 'paper': eq. 16's "
+    "thresholds and only the partial-sum constraints of eq. 12 / eq. 19 as printed.",
 )
 @columns_option
 @fs_option
@@ -214,6 +228,7 @@ def identify(
     everett,
     grid,
     regularization,
+    constraints,
     columns,
     sample_rate,
     transient,
@@ -229,6 +244,13 @@ def identify(
     Preisach: the paper's fit to reversal curves (Section III-A) or least squares over any
     record (--fit). dynamics (beyond the paper): creep and first resonance from the answer to
     'hystcomp excite dynamics', for compensate/export-c --dynamics; --plot draws its Bode plot.
+    By default the play weights beyond the first are non-negative (--constraints physical);
+    --constraints paper --regularization 0 is eq. 19 as printed.
+
+    Besides the fit error, prints an estimate of the compensator's tracking error in µm
+    rms (the inverse run on the measured displacement, its voltage error times the record's
+    gain) beside the same estimate for a straight line, and warns when the compensator is
+    predicted to do no better than the line, or when a hold-out leaves the fitted range.
     """
     check_output_path(output, inputs=(data,), what="model file")
     if plot is not None:  # matplotlib is imported only when a figure is asked for
@@ -260,6 +282,7 @@ def identify(
         fit=fit,
         everett=everett,
         grid=grid,
+        constraints=constraints,
     )
     rec = read_record(data, **read_options(columns, sample_rate))
     n = len(rec)
@@ -294,7 +317,7 @@ def identify(
     if model.get_params().get("regularization") == "auto":
         chosen = model.fit_report_["regularization"]
         click.echo(
-            f"  regularization: {chosen:g} (auto: the smallest fit error of 0, 1e-4 .. 1e-1)"
+            f"  regularization: {chosen:g} (auto: the best predicted tracking of 0, 1e-4 .. 1e-1)"
         )
     if kind == "preisach":
         click.echo(f"  Everett fit: {_preisach_fit_line(model)}")
@@ -303,6 +326,19 @@ def identify(
         f"({report['rms_error_percent']:.3g} % of {report['displacement_range_um']:.4g} µm), "
         f"max {report['max_error_um']:.4g} µm ({report['max_error_percent']:.3g} %)"
     )
+    est = compensation_error(model, v, x, start=start)
+    click.echo(
+        f"  compensation (estimated): tracking rms {est['tracking_rms_um']:.4g} µm, straight "
+        f"line v = x/k_lin {est['baseline_rms_um']:.4g} µm ({est['ratio']:.2g}x)"
+    )
+    if not est["ratio"] < 1.0:
+        click.echo(
+            f"hystcomp: warning: the {label} compensator is predicted to track no better than "
+            f"a straight line ({est['tracking_rms_um']:.3g} vs {est['baseline_rms_um']:.3g} µm "
+            "rms); record a signal with turning points across the range (hystcomp excite "
+            "rich) or try another model.",
+            err=True,
+        )
     if holdout is not None:
         held = holdout_report(model, rec.v, rec.x, n_fit, start)
         click.echo(
@@ -310,6 +346,15 @@ def identify(
             f"{held['model_rms_um']:.4g} µm, straight line rms {held['line_rms_um']:.4g} µm: "
             f"{held['improvement']:.3g}x better"
         )
+        lo, hi = float(v.min()), float(v.max())
+        held_v = rec.v[n_fit:]
+        if held_v.min() < lo or held_v.max() > hi:
+            click.echo(
+                f"hystcomp: warning: the hold-out drives {held_v.min():.4g} .. "
+                f"{held_v.max():.4g} V, beyond the fitted range {lo:.4g} .. {hi:.4g} V; the "
+                "model extrapolates there. Hold out a part that stays inside the range.",
+                err=True,
+            )
     # Everything is computed; now write all outputs at once (a failure writes none of them).
     text = model_text(model)
     outputs = [output] if plot is None else [output, plot]

@@ -191,3 +191,80 @@ def random_turning_points(
             "shorter sweeps or a lower sample rate."
         )
     return np.arange(v.size) / sample_rate, v
+
+
+def rich_turning_points(*, v_min: float = 0.0, v_max: float = 120.0, seed: int = 0) -> np.ndarray:
+    """Turning points of :func:`rich_sequence`: decaying oscillations from both ends, then random.
+
+    Four sweeps, each from an end of the range: ``v_max`` then down-up oscillations whose
+    amplitude decays from the span to 3 % of it (nested minor loops near the top, each
+    descent a reversal curve from a new level); the same from ``v_min`` upwards; then twice
+    16 turning points drawn uniformly in the range. It ends at ``v_min``.
+
+    Examples
+    --------
+    >>> p = rich_turning_points()
+    >>> float(p[0]), float(p[-1]), float(p.min()), float(p.max())
+    (0.0, 0.0, 0.0, 120.0)
+    """
+    rng = np.random.default_rng(seed)
+    span = v_max - v_min
+    points = [v_min]
+    decay = span * np.geomspace(1.0, 0.03, 12)
+    for from_top in (True, False, True, False):
+        end = v_max if from_top else v_min
+        points.append(end)
+        sign = -1.0 if from_top else 1.0
+        level = end
+        for amplitude in decay * rng.uniform(0.7, 1.0, decay.size):
+            level = float(np.clip(level + sign * amplitude, v_min, v_max))
+            points.append(level)
+            sign = -sign
+    points += [*list(rng.uniform(v_min, v_max, 32)), v_max, v_min]
+    return np.asarray(points, dtype=np.float64)
+
+
+def rich_sequence(
+    *,
+    rate: float = 240.0,
+    sample_rate: float = DEFAULT_SAMPLE_RATE,
+    v_min: float = 0.0,
+    v_max: float = 120.0,
+    seed: int = 0,
+) -> tuple[np.ndarray, np.ndarray]:
+    """An identification signal for all three models: ramps between :func:`rich_turning_points`.
+
+    Not in the paper. The paper's triangles (Section IV-A) visit only four reversal levels
+    and its sinusoids (Section III-A) only descents from rest; this signal reverses at many
+    levels in both directions (decaying loops from each end, then random turning points), so
+    a model fitted to it has seen the minor loops a tracking reference produces. Ramps run at
+    ``rate`` V/s (240 V/s: the slope of the paper's 120 V triangle at 1 Hz).
+
+    Returns
+    -------
+    t, v : ndarray
+        Time in s and voltage in V, starting and ending at ``v_min``.
+
+    Examples
+    --------
+    >>> t, v = rich_sequence(sample_rate=1000.0)
+    >>> float(v[0]), float(v[-1]), float(v.max())
+    (0.0, 0.0, 120.0)
+    """
+    owner = "rich_sequence"
+    rate = check_real(rate, "rate", owner, positive=True)
+    sample_rate = check_real(sample_rate, "sample_rate", owner, positive=True)
+    v_min, v_max = check_range((v_min, v_max), "voltage range (v_min, v_max)", owner)
+    points = rich_turning_points(v_min=v_min, v_max=v_max, seed=seed)
+    step = rate / sample_rate
+    if float(np.sum(np.abs(np.diff(points)))) / step > MAX_SAMPLES:
+        raise InvalidParameterError(
+            f"{owner}: a rate of {rate:g} V/s at {sample_rate:g} Hz makes more than "
+            f"{MAX_SAMPLES} samples. Raise the rate or lower the sample rate."
+        )
+    pieces = []
+    for lo, hi in itertools.pairwise(points):
+        n = max(1, int(np.ceil(abs(hi - lo) / step)))
+        pieces.append(lo + (hi - lo) * np.arange(n) / n)
+    v = np.r_[np.concatenate(pieces), points[-1]]
+    return np.arange(v.size) / sample_rate, v

@@ -125,11 +125,16 @@ class LsqSolution:
 RIDGE = 1e-10
 
 
-def constrained_lsq(gram, *, blocks, scales, flat_tol=1e-6, ridge=RIDGE) -> LsqSolution:
+def constrained_lsq(
+    gram, *, blocks, scales, floors=(), caps=(), flat_tol=1e-6, ridge=RIDGE
+) -> LsqSolution:
     """Least squares from normal equations, every partial sum in each block above a bound.
 
     Minimises ``|Phi theta - z|^2`` subject to ``theta[a] + ... + theta[i] >= bound`` for
-    every block ``(a, b, bound)`` and every ``a <= i < b``. The last regressor is the
+    every block ``(a, b, bound)`` and every ``a <= i < b``; optionally also
+    ``theta[i] >= bound`` for every ``(a, b, bound)`` of ``floors`` and ``a <= i < b``
+    (non-negative weights), and ``theta[a] + ... + theta[i] <= bound`` for every
+    ``(a, b, bound)`` of ``caps`` (a largest slope). The last regressor is the
     constant (an unconstrained offset): it is eliminated exactly first (the Schur complement,
     i.e. the columns are centred), which also removes the large column means that would
     otherwise spoil the conditioning.
@@ -148,6 +153,10 @@ def constrained_lsq(gram, *, blocks, scales, flat_tol=1e-6, ridge=RIDGE) -> LsqS
     blocks : sequence of (int, int, float)
         ``(first, stop, bound)``: partial sums of ``theta[first:stop]`` must be ``>= bound``.
         The first regressor of a block with ``bound > 0`` must vary over the samples.
+    floors : sequence of (int, int, float), optional
+        ``(first, stop, bound)``: each of ``theta[first:stop]`` must be ``>= bound``.
+    caps : sequence of (int, int, float), optional
+        ``(first, stop, bound)``: partial sums of ``theta[first:stop]`` must be ``<= bound``.
     scales : array_like, shape (p - 1,)
         Typical size of each non-constant regressor (its range), in its own units.
     flat_tol : float
@@ -192,6 +201,16 @@ def constrained_lsq(gram, *, blocks, scales, flat_tol=1e-6, ridge=RIDGE) -> LsqS
         for i in range(first, stop):
             if varies[i]:  # partial sums at a fixed (zero) coefficient repeat the one before
                 rows.append(np.where((idx >= first) & (idx <= i), scale, 0.0))
+                bounds.append(bound)
+    for first, stop, bound in caps:
+        for i in range(first, stop):
+            if varies[i]:
+                rows.append(np.where((idx >= first) & (idx <= i), -scale, 0.0))
+                bounds.append(-bound)
+    for first, stop, bound in floors:
+        for i in range(first, stop):
+            if varies[i]:
+                rows.append(np.where(idx == i, scale, 0.0))
                 bounds.append(bound)
     cons = np.array(rows, dtype=np.float64).reshape(len(rows), idx.size)
     try:

@@ -48,7 +48,7 @@ def transient_end(v) -> int:
     v = as_signal(v, "v", min_samples=1)
     lo, hi = v.min(), v.max()
     tol = END_TOLERANCE * (hi - lo)
-    return int(np.flatnonzero((v <= lo + tol) | (v >= hi - tol))[0])
+    return int(np.argmax((v <= lo + tol) | (v >= hi - tol)))
 
 
 def check_transient(transient, v: np.ndarray, owner: str, *, min_used: int) -> int:
@@ -65,6 +65,37 @@ def check_transient(transient, v: np.ndarray, owner: str, *, min_used: int) -> i
             "Record longer, use fewer operators, or set a shorter transient."
         )
     return start
+
+
+#: Records longer than this are thinned (:func:`thin`) before a fit or a score.
+MAX_SAMPLES = 500_000
+
+
+def thin(v, start: int = 0, max_samples: int = MAX_SAMPLES) -> np.ndarray:
+    """Indices of at most about ``max_samples`` samples: every turning point, and a regular grid.
+
+    The output of a rate-independent model (plays, dead-zones, relays) at the kept samples
+    is unchanged when the others are dropped, as long as every turning point of its input is
+    kept: between two turning points the input is monotone, and a play or a relay only moves
+    further the same way. A least-squares fit or a score over a regular subset of the samples
+    weights the record as the whole does. Before ``start`` (a start-up transient, out of the
+    cost) only the turning points are kept, to set the model's state.
+
+    Examples
+    --------
+    >>> thin(np.array([0.0, 1.0, 2.0, 3.0, 2.0, 1.0, 2.0]), max_samples=2).tolist()
+    [0, 3, 5, 6]
+    """
+    v = np.asarray(v, dtype=np.float64)
+    n = v.size
+    if n <= max_samples:
+        return np.arange(n)
+    keep = np.zeros(n, dtype=bool)
+    sign = np.sign(np.diff(v))
+    keep[1:-1] = sign[1:] != sign[:-1]
+    keep[start :: max(1, (n - start) // max_samples)] = True
+    keep[0] = keep[-1] = True
+    return np.flatnonzero(keep)
 
 
 def error_report(x, x_model, start: int = 0) -> dict:
@@ -117,9 +148,11 @@ def straight_line(v, x) -> tuple[float, float]:
     (2.0, 1.0)
     """
     v, x = as_signal_pair(v, x, ("v", "x"), "straight_line")
-    design = np.column_stack([v, np.ones_like(v)])
-    (a, b), *_ = np.linalg.lstsq(design, x, rcond=None)
-    return float(a), float(b)
+    v_mean, x_mean = float(v.mean()), float(x.mean())
+    dv = v - v_mean
+    spread = float(dv @ dv)
+    a = float(dv @ (x - x_mean)) / spread if spread > 0 else 0.0
+    return a, x_mean - a * v_mean
 
 
 def holdout_report(model, v, x, n_fit: int, start: int = 0) -> dict:

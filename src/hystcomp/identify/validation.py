@@ -63,8 +63,8 @@ def choose_regularization(estimator, v, x, v_val, x_val, *, grid=REGULARIZATION_
     >>> true = presets.paper_mpi()
     >>> _, v = triangle_sequence(sample_rate=500)
     >>> v_val = 100.0 * np.abs(np.sin(np.linspace(0.0, 9.0, 3000)))
-    >>> choice = choose_regularization(
-    ...     ModifiedPrandtlIshlinskii(), v, true.simulate(v), v_val, true.simulate(v_val))
+    >>> estimator = ModifiedPrandtlIshlinskii(constraints="paper")  # eq. 19: the paper's model
+    >>> choice = choose_regularization(estimator, v, true.simulate(v), v_val, true.simulate(v_val))
     >>> choice.value  # an MPI system of the estimator's size needs none
     0.0
     >>> bool(choice.scores[0.0] < 1e-6 < choice.scores[1e-2])

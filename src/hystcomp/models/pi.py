@@ -6,6 +6,7 @@ import numpy as np
 
 from hystcomp import operators
 from hystcomp._validation import check_int
+from hystcomp.identify.compensation import compensation_error
 from hystcomp.identify.pi import fit_pi, paper_thresholds
 from hystcomp.identify.scoring import error_report
 from hystcomp.models.base import (
@@ -15,6 +16,7 @@ from hystcomp.models.base import (
     inverse_play_compensator,
     set_common_parameters,
     set_plays,
+    thinned_record,
 )
 from hystcomp.models.compensator import Compensator
 from hystcomp.models.dynamic_compensator import with_dynamics
@@ -46,6 +48,11 @@ class PrandtlIshlinskii(HysteresisModel):
     margin : float, default 1e-3
         Invertibility margin of the fit: every partial sum of the weights is at least
         ``margin`` times the record's mean slope (see :func:`hystcomp.identify.pi.fit_pi`).
+    constraints : {"physical", "paper"}, default "physical"
+        ``"physical"``: the weights beyond the first are also non-negative, so the loops
+        widen with amplitude and the inverse has no steep slopes (a deviation from the
+        paper, see :mod:`hystcomp.identify.pi`); ``"paper"``: the partial-sum constraints
+        of eq. (12) only.
 
     Attributes
     ----------
@@ -61,7 +68,10 @@ class PrandtlIshlinskii(HysteresisModel):
         ``v_0`` in V and ``x_0`` in µm.
     fit_report_ : dict
         After :meth:`fit`: errors of the model on the record
-        (:func:`hystcomp.identify.scoring.error_report`).
+        (:func:`hystcomp.identify.scoring.error_report`), ``tracking_rms_um`` (the estimated
+        tracking error of its compensator, µm rms,
+        :func:`hystcomp.identify.compensation.compensation_error`) and
+        ``baseline_tracking_rms_um`` (the same for a straight line ``v = x / k_lin``).
 
     Examples
     --------
@@ -83,11 +93,20 @@ class PrandtlIshlinskii(HysteresisModel):
         "output_offset",
     )
 
-    def __init__(self, *, n_operators=16, voltage_range=None, transient=None, margin=1e-3):
+    def __init__(
+        self,
+        *,
+        n_operators=16,
+        voltage_range=None,
+        transient=None,
+        margin=1e-3,
+        constraints="physical",
+    ):
         self.n_operators = n_operators
         self.voltage_range = voltage_range
         self.transient = transient
         self.margin = margin
+        self.constraints = constraints
 
     def fit(self, v, x) -> PrandtlIshlinskii:
         """Identify the model from a measured record (Section IV-A, eqs. 12, 16, 18).
@@ -109,7 +128,14 @@ class PrandtlIshlinskii(HysteresisModel):
         owner = type(self).__name__
         n = check_int(self.n_operators, "n_operators", owner)
         check_fit_options(self, owner)
-        fit = fit_pi(v, x, n_operators=n, transient=self.transient, margin=self.margin)
+        fit = fit_pi(
+            v,
+            x,
+            n_operators=n,
+            transient=self.transient,
+            margin=self.margin,
+            constraints=self.constraints,
+        )
         fitted = self.from_parameters(
             thresholds=fit.thresholds,
             weights=fit.weights,
@@ -118,7 +144,12 @@ class PrandtlIshlinskii(HysteresisModel):
             input_offset=fit.input_offset,
             output_offset=fit.output_offset,
         )
-        self._adopt(fitted, error_report(x, fitted.simulate(v), fit.first_sample))
+        v_k, x_k, first = thinned_record(v, x, fit)
+        report = error_report(x_k, fitted.simulate(v_k), first)
+        est = compensation_error(fitted, v_k, x_k, start=first)
+        report["tracking_rms_um"] = est["tracking_rms_um"]
+        report["baseline_tracking_rms_um"] = est["baseline_rms_um"]
+        self._adopt(fitted, report)
         return self
 
     @classmethod
