@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import click
 
+from hystcomp import paper
 from hystcomp.cli import main
 from hystcomp.cli._options import check_data_output, output_option, positive, voltage_range
 from hystcomp.data import format_csv, write_table
@@ -41,7 +42,7 @@ SIGNALS = {
     "--voltage-range",
     nargs=2,
     type=float,
-    default=(0.0, 120.0),
+    default=paper.VOLTAGE_RANGE,
     show_default=True,
     metavar="LO HI",
     callback=voltage_range,

@@ -20,6 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from hystcomp import paper
 from hystcomp._validation import as_signal, check_int, check_real
 from hystcomp.errors import IdentificationError, InvalidParameterError, InvalidSignalError
 from hystcomp.identify.lsq import constrained_lsq, normal_equations
@@ -134,7 +135,7 @@ class PIFit:
     first_sample: int
 
 
-def fit_pi(v, x, *, n_operators=16, transient=None, margin=DEFAULT_MARGIN) -> PIFit:
+def fit_pi(v, x, *, n_operators=paper.N_OPERATORS, transient=None, margin=DEFAULT_MARGIN) -> PIFit:
     """Identify a classical PI model (eq. 12) from a measured record by constrained least squares.
 
     Minimises ``sum_k (x_0 + sum_i w_i play_{r_i}(v - v_0)[k] - x[k])^2`` over the samples

@@ -4,11 +4,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from hystcomp import operators
+from hystcomp import operators, paper
 from hystcomp._validation import check_int
 from hystcomp.identify.pi import fit_pi, paper_thresholds
 from hystcomp.identify.scoring import error_report
 from hystcomp.models.base import (
+    DEFAULT_VOLTAGE_RANGE,
     HysteresisModel,
     check_fit_options,
     fit_voltage_range,
@@ -82,7 +83,9 @@ class PrandtlIshlinskii(HysteresisModel):
         "output_offset",
     )
 
-    def __init__(self, *, n_operators=16, voltage_range=None, transient=None, margin=1e-3):
+    def __init__(
+        self, *, n_operators=paper.N_OPERATORS, voltage_range=None, transient=None, margin=1e-3
+    ):
         self.n_operators = n_operators
         self.voltage_range = voltage_range
         self.transient = transient
@@ -127,7 +130,7 @@ class PrandtlIshlinskii(HysteresisModel):
         thresholds,
         weights,
         initial_state=None,
-        voltage_range=(0.0, 120.0),
+        voltage_range=DEFAULT_VOLTAGE_RANGE,
         input_offset=0.0,
         output_offset=0.0,
     ) -> PrandtlIshlinskii:
@@ -152,7 +155,9 @@ class PrandtlIshlinskii(HysteresisModel):
             out_offset=self.output_offset_,
         )
 
-    def inverse(self, *, slew_rate=None, sample_rate=20_000.0, voltage_range=None) -> Compensator:
+    def inverse(
+        self, *, slew_rate=None, sample_rate=paper.SAMPLE_RATE, voltage_range=None
+    ) -> Compensator:
         """The analytic inverse PI (eqs. 24-26) as a compensator clamped to the voltage range.
 
         Parameters
