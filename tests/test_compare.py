@@ -11,8 +11,8 @@ from hystcomp.cli import main
 from hystcomp.errors import InvalidParameterError
 from hystcomp.experiment import compare as compare_module
 from hystcomp.experiment.compare import CompareConfig, run_comparison
-from hystcomp.experiment.paper import METHODS
 from hystcomp.experiment.report import write_outputs
+from hystcomp.paper import METHODS
 
 PNG = b"\x89PNG\r\n\x1a\n"
 

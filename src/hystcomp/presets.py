@@ -23,76 +23,20 @@ from __future__ import annotations
 
 import numpy as np
 
+from hystcomp import paper
 from hystcomp.identify.excitation import triangle_sequence
 from hystcomp.models.mpi import ModifiedPrandtlIshlinskii
 from hystcomp.models.pi import PrandtlIshlinskii, paper_thresholds
 from hystcomp.models.preisach import Preisach
 
-PAPER_V_MAX = 120.0  # V, eq. (16)
+PAPER_V_MAX = paper.VOLTAGE_RANGE[1]  # V, eq. (16)
 
 #: Eq. (20), PI play weights in µm/V.
-PAPER_PI_WEIGHTS = np.array(
-    [
-        0.1386,
-        0.1101,
-        0.0276,
-        -0.0651,
-        0.1568,
-        -0.0698,
-        0.0491,
-        -0.0413,
-        0.0396,
-        0.0105,
-        -0.0016,
-        0.0232,
-        -0.0957,
-        0.0954,
-        0.0323,
-        -0.0685,
-    ]
-)
+PAPER_PI_WEIGHTS = np.array(paper.PI_WEIGHTS)
 #: Eq. (21), MPI play weights in µm/V.
-PAPER_MPI_WEIGHTS = np.array(
-    [
-        0.4001,
-        0.0492,
-        0.0814,
-        -0.0242,
-        0.0886,
-        0.0074,
-        0.0548,
-        0.0265,
-        -0.0374,
-        0.0378,
-        0.0093,
-        0.1146,
-        -0.2047,
-        0.0989,
-        0.1547,
-        -0.1286,
-    ]
-)
+PAPER_MPI_WEIGHTS = np.array(paper.MPI_WEIGHTS)
 #: Eq. (22), MPI inverse dead-zone weights (unitless).
-PAPER_MPI_INVERSE_DEADZONE_WEIGHTS = np.array(
-    [
-        3.0803,
-        -1.2216,
-        0.1782,
-        -0.2045,
-        0.0502,
-        0.0478,
-        0.0894,
-        -0.0221,
-        -0.0336,
-        0.0163,
-        0.0620,
-        0.2135,
-        -0.0247,
-        -0.1913,
-        0.4753,
-        -0.2476,
-    ]
-)
+PAPER_MPI_INVERSE_DEADZONE_WEIGHTS = np.array(paper.MPI_INVERSE_DEADZONE_WEIGHTS)
 
 
 def paper_identification_triangle(sample_rate: float = 1000.0) -> np.ndarray:
@@ -110,22 +54,22 @@ def paper_pi() -> PrandtlIshlinskii:
     37.789
     """
     return PrandtlIshlinskii.from_parameters(
-        thresholds=paper_thresholds(16, PAPER_V_MAX),
+        thresholds=paper_thresholds(paper.N_OPERATORS, PAPER_V_MAX),
         weights=PAPER_PI_WEIGHTS,
-        voltage_range=(0.0, PAPER_V_MAX),
+        voltage_range=paper.VOLTAGE_RANGE,
     )
 
 
 def paper_mpi_with(max_displacement: float) -> ModifiedPrandtlIshlinskii:
     """The MPI of eqs. (21)-(22) with eq. (17)'s thresholds for ``max{x_p} = max_displacement`` µm."""
-    r_inv = paper_thresholds(16, max_displacement)  # eq. (17)
+    r_inv = paper_thresholds(paper.N_DEADZONES, max_displacement)  # eq. (17)
     rs, ws = ModifiedPrandtlIshlinskii.forward_deadzones(r_inv, PAPER_MPI_INVERSE_DEADZONE_WEIGHTS)
     return ModifiedPrandtlIshlinskii.from_parameters(
-        thresholds=paper_thresholds(16, PAPER_V_MAX),
+        thresholds=paper_thresholds(paper.N_OPERATORS, PAPER_V_MAX),
         weights=PAPER_MPI_WEIGHTS,
         deadzone_thresholds=rs,
         deadzone_weights=ws,
-        voltage_range=(0.0, PAPER_V_MAX),
+        voltage_range=paper.VOLTAGE_RANGE,
     )
 
 
@@ -148,9 +92,7 @@ def paper_mpi() -> ModifiedPrandtlIshlinskii:
 
 
 #: Eq. (6), the coefficients of eq. (5) in µm/V, µm/V^2 and µm/V^3 (eq. 5's order).
-PAPER_PREISACH_THETA = np.array(
-    [-0.137, 0.15, 0.0014, -0.0045, 0.00298, 0.0000025, -0.000007, 0.000019, -0.000014]
-)
+PAPER_PREISACH_THETA = np.array(paper.PREISACH_THETA)
 
 
 def paper_preisach(*, zero_diagonal: bool = False) -> Preisach:
@@ -190,5 +132,5 @@ def paper_preisach(*, zero_diagonal: bool = False) -> Preisach:
         theta[2] = -(theta[3] + theta[4])
         theta[5] = -(theta[6] + theta[7] + theta[8])
     return Preisach.from_parameters(
-        theta=theta, voltage_range=(0.0, PAPER_V_MAX), output_offset=0.0
+        theta=theta, voltage_range=paper.VOLTAGE_RANGE, output_offset=0.0
     )

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import click
 
+from hystcomp import paper
 from hystcomp.cli import main
 from hystcomp.cli._options import check_data_output, output_option, positive, voltage_range
 from hystcomp.data import format_csv, write_table
@@ -42,7 +43,7 @@ SIGNALS = {
     "--voltage-range",
     nargs=2,
     type=float,
-    default=(0.0, 120.0),
+    default=paper.VOLTAGE_RANGE,
     show_default=True,
     metavar="LO HI",
     callback=voltage_range,
@@ -58,7 +59,7 @@ SIGNALS = {
     help="Period rate.",
 )
 def excite(model, output, sample_rate, voltage_range, frequency):
-    """Write the identification input for MODEL (pi, mpi, preisach or rich).
+    """Write the identification input for MODEL: pi, mpi, preisach, rich or dynamics.
 
     pi, mpi: triangles of 30, 60, 90, 120 V at 1 Hz (Section IV-A); preisach: sinusoids of
     5, 10, ..., 120 V at 1 Hz (Section III-A); rich (not in the paper, one record for all

@@ -6,6 +6,7 @@ from pathlib import Path
 
 import click
 
+from hystcomp import paper
 from hystcomp.cli import main
 from hystcomp.cli._dynamics import load_dynamics, refuse_dynamics_as_model
 from hystcomp.cli._options import method_option, method_options
@@ -40,7 +41,7 @@ from hystcomp.io import load_model
     "--fs",
     "sample_rate",
     type=float,
-    default=20_000.0,
+    default=paper.SAMPLE_RATE,
     show_default=True,
     metavar="HZ",
     help="Sample rate at which NAME_step is called; sets the slew step per sample.",

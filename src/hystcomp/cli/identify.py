@@ -7,6 +7,7 @@ from pathlib import Path
 import click
 import numpy as np
 
+from hystcomp import paper
 from hystcomp.cli import main
 from hystcomp.cli._options import (
     columns_option,
@@ -25,7 +26,7 @@ from hystcomp.identify.preisach_lsq import MAX_LSQ_GRID
 from hystcomp.identify.scoring import error_report, holdout_report, straight_line, transient_end
 from hystcomp.io import MODEL_KINDS, atomic_paths, check_output_path, model_text
 
-DEFAULT_OPERATORS = 16
+DEFAULT_OPERATORS = paper.N_OPERATORS
 
 #: What each --model builds, and which size options it takes.
 LABELS = {"pi": "PI", "mpi": "MPI", "preisach": "Preisach", "dynamics": "dynamics"}

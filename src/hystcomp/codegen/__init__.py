@@ -18,6 +18,7 @@ import os
 from collections.abc import Callable
 from pathlib import Path
 
+from hystcomp import paper
 from hystcomp.codegen.c99 import CTemplate, check_prefix, render
 from hystcomp.codegen.chain import chain_template
 from hystcomp.codegen.preisach import preisach_template
@@ -41,7 +42,7 @@ def generate_c(
     *,
     prefix: str = DEFAULT_PREFIX,
     source: str | None = None,
-    sample_rate: float = 20_000.0,
+    sample_rate: float = paper.SAMPLE_RATE,
 ) -> tuple[str, str]:
     """The C99 header and source of ``compensator`` (see :func:`export_c`).
 
@@ -77,7 +78,7 @@ def export_c(
     *,
     prefix: str = DEFAULT_PREFIX,
     source: str | None = None,
-    sample_rate: float = 20_000.0,
+    sample_rate: float = paper.SAMPLE_RATE,
 ) -> tuple[Path, Path]:
     """Write ``PREFIX.h`` and ``PREFIX.c``, a C99 version of ``compensator``, into ``directory``.
 

@@ -25,6 +25,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from hystcomp import paper
 from hystcomp.errors import InvalidParameterError
 
 # A C identifier that does not start with '_' (reserved at file scope, C99 7.1.3).
@@ -113,7 +114,11 @@ def c_table(name: str, values, comment: str) -> str:
 
 
 def render(
-    template: CTemplate, prefix: str, *, source: str | None = None, sample_rate: float = 20_000.0
+    template: CTemplate,
+    prefix: str,
+    *,
+    source: str | None = None,
+    sample_rate: float = paper.SAMPLE_RATE,
 ) -> tuple[str, str]:
     """The texts of ``NAME.h`` and ``NAME.c`` for ``template``.
 

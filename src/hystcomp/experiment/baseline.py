@@ -13,6 +13,7 @@ import numpy as np
 
 from hystcomp._validation import as_signal, as_signal_pair, check_range, check_real
 from hystcomp.errors import IdentificationError, InvalidParameterError
+from hystcomp.paper import VOLTAGE_RANGE
 
 GAIN_METHODS = ("least-squares", "end-point")
 
@@ -68,7 +69,7 @@ class LinearCompensator:
 
     kind = "linear"
 
-    def __init__(self, gain: float, voltage_range=(0.0, 120.0)):
+    def __init__(self, gain: float, voltage_range=VOLTAGE_RANGE):
         self.gain = check_real(gain, "gain", "LinearCompensator", positive=True)
         self.voltage_range = check_range(voltage_range, "voltage_range", "LinearCompensator")
 

@@ -23,11 +23,9 @@ from hystcomp._validation import check_int, check_real
 from hystcomp.data import Record
 from hystcomp.errors import InvalidParameterError, InvalidTypeError
 from hystcomp.experiment.baseline import LinearCompensator, linear_gain
-from hystcomp.experiment.paper import DATASHEET_GAIN, METHODS
 from hystcomp.experiment.references import FREQUENCIES, REFERENCE_FRACTION, triangle_reference
 from hystcomp.experiment.tracking import TrackingResult, check_compensator, run_tracking
 from hystcomp.identify.excitation import (
-    PI_AMPLITUDES,
     PREISACH_AMPLITUDES,
     sinusoid_sequence,
     triangle_sequence,
@@ -35,11 +33,11 @@ from hystcomp.identify.excitation import (
 from hystcomp.models.mpi import ModifiedPrandtlIshlinskii
 from hystcomp.models.pi import PrandtlIshlinskii
 from hystcomp.models.preisach import Preisach
+from hystcomp.paper import DATASHEET_GAIN, FIG5_AMPLITUDES, METHODS, N_DEADZONES, N_OPERATORS
 from hystcomp.plant import Twin, TwinParameters, creep_twin
 
 #: The model kinds that :func:`identify_models` returns, and the amplitudes of Fig. 5.
 MODEL_KINDS = ("preisach", "pi", "mpi")
-FIG5_AMPLITUDES = PI_AMPLITUDES  # 30, 60, 90, 120 V
 
 
 @dataclasses.dataclass(frozen=True)
@@ -76,8 +74,8 @@ class CompareConfig:
     frequencies: tuple[float, ...] = FREQUENCIES
     reference_fraction: float = REFERENCE_FRACTION
     preisach_amplitudes: tuple[float, ...] = PREISACH_AMPLITUDES
-    n_operators: int = 16
-    n_deadzones: int = 16
+    n_operators: int = N_OPERATORS
+    n_deadzones: int = N_DEADZONES
     preisach_degree: int = 3
     twin: TwinParameters = dataclasses.field(default_factory=creep_twin)
     dynamics: bool = True

@@ -11,9 +11,7 @@ from hystcomp._validation import as_signal, check_real
 from hystcomp.errors import InvalidParameterError, InvalidSignalError
 from hystcomp.identify.excitation import scaled_amplitudes, sinusoid_sequence
 from hystcomp.io import atomic_path
-
-#: Fig. 5's amplitudes on the paper's 0..120 V.
-FIG5_AMPLITUDES = (30.0, 60.0, 90.0, 120.0)
+from hystcomp.paper import FIG5_AMPLITUDES
 
 
 def plot_preisach_loops(

@@ -1,4 +1,4 @@
-"""Figures of the comparison: the paper's Figs. 9 and 10, and hooks for Figs. 5 and 8.
+"""Figures of the comparison: the paper's Figs. 9 and 10 here, Figs. 5 and 8 from their modules.
 
 Every figure is drawn on its own :class:`~matplotlib.figure.Figure` (no global pyplot
 state) and saved through :func:`hystcomp.io.atomic_path`, so a failure never leaves a
@@ -7,16 +7,17 @@ broken image.
 
 from __future__ import annotations
 
-import importlib
 from pathlib import Path
 
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
+from hystcomp.experiment.fig_identification import plot_identification
+from hystcomp.experiment.fig_preisach import plot_preisach_loops
 from hystcomp.experiment.metrics import SATURATION_ZONE
-from hystcomp.experiment.paper import LABELS, METHODS
 from hystcomp.io import atomic_path
+from hystcomp.paper import LABELS, METHODS
 
 COLOURS = {"uncompensated": "0.45", "preisach": "tab:green", "pi": "tab:blue", "mpi": "tab:red"}
 
@@ -108,16 +109,14 @@ def figure_10(results: dict, path: Path) -> None:
     _save(fig, path)
 
 
-def _hook(module: str, name: str):
-    """A figure function written in another module of the package, or None if absent."""
-    try:
-        return getattr(importlib.import_module(module), name, None)
-    except ImportError:
-        return None
-
-
 def write_figures(comparison, out_dir: Path) -> dict[str, str | None]:
-    """Draw every figure into ``out_dir``; returns ``{file name: None if drawn, else why not}``."""
+    """Draw every figure into ``out_dir``; returns ``{file name: None if drawn, else why not}``.
+
+    Figs. 9 and 10 (:func:`figure_9`, :func:`figure_10`), Fig. 5
+    (:func:`~hystcomp.experiment.fig_preisach.plot_preisach_loops`) and Fig. 8 for PI and
+    MPI (:func:`~hystcomp.experiment.fig_identification.plot_identification`); every one is
+    drawn, so every value is None.
+    """
     notes: dict[str, str | None] = {}
     frequencies = sorted(comparison.results)
     first = frequencies[0]
@@ -126,28 +125,15 @@ def write_figures(comparison, out_dir: Path) -> dict[str, str | None]:
     figure_10(comparison.results, out_dir / "fig10_tracking.png")
     notes["fig10_tracking.png"] = None
 
-    plot_loops = _hook("hystcomp.experiment.fig_preisach", "plot_preisach_loops")
-    if plot_loops is None:
-        notes["fig5_preisach.png"] = (
-            "not drawn: hystcomp.experiment.fig_preisach.plot_preisach_loops is not available"
-        )
-    else:
-        rec = comparison.record_loops
-        plot_loops(
-            comparison.models["preisach"], out_dir / "fig5_preisach.png", measured=(rec.v, rec.x)
-        )
-        notes["fig5_preisach.png"] = None
+    rec = comparison.record_loops
+    plot_preisach_loops(
+        comparison.models["preisach"], out_dir / "fig5_preisach.png", measured=(rec.v, rec.x)
+    )
+    notes["fig5_preisach.png"] = None
 
-    plot_identification = _hook("hystcomp.experiment.fig_identification", "plot_identification")
     rec = comparison.record_pi
     for kind in ("pi", "mpi"):
         name = f"fig8_{kind}.png"
-        if plot_identification is None:
-            notes[name] = (
-                "not drawn: hystcomp.experiment.fig_identification.plot_identification "
-                "is not available"
-            )
-            continue
         slope, intercept = np.polyfit(rec.v, rec.x, 1)  # "before": the best straight line
         after = comparison.models[kind].simulate(rec.v)
         plot_identification(

@@ -11,11 +11,12 @@ from __future__ import annotations
 
 import numpy as np
 
+from hystcomp import paper
 from hystcomp._validation import check_int, check_real
 from hystcomp.errors import InvalidParameterError
 from hystcomp.identify.excitation import DEFAULT_SAMPLE_RATE, triangle_sequence
 
-FREQUENCIES = (1.0, 10.0, 50.0)  # Hz, Table I
+FREQUENCIES = paper.FREQUENCIES  # Hz, Table I
 REFERENCE_FRACTION = 0.9  # of the stroke measured during identification
 
 

@@ -17,12 +17,12 @@ import io
 import os
 from pathlib import Path
 
+from hystcomp import paper
 from hystcomp.errors import InvalidParameterError
-from hystcomp.experiment import paper
 from hystcomp.experiment.figures import write_figures
 from hystcomp.experiment.metrics import SATURATION_ZONE
-from hystcomp.experiment.paper import LABELS, METHODS
 from hystcomp.io import atomic_path
+from hystcomp.paper import LABELS, METHODS
 
 
 def table1_rows(comparison) -> list[dict]:
@@ -183,7 +183,7 @@ def report_markdown(comparison, figure_notes: dict[str, str | None]) -> str:
         "|---|---:|---:|---:|",
     ]
     for m, r in c.results[low].items():
-        ref = paper.SATURATION_ZONE_PCT.get(m) if low == 1.0 else None
+        ref = paper.SATURATION_ZONE_PCT.get(m) if low == paper.FIG9_FREQUENCY else None
         theirs = f"{ref:g}" if ref is not None else "-"
         parts.append(
             f"| {LABELS[m]} | {r.hysteresis_pct:.2f} | {r.saturation_zone_pct:.2f} | {theirs} |"
@@ -315,12 +315,14 @@ def _reading(c) -> list[str]:
     worst = max(compensated, key=compensated.get)
     best = min(compensated, key=compensated.get)
     paper_zone = paper.SATURATION_ZONE_PCT
+    p_worst = max(METHODS[1:], key=paper_zone.get)
+    p_best = min(METHODS[1:], key=paper_zone.get)
     lines.append(
         f"In the saturation zone at {low:g} Hz the uncompensated loop has {zone['uncompensated']:.1f} % "
         f"of hysteresis (paper {paper_zone['uncompensated']:g} %); among the compensated methods "
         f"{LABELS[worst]} leaves the most ({compensated[worst]:.1f} %) and {LABELS[best]} the least "
-        f"({compensated[best]:.1f} %); in the paper PI leaves the most (3.3 %) and MPI the least "
-        "(0.5 %)."
+        f"({compensated[best]:.1f} %); in the paper {LABELS[p_worst]} leaves the most "
+        f"({paper_zone[p_worst]:g} %) and {LABELS[p_best]} the least ({paper_zone[p_best]:g} %)."
     )
     return lines
 

@@ -37,6 +37,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from hystcomp import paper
 from hystcomp._lti import (
     creep_fraction,
     creep_response,
@@ -75,8 +76,8 @@ CREEP_SAMPLES = 2000
 
 def dynamics_excitation(
     *,
-    sample_rate: float = 20_000.0,
-    voltage_range: tuple[float, float] = (0.0, 120.0),
+    sample_rate: float = paper.SAMPLE_RATE,
+    voltage_range: tuple[float, float] = paper.VOLTAGE_RANGE,
     amplitude: float = AMPLITUDE,
     seed: int = 0,
 ) -> tuple[np.ndarray, np.ndarray]:

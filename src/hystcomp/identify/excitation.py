@@ -10,12 +10,13 @@ import itertools
 
 import numpy as np
 
+from hystcomp import paper
 from hystcomp._validation import as_vector, check_range, check_real
 from hystcomp.errors import InvalidParameterError
 
-DEFAULT_SAMPLE_RATE = 20_000.0  # Hz, the paper's rig (Section II)
-PI_AMPLITUDES = (30.0, 60.0, 90.0, 120.0)  # V, Section IV-A (ii)
-PREISACH_AMPLITUDES = tuple(float(a) for a in range(5, 125, 5))  # V, Section III-A (i)
+DEFAULT_SAMPLE_RATE = paper.SAMPLE_RATE  # Hz, the paper's rig (Section II)
+PI_AMPLITUDES = paper.PI_AMPLITUDES  # V, Section IV-A (ii)
+PREISACH_AMPLITUDES = paper.PREISACH_AMPLITUDES  # V, Section III-A (i)
 MIN_SAMPLES_PER_PERIOD = 4  # fewer cannot draw a triangle or a sinusoid
 MAX_SAMPLES = 10**8  # 1.6 GB of t and v; beyond that the request is a mistake
 
@@ -104,7 +105,9 @@ def sinusoid_sequence(
     return np.arange(v.size) / sample_rate, v
 
 
-def scaled_amplitudes(amplitudes, paper_range=(0.0, 120.0), voltage_range=(0.0, 120.0)):
+def scaled_amplitudes(
+    amplitudes, paper_range=paper.VOLTAGE_RANGE, voltage_range=paper.VOLTAGE_RANGE
+):
     """The paper's amplitudes rescaled from 0..120 V to another ``voltage_range``."""
     lo, hi = check_range(voltage_range, "voltage_range", "scaled_amplitudes")
     paper_range = check_range(paper_range, "paper_range", "scaled_amplitudes")
@@ -119,7 +122,7 @@ def random_turning_points(
     seed: int = 0,
     durations=(0.15, 0.6),
     sample_rate: float = DEFAULT_SAMPLE_RATE,
-    voltage_range=(0.0, 120.0),
+    voltage_range=paper.VOLTAGE_RANGE,
 ) -> tuple[np.ndarray, np.ndarray]:
     """A band-limited random voltage: random turning points joined by half-cosine sweeps.
 
@@ -193,7 +196,9 @@ def random_turning_points(
     return np.arange(v.size) / sample_rate, v
 
 
-def rich_turning_points(*, v_min: float = 0.0, v_max: float = 120.0, seed: int = 0) -> np.ndarray:
+def rich_turning_points(
+    *, v_min: float = 0.0, v_max: float = paper.VOLTAGE_RANGE[1], seed: int = 0
+) -> np.ndarray:
     """Turning points of :func:`rich_sequence`: decaying oscillations from both ends, then random.
 
     Four sweeps, each from an end of the range: ``v_max`` then down-up oscillations whose
@@ -229,7 +234,7 @@ def rich_sequence(
     rate: float = 240.0,
     sample_rate: float = DEFAULT_SAMPLE_RATE,
     v_min: float = 0.0,
-    v_max: float = 120.0,
+    v_max: float = paper.VOLTAGE_RANGE[1],
     seed: int = 0,
 ) -> tuple[np.ndarray, np.ndarray]:
     """An identification signal for all three models: ramps between :func:`rich_turning_points`.

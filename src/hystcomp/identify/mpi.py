@@ -65,6 +65,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from hystcomp import paper
 from hystcomp._validation import as_vector, check_int, check_real
 from hystcomp.errors import InvalidParameterError
 from hystcomp.identify.lsq import RIDGE, constrained_lsq, normal_equations
@@ -160,8 +161,8 @@ def fit_mpi(
     v,
     x,
     *,
-    n_operators=16,
-    n_deadzones=16,
+    n_operators=paper.N_OPERATORS,
+    n_deadzones=paper.N_DEADZONES,
     transient=None,
     margin=DEFAULT_MARGIN,
     regularization=0.0,
@@ -213,8 +214,8 @@ def fit_mpi_path(
     v,
     x,
     *,
-    n_operators=16,
-    n_deadzones=16,
+    n_operators=paper.N_OPERATORS,
+    n_deadzones=paper.N_DEADZONES,
     transient=None,
     margin=DEFAULT_MARGIN,
     regularizations=REGULARIZATION_GRID,

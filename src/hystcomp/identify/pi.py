@@ -37,6 +37,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from hystcomp import paper
 from hystcomp._validation import as_signal, check_int, check_real
 from hystcomp.errors import IdentificationError, InvalidParameterError, InvalidSignalError
 from hystcomp.identify import scoring
@@ -213,7 +214,13 @@ class PIFit:
 
 
 def fit_pi(
-    v, x, *, n_operators=16, transient=None, margin=DEFAULT_MARGIN, constraints="physical"
+    v,
+    x,
+    *,
+    n_operators=paper.N_OPERATORS,
+    transient=None,
+    margin=DEFAULT_MARGIN,
+    constraints="physical",
 ) -> PIFit:
     """Identify a classical PI model (eq. 12) from a measured record by constrained least squares.
 

@@ -7,7 +7,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from hystcomp import operators
+from hystcomp import operators, paper
 from hystcomp._validation import (
     as_signal_pair,
     as_vector,
@@ -21,7 +21,7 @@ from hystcomp.identify.pi import check_margin
 from hystcomp.models.compensator import ChainSystem, Compensator
 from hystcomp.models.inversion import inverse_initial_state, invert_superposition
 
-DEFAULT_VOLTAGE_RANGE = (0.0, 120.0)
+DEFAULT_VOLTAGE_RANGE = paper.VOLTAGE_RANGE  # V, the paper's piezo voltage v_px
 
 
 class HysteresisModel(ChainSystem):

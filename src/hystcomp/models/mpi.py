@@ -4,13 +4,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from hystcomp import operators
+from hystcomp import operators, paper
 from hystcomp._validation import as_vector, check_int, check_thresholds
 from hystcomp.errors import InvalidParameterError
 from hystcomp.identify.compensation import tracking_scorer
 from hystcomp.identify.mpi import REGULARIZATION_GRID, check_regularization, fit_mpi_path
 from hystcomp.identify.scoring import error_report
 from hystcomp.models.base import (
+    DEFAULT_VOLTAGE_RANGE,
     HysteresisModel,
     check_fit_options,
     fit_voltage_range,
@@ -106,8 +107,8 @@ class ModifiedPrandtlIshlinskii(HysteresisModel):
     def __init__(
         self,
         *,
-        n_operators=16,
-        n_deadzones=16,
+        n_operators=paper.N_OPERATORS,
+        n_deadzones=paper.N_DEADZONES,
         voltage_range=None,
         transient=None,
         margin=1e-3,
@@ -204,7 +205,7 @@ class ModifiedPrandtlIshlinskii(HysteresisModel):
         deadzone_thresholds,
         deadzone_weights,
         initial_state=None,
-        voltage_range=(0.0, 120.0),
+        voltage_range=DEFAULT_VOLTAGE_RANGE,
         input_offset=0.0,
         output_offset=0.0,
     ) -> ModifiedPrandtlIshlinskii:
@@ -236,7 +237,7 @@ class ModifiedPrandtlIshlinskii(HysteresisModel):
         )
 
     def inverse(
-        self, *, slew_rate=None, sample_rate=20_000.0, voltage_range=None, dynamics=None
+        self, *, slew_rate=None, sample_rate=paper.SAMPLE_RATE, voltage_range=None, dynamics=None
     ) -> Compensator:
         """The analytic inverse MPI, eq. (23): ``v = v_0 + H^-1[S^-1[x - x_0]]``, clamped.
 

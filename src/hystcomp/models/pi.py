@@ -4,12 +4,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from hystcomp import operators
+from hystcomp import operators, paper
 from hystcomp._validation import check_int
 from hystcomp.identify.compensation import compensation_error
 from hystcomp.identify.pi import fit_pi, paper_thresholds
 from hystcomp.identify.scoring import error_report
 from hystcomp.models.base import (
+    DEFAULT_VOLTAGE_RANGE,
     HysteresisModel,
     check_fit_options,
     fit_voltage_range,
@@ -96,7 +97,7 @@ class PrandtlIshlinskii(HysteresisModel):
     def __init__(
         self,
         *,
-        n_operators=16,
+        n_operators=paper.N_OPERATORS,
         voltage_range=None,
         transient=None,
         margin=1e-3,
@@ -159,7 +160,7 @@ class PrandtlIshlinskii(HysteresisModel):
         thresholds,
         weights,
         initial_state=None,
-        voltage_range=(0.0, 120.0),
+        voltage_range=DEFAULT_VOLTAGE_RANGE,
         input_offset=0.0,
         output_offset=0.0,
     ) -> PrandtlIshlinskii:
@@ -185,7 +186,7 @@ class PrandtlIshlinskii(HysteresisModel):
         )
 
     def inverse(
-        self, *, slew_rate=None, sample_rate=20_000.0, voltage_range=None, dynamics=None
+        self, *, slew_rate=None, sample_rate=paper.SAMPLE_RATE, voltage_range=None, dynamics=None
     ) -> Compensator:
         """The analytic inverse PI (eqs. 24-26) as a compensator clamped to the voltage range.
 

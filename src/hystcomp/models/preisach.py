@@ -9,11 +9,12 @@ from __future__ import annotations
 
 import numpy as np
 
+from hystcomp import paper
 from hystcomp import preisach_kernels as pk
 from hystcomp._validation import as_signal, as_vector, check_int, check_range, check_real
 from hystcomp.errors import InvalidParameterError, InvalidTypeError
 from hystcomp.identify.preisach import MAX_DEGREE, identify_preisach
-from hystcomp.models.base import HysteresisModel, slew_to_step
+from hystcomp.models.base import DEFAULT_VOLTAGE_RANGE, HysteresisModel, slew_to_step
 from hystcomp.models.compensator import Compensator, Stepper
 from hystcomp.models.dynamic_compensator import with_dynamics
 
@@ -132,7 +133,7 @@ class Preisach(HysteresisModel):
         *,
         theta=None,
         table=None,
-        voltage_range=(0.0, 120.0),
+        voltage_range=DEFAULT_VOLTAGE_RANGE,
         output_offset=0.0,
         max_extrema=pk.DEFAULT_DEPTH,
     ) -> Preisach:
@@ -271,7 +272,7 @@ class Preisach(HysteresisModel):
         method="multiplicative",
         rho=None,
         slew_rate=None,
-        sample_rate=20_000.0,
+        sample_rate=paper.SAMPLE_RATE,
         voltage_range=None,
         dynamics=None,
     ) -> PreisachCompensator:

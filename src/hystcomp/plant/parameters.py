@@ -65,6 +65,7 @@ import dataclasses
 
 import numpy as np
 
+from hystcomp import paper
 from hystcomp._validation import check_range, check_real
 from hystcomp.errors import InvalidParameterError
 
@@ -108,19 +109,19 @@ class TwinParameters:
         Sensor reading at rest, in µm.
     """
 
-    sample_rate: float = 20_000.0
-    voltage_range: tuple[float, float] = (0.0, 120.0)
+    sample_rate: float = paper.SAMPLE_RATE
+    voltage_range: tuple[float, float] = paper.VOLTAGE_RANGE
     amplifier_gain: float = 1.0
     anhysteretic: tuple[float, float, float] = (24.68, 35.13, -20.59)
     hysteresis_amplitude: float = 2.272
     hysteresis_onset: float = 0.0914
     bouc_wen_rate: float = 6.763
     bouc_wen_shape: float = 0.6749
-    resonance_hz: float = 630.0
+    resonance_hz: float = paper.PIEZO_BANDWIDTH
     damping_ratio: float = 0.1
     creep_gain: float = 0.0
     creep_time_constants: tuple[float, ...] = (1e-3, 1e-2, 0.1, 1.0, 10.0, 100.0)
-    sensor_gain: float = 0.2
+    sensor_gain: float = paper.SENSOR_GAIN
     sensor_noise: float = 0.6e-3
     sensor_offset: float = 0.0
 
