@@ -18,6 +18,7 @@ from hystcomp.cli._options import (
     voltage_range,
 )
 from hystcomp.data import read_table, write_table
+from hystcomp.errors import InvalidSignalError
 from hystcomp.io import load_model
 
 
@@ -71,14 +72,30 @@ def inverse_options(model, table, *, slew_rate, narrow_range) -> dict:
     "narrow it) [the model's range].",
 )
 @method_option
+@click.option(
+    "--strict",
+    is_flag=True,
+    help="Refuse (exit 2, nothing written) a reference that the clamp cuts anywhere, "
+    "instead of warning.",
+)
 def compensate(
-    model_file, reference_file, output, columns, sample_rate, slew_rate, narrow_range, method
+    model_file,
+    reference_file,
+    output,
+    columns,
+    sample_rate,
+    slew_rate,
+    narrow_range,
+    method,
+    strict,
 ):
     """Voltage that makes the actuator of MODEL.json follow REFERENCE (columns t, x).
 
     Uses the model's inverse (eqs. 23-26 for PI/MPI; for Preisach eq. 10 or, with
     --method exact, the exact inverse), clamped to the model's voltage range (or a narrower
-    --voltage-range). Writes t (s), v (V) and x_ref (µm).
+    --voltage-range). Writes t (s), v (V) and x_ref (µm). Samples whose reference lies out
+    of the actuator's reach are clamped and counted: a warning says how many (exit 0), or
+    with --strict the command refuses (exit 2) and writes nothing.
     """
     check_data_output(output, inputs=(model_file, reference_file), what="voltage file")
     model = load_model(model_file)
@@ -86,10 +103,25 @@ def compensate(
     table = read_table(reference_file, ("x",), **read_options(columns, sample_rate))
     options = inverse_options(model, table, slew_rate=slew_rate, narrow_range=narrow_range)
     compensator = model.inverse(**options, **chosen)
-    v = compensator.simulate(table["x"])
-    write_table(output, {"t": table["t"], "v": v, "x_ref": table["x"]})
+    result = compensator.run(table["x"])
+    v = result.v
     lo, hi = compensator.voltage_range
+    if result.clamped:
+        x_lo, x_hi = model.reachable_range(voltage_range=(lo, hi))
+        x = table["x"]
+        what = (
+            f"{result.clamped} of {v.size} samples ({100 * result.clamped_share:.3g} %) are "
+            f"out of reach and clamped to {lo:.4g} .. {hi:.4g} V: the reference spans "
+            f"{x.min():.4g} .. {x.max():.4g} µm, the model reaches {x_lo:.4g} .. {x_hi:.4g} µm"
+        )
+        if strict:
+            raise InvalidSignalError(
+                f"{what}. Nothing written (--strict); shift or scale the reference into "
+                "the reachable range, or drop --strict to accept the clamp."
+            )
+        click.echo(f"hystcomp: warning: {what}.", err=True)
+    write_table(output, {"t": table["t"], "v": v, "x_ref": table["x"]})
     click.echo(
         f"wrote {output}: {v.size} samples, v from {v.min():.4g} to {v.max():.4g} V "
-        f"(clamped to {lo:.4g} .. {hi:.4g} V)"
+        f"(range {lo:.4g} .. {hi:.4g} V, {result.clamped} clamped)"
     )

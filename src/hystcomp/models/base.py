@@ -101,6 +101,29 @@ class HysteresisModel(ChainSystem):
             )
         return low, high
 
+    def reachable_range(self, voltage_range=None) -> tuple[float, float]:
+        """The displacements (µm) the model reaches with voltages inside a range.
+
+        The extremes of the major loop: the model run from its initial state over
+        ``lo -> hi -> lo -> hi`` (its branches are monotone, so the extremes lie at the
+        ends). A compensator clamps every reference beyond this range
+        (:meth:`Compensator.run <hystcomp.models.compensator.Compensator.run>` counts them).
+
+        Parameters
+        ----------
+        voltage_range : (float, float), optional
+            A range in V inside ``voltage_range_`` (default: ``voltage_range_``).
+
+        Returns
+        -------
+        (float, float)
+            Lowest and highest displacement in µm.
+        """
+        self._check_fitted()
+        lo, hi = self._clamp_range(voltage_range, f"{type(self).__name__}.reachable_range")
+        x = self.simulate(np.array([lo, hi, lo, hi]))
+        return float(x.min()), float(x.max())
+
     def _adopt(self, fitted: HysteresisModel, fit_report: dict) -> None:
         """Take the learned parameters of ``fitted`` (built by ``from_parameters``, so validated)."""
         for name in self._learned:

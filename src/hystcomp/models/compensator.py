@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import functools
 from abc import ABC, abstractmethod
+from typing import NamedTuple
 
 import numpy as np
 
@@ -88,6 +89,17 @@ class Stepper:
         return int(self._p[self._start + self.kernels.nonfinite])
 
     @property
+    def clamped_count(self) -> int:
+        """How many outputs the voltage range clamped since the last reset.
+
+        An output counts when the compensator asked for a voltage beyond the range by more
+        than :data:`~hystcomp.operators.CLAMP_TOLERANCE` of it (or, for the exact Preisach
+        inverse, stopped at a range end short of the reference): the reference was out of
+        the actuator's reach there. Always 0 for a forward model.
+        """
+        return int(self._p[self._start + self.kernels.clamped])
+
+    @property
     def last_output(self) -> float:
         """The last output (before the first sample: the rest value of the system)."""
         return float(self._p[self._start + self.kernels.last])
@@ -126,6 +138,29 @@ class ChainSystem(ABC):
         return Stepper(self._packed())
 
 
+class CompensatorRun(NamedTuple):
+    """The result of :meth:`Compensator.run`: the voltage and what the clamp did to it.
+
+    Attributes
+    ----------
+    v : ndarray
+        The voltage in V, one sample per reference sample (as ``simulate`` gives).
+    clamped : int
+        Samples whose voltage the range clamped: the reference was out of reach there.
+    nonfinite : int
+        Non-finite reference samples (each held the last output).
+    """
+
+    v: np.ndarray
+    clamped: int
+    nonfinite: int
+
+    @property
+    def clamped_share(self) -> float:
+        """``clamped`` as a fraction of the samples (0 for an empty run)."""
+        return self.clamped / self.v.size if self.v.size else 0.0
+
+
 class Compensator(ChainSystem):
     """Inverse-based feedforward: reference displacement (µm) in, voltage (V) out.
 
@@ -153,6 +188,28 @@ class Compensator(ChainSystem):
 
     def _packed(self) -> np.ndarray:
         return self._chain
+
+    def run(self, x_ref) -> CompensatorRun:
+        """Like :meth:`simulate`, and also count the samples the voltage range clamped.
+
+        A clamped sample is one whose reference the actuator cannot reach inside the range
+        (``model.reachable_range()`` tells the reachable displacements): the voltage then
+        stays at the end of the range, and the tracking error there is the model's gap.
+
+        Parameters
+        ----------
+        x_ref : array_like
+            1-D finite reference in µm.
+
+        Returns
+        -------
+        CompensatorRun
+            ``(v, clamped, nonfinite)``; ``v`` equals ``simulate(x_ref)`` bit for bit.
+        """
+        u = as_signal(x_ref, self._input_name)
+        s = self.stepper()
+        v = s.step_block(u)
+        return CompensatorRun(v, s.clamped_count, s.nonfinite_count)
 
     @property
     def packed(self) -> np.ndarray:
