@@ -12,6 +12,7 @@ import hystcomp
 from hystcomp import presets
 from hystcomp.cli import main
 from hystcomp.data import read_table, write_table
+from hystcomp.identify.excitation import triangle_sequence
 from tests.test_codegen import CC, _compile, _run_c, needs_cc
 
 COMPENSATORS = {
@@ -178,3 +179,25 @@ def test_cli_reachable_reference_gives_no_warning(tmp_path, strict):
     assert result.exit_code == 0, result.output
     assert "warning" not in result.stderr
     assert "0 clamped" in result.stdout
+
+
+def _record(tmp_path, v_max=120.0):
+    t, v = triangle_sequence((0.5 * v_max, v_max), sample_rate=200.0)
+    x = presets.paper_pi().simulate(v)
+    write_table(tmp_path / "rec.csv", {"t": t, "v": v, "x": x})
+    return tmp_path / "rec.csv"
+
+
+def test_identify_refuses_a_voltage_range_wider_than_the_record(tmp_path):
+    rec = _record(tmp_path)
+    args = ["identify", rec, "--model", "pi", "-o", tmp_path / "m.json"]
+    result = run(*args, "--voltage-range", 0, 200)
+    assert result.exit_code == 2, result.output
+    assert "--allow-extrapolation" in result.output
+    assert not (tmp_path / "m.json").exists()
+    assert run(*args, "--voltage-range", 0, 200, "--allow-extrapolation").exit_code == 0
+    assert hystcomp.load_model(tmp_path / "m.json").voltage_range_ == (0.0, 200.0)
+    assert run(*args, "--voltage-range", 10, 100).exit_code == 0  # narrower: the clamp
+    comp = hystcomp.load_model(tmp_path / "m.json").inverse()
+    assert comp.simulate([1e3]).max() == 100.0
+    assert "refused, not capped" in " ".join(run("identify", "--help").output.split())

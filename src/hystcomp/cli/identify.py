@@ -78,6 +78,20 @@ def _regularization(ctx, param, value):
     return number
 
 
+def _refuse_extrapolation(voltage_range, v) -> None:
+    """Refuse a --voltage-range that reaches beyond the input the model is fitted on."""
+    lo, hi = voltage_range
+    v_lo, v_hi = float(v.min()), float(v.max())
+    slack = 1e-9 * (v_hi - v_lo)
+    if lo < v_lo - slack or hi > v_hi + slack:
+        raise click.BadParameter(
+            f"{lo:g} {hi:g} V reaches beyond the record's input ({v_lo:.6g} .. {v_hi:.6g} V): "
+            "the compensator would command voltages the model never saw. Give a range "
+            "within the record, record over the whole range, or pass --allow-extrapolation.",
+            param_hint="'--voltage-range'",
+        )
+
+
 def _sizes(model) -> str:
     parts = []
     if hasattr(model, "n_operators"):
@@ -134,7 +148,16 @@ def _sizes(model) -> str:
     default=None,
     metavar="LO HI",
     callback=voltage_range,
-    help="Amplifier range in V, the compensator's clamp [the record's range].",
+    help="Amplifier range in V, the compensator's clamp [the record's range]. A range "
+    "reaching beyond the record's input is refused, not capped (a cap would quietly give "
+    "another range than asked): the compensator would command voltages the model never "
+    "saw. --allow-extrapolation accepts it.",
+)
+@click.option(
+    "--allow-extrapolation",
+    is_flag=True,
+    help="Accept a --voltage-range wider than the record's input; the model then "
+    "extrapolates there.",
 )
 @click.option(
     "--holdout",
@@ -158,6 +181,7 @@ def identify(
     sample_rate,
     transient,
     voltage_range,
+    allow_extrapolation,
     holdout,
     plot,
     output,
@@ -193,6 +217,8 @@ def identify(
             "that keeps samples on both sides."
         )
     v, x = rec.v[:n_fit], rec.x[:n_fit]
+    if voltage_range is not None and not allow_extrapolation:
+        _refuse_extrapolation(voltage_range, v)
     if transient is None:
         start = transient_end(v)
     else:
