@@ -28,6 +28,7 @@ from hystcomp.errors import (
     InvalidSignalError,
     InvalidTypeError,
 )
+from hystcomp.identify.scoring import check_response
 
 MAX_DEGREE = 8
 EVERETT_KINDS = ("polynomial", "table")
@@ -299,7 +300,8 @@ def fit_everett_table(alpha, beta, value, *, grid_size: int, voltage_range) -> n
     return pk.antisymmetric_table(lower)
 
 
-def _check_options(degree, everett, grid_size, zero_diagonal, owner):
+def check_options(degree, everett, grid_size, zero_diagonal, owner):
+    """Validate the fit options of a Preisach identification; returns ``(degree, grid_size)``."""
     degree = check_int(degree, "degree", owner)
     if not isinstance(zero_diagonal, bool | np.bool_):
         raise InvalidTypeError(
@@ -370,8 +372,9 @@ def identify_preisach(
         If the record holds no first-order descending curve, or too few to fit X.
     """
     owner = "identify_preisach"
-    degree, grid_size = _check_options(degree, everett, grid_size, zero_diagonal, owner)
+    degree, grid_size = check_options(degree, everett, grid_size, zero_diagonal, owner)
     curves = find_reversal_curves(v, x, tolerance=tolerance)
+    check_response(v, x, owner)  # rising, and more than noise
     v = np.ascontiguousarray(v, dtype=np.float64).reshape(-1)
     x = np.ascontiguousarray(x, dtype=np.float64).reshape(-1)
     data_range = (float(v.min()), float(v.max()))
