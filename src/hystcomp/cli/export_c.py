@@ -7,9 +7,9 @@ from pathlib import Path
 import click
 
 from hystcomp.cli import main
-from hystcomp.cli._options import method_option, method_options
-from hystcomp.codegen import DEFAULT_PREFIX, export_c
-from hystcomp.io import load_model
+from hystcomp.cli._options import method_option, method_options, positive
+from hystcomp.codegen import DEFAULT_PREFIX, check_prefix, export_c
+from hystcomp.io import check_output_path, load_model
 
 
 @main.command("export-c")
@@ -33,6 +33,7 @@ from hystcomp.io import load_model
     type=float,
     default=None,
     metavar="V_PER_S",
+    callback=positive("V/s"),
     help="Largest output slew rate in V/s, baked into the code (none by default).",
 )
 @click.option(
@@ -42,6 +43,7 @@ from hystcomp.io import load_model
     default=20_000.0,
     show_default=True,
     metavar="HZ",
+    callback=positive("Hz"),
     help="Sample rate at which NAME_step is called; sets the slew step per sample.",
 )
 @method_option
@@ -56,10 +58,18 @@ def export_c_command(model_file, directory, prefix, slew_rate, sample_rate, meth
       void   NAME_reset(NAME_state *s);
       double NAME_step(NAME_state *s, double x_ref);   /* um in, V out */
     """
+    check_prefix(prefix)
+    for suffix in (".h", ".c") if directory.is_dir() else ():  # never overwrite the model
+        check_output_path(directory / f"{prefix}{suffix}", inputs=(model_file,), what="C file")
     model = load_model(model_file)
     options = {"slew_rate": slew_rate, "sample_rate": sample_rate}
     compensator = model.inverse(**options, **method_options(model, model_file, method))
     header, source = export_c(
-        compensator, directory, prefix=prefix, source=str(model_file), sample_rate=sample_rate
+        compensator,
+        directory,
+        prefix=prefix,
+        source=str(model_file),
+        sample_rate=sample_rate,
+        inputs=(model_file,),
     )
     click.echo(f"wrote {header} and {source}")

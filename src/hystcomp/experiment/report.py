@@ -1,6 +1,6 @@
 """Tables and the written report of the comparison, beside the paper's numbers.
 
-Files written by :func:`write_outputs` (each atomically):
+Files written by :func:`write_outputs` (as one set: all new, or all as they were):
 
 * ``table1.csv``: ``frequency_hz, method, rms_um, max_um`` (the paper's Table I);
 * ``hysteresis.csv``: ``method, hysteresis_pct, saturation_zone_pct`` at the lowest
@@ -22,7 +22,7 @@ from hystcomp.experiment import paper
 from hystcomp.experiment.figures import write_figures
 from hystcomp.experiment.metrics import SATURATION_ZONE
 from hystcomp.experiment.paper import LABELS, METHODS
-from hystcomp.io import atomic_path
+from hystcomp.io import atomic_path, check_output_path, replace_all, staging_folder
 
 
 def table1_rows(comparison) -> list[dict]:
@@ -94,14 +94,30 @@ def prepare_output_dir(out_dir) -> Path:
 
 
 def write_outputs(comparison, out_dir) -> list[Path]:
-    """Write tables, figures and ``report.md`` into ``out_dir``; return the files written."""
+    """Write tables, figures and ``report.md`` into ``out_dir``; return the files written.
+
+    Every file is first written into a hidden folder inside ``out_dir``, then all are
+    renamed into place together (:func:`hystcomp.io.replace_all`): a failure or an
+    interruption leaves the files of an earlier run as they were, never a mix of two runs.
+    """
     out = prepare_output_dir(out_dir)
-    _write_text(out / "table1.csv", _csv_text(table1_rows(comparison)))
-    _write_text(out / "hysteresis.csv", _csv_text(hysteresis_rows(comparison)))
-    notes = write_figures(comparison, out)
-    _write_text(out / "report.md", report_markdown(comparison, notes))
-    names = ["table1.csv", "hysteresis.csv", *(n for n, why in notes.items() if why is None)]
-    return [out / n for n in [*names, "report.md"]]
+    with staging_folder(out) as stage:
+        _write_text(stage / "table1.csv", _csv_text(table1_rows(comparison)))
+        _write_text(stage / "hysteresis.csv", _csv_text(hysteresis_rows(comparison)))
+        notes = write_figures(comparison, stage)
+        _write_text(stage / "report.md", report_markdown(comparison, notes))
+        names = ["table1.csv", "hysteresis.csv", *(n for n, why in notes.items() if why is None)]
+        names.append("report.md")
+        for name in names:
+            check_output_path(out / name, what="output")
+        try:
+            replace_all([(stage / n, out / n) for n in names])
+        except OSError as exc:
+            raise InvalidParameterError(
+                f"Cannot write into {str(out)!r}: {exc.strerror or exc}; the files of any "
+                "earlier run are unchanged. Check the permissions and the free space."
+            ) from None
+    return [out / n for n in names]
 
 
 # ----------------------------------------------------------------------------- report text
