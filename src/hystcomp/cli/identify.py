@@ -92,6 +92,15 @@ def _refuse_extrapolation(voltage_range, v) -> None:
         )
 
 
+def _verdict(improvement: float) -> str:
+    """``line rms / model rms`` in words: "2.5x better", or "1.14x worse" below 1."""
+    if improvement >= 1.0:
+        return f"{improvement:.3g}x better"
+    if improvement > 0.0:
+        return f"{1.0 / improvement:.3g}x worse"
+    return "no better (the line fits the held-out part exactly)"
+
+
 def _sizes(model) -> str:
     parts = []
     if hasattr(model, "n_operators"):
@@ -255,7 +264,7 @@ def identify(
         click.echo(
             f"  hold-out:  last {held['n_holdout']} samples ({100 * holdout:g} %): model rms "
             f"{held['model_rms_um']:.4g} µm, straight line rms {held['line_rms_um']:.4g} µm: "
-            f"{held['improvement']:.3g}x better"
+            f"{_verdict(held['improvement'])}"
         )
     # Everything is computed; now write all outputs at once (a failure writes none of them).
     text = model_text(model)

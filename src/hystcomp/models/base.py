@@ -37,6 +37,20 @@ class HysteresisModel(ChainSystem):
                 "hystcomp.load_model(path)."
             )
 
+    def _derived_hyperparameters(self) -> dict[str, Any]:
+        """Hyperparameters that the learned parameters determine (e.g. the operator count
+        from the thresholds), with their values; a model file must agree with them."""
+        return {}
+
+    def _check_hyperparameters(self) -> None:
+        """Validate every hyperparameter's type and value, as ``fit`` does (and raise).
+
+        Subclasses extend it for their own; ``fit`` and ``from_dict`` both call it, so a
+        new hyperparameter is checked on both paths once it is checked here.
+        """
+        if self.voltage_range is not None:
+            check_range(self.voltage_range, "voltage_range", type(self).__name__)
+
     def get_params(self) -> dict[str, Any]:
         """The hyperparameters given to ``__init__``."""
         return {name: getattr(self, name) for name in self._hyper}
@@ -74,9 +88,18 @@ class HysteresisModel(ChainSystem):
                 f"by to_dict). Got {type(data).__name__}."
             )
         model = cls.from_parameters(**data["parameters"])
+        derived = model._derived_hyperparameters()
         for name, value in data.get("hyperparameters", {}).items():
-            if name in cls._hyper:
-                setattr(model, name, value)
+            if name not in cls._hyper:
+                continue
+            if name in derived and not _same_value(value, derived[name]):
+                raise InvalidParameterError(
+                    f"The hyperparameter {name!r} of this {cls.__name__} is {value!r}, but its "
+                    f"parameters give {derived[name]!r}: the two disagree. The file was "
+                    f"edited by hand; set {name!r} to {derived[name]!r} or identify again."
+                )
+            setattr(model, name, value)
+        model._check_hyperparameters()  # every value, as fit() would check it
         if "fit_report" in data:
             model.fit_report_ = dict(data["fit_report"])
         return model
@@ -134,6 +157,18 @@ class HysteresisModel(ChainSystem):
         args = ", ".join(f"{k}={v!r}" for k, v in self.get_params().items())
         state = "" if hasattr(self, self._learned[0] + "_") else ", unfitted"
         return f"{type(self).__name__}({args}{state})"
+
+
+def _same_value(value, expected) -> bool:
+    """Equal and of the same JSON type (3 is not 3.0, "3" or True)."""
+    return type(value) is type(expected) and value == expected
+
+
+def check_play_hyperparameters(model) -> None:
+    """The hyperparameters of every PI-type model: operator count, range, transient, margin."""
+    owner = type(model).__name__
+    check_int(model.n_operators, "n_operators", owner)
+    check_fit_options(model, owner)
 
 
 def set_common_parameters(model, owner, *, voltage_range, input_offset, output_offset):

@@ -10,7 +10,7 @@ the same answer; a :class:`Stepper` owns its own copy and can be reset or copied
 
 from __future__ import annotations
 
-import functools
+import numbers
 from abc import ABC, abstractmethod
 from typing import NamedTuple
 
@@ -18,6 +18,33 @@ import numpy as np
 
 from hystcomp import operators
 from hystcomp._validation import as_signal
+from hystcomp.errors import InvalidSignalError, InvalidTypeError
+
+
+def _sample(u) -> float:
+    """One input sample as a float: a real number (not a bool, text or array), else raise."""
+    if isinstance(u, numbers.Real | np.floating | np.integer) and not isinstance(
+        u, bool | np.bool_
+    ):
+        return float(u)
+    raise InvalidTypeError(
+        f"Stepper.step takes one sample, a real number. Got {u!r:.40} of type "
+        f"{type(u).__name__}; convert it with float(...), or pass a block of samples to "
+        "step_block."
+    )
+
+
+def _checked_step(kernel, p):
+    """``step(u) = kernel(p, u)`` for a float ``u`` (the fast path: one type test), and
+    for any other real number after conversion; text, bools and arrays are refused (the
+    compiled kernel alone would parse a string)."""
+
+    def step(u):
+        if u.__class__ is float:
+            return kernel(p, u)
+        return kernel(p, _sample(u))
+
+    return step
 
 
 class Stepper:
@@ -27,7 +54,8 @@ class Stepper:
     is counted in :attr:`nonfinite_count`; nothing is raised inside a real-time loop.
 
     For speed, each stepper binds :meth:`step` to the compiled step kernel and its own state
-    when it is made (no method frame, no dispatch on argument types): a call from Python
+    when it is made (no method lookup, no dispatch on argument types; one test that the
+    sample is a float, which refuses text the kernel would parse): a call from Python
     costs about a quarter of a microsecond, 0.5 % of a 20 kHz period, for the play chains
     and for the Preisach model and its multiplicative inverse; the exact Preisach inverse
     adds its root search per sample (``python benchmarks/run.py realtime`` and ``...
@@ -48,7 +76,7 @@ class Stepper:
         self._start = int(self.kernels.state_start(packed))
         self._run = self.kernels.run  # looked up once: a block call is short too
         # an instance attribute hides the method below, which documents it
-        self.step = functools.partial(operators.step_function(self.kernels.step), self._p)
+        self.step = _checked_step(operators.step_function(self.kernels.step), self._p)
 
     def step(self, u: float) -> float:
         """Advance one sample and return the output.
@@ -67,8 +95,32 @@ class Stepper:
         return self.kernels.step(self._p, u)
 
     def step_block(self, u) -> np.ndarray:
-        """Advance over a block of samples and return the outputs (non-finite samples held)."""
-        u = np.ascontiguousarray(u, dtype=np.float64).reshape(-1)
+        """Advance over a block of samples and return the outputs (non-finite samples held).
+
+        Parameters
+        ----------
+        u : array_like
+            A 1-D block of real samples (a single number is a block of one).
+
+        Raises
+        ------
+        InvalidSignalError
+            If ``u`` has more than one dimension (one channel at a time).
+        InvalidTypeError
+            If ``u`` holds text, booleans or objects.
+        """
+        arr = np.asarray(u)
+        if arr.dtype.kind not in "fiu":
+            raise InvalidTypeError(
+                f"Stepper.step_block takes real numbers. Got an array of {arr.dtype} "
+                f"({type(u).__name__}); convert it with np.asarray(u, dtype=float)."
+            )
+        if arr.ndim > 1:
+            raise InvalidSignalError(
+                f"Stepper.step_block takes a 1-D block of samples. Got shape {arr.shape}; "
+                "pass one channel at a time (for example u[:, 0])."
+            )
+        u = np.ascontiguousarray(arr, dtype=np.float64).reshape(-1)
         out = np.empty_like(u)
         self._run(self._p, u, out)
         return out
