@@ -54,13 +54,14 @@ class Stepper:
     is counted in :attr:`nonfinite_count`; nothing is raised inside a real-time loop.
 
     For speed, each stepper binds :meth:`step` to the compiled step kernel and its own state
-    when it is made (no method lookup, no dispatch on argument types; one test that the
-    sample is a float, which refuses text the kernel would parse): a call from Python
+    when it is made (no method lookup, no dispatch on argument types): a call from Python
     costs about a quarter of a microsecond, 0.5 % of a 20 kHz period, for the play chains
     and for the Preisach model and its multiplicative inverse; the exact Preisach inverse
     adds its root search per sample (``python benchmarks/run.py realtime`` and ``...
-    preisach``). A loop that has its samples in blocks can use :meth:`step_block`, faster
-    per sample.
+    preisach``). One test that the sample is a float guards it (the compiled kernel alone
+    would parse the text ``"1.0"``); that small Python frame is the only cost above the
+    bare kernel (the ``realtime`` benchmark gives the ratio). A loop that has its samples
+    in blocks can use :meth:`step_block`, faster per sample.
 
     The same class serves every kind of packed system: the class attribute ``kernels``
     (:class:`~hystcomp.operators.StepKernels`) names its step and batch kernels and where
