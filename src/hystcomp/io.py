@@ -67,7 +67,9 @@ def check_output_path(path: str | os.PathLike, *, inputs=(), what: str = "output
     Raises
     ------
     OutputPathError
-        If the folder does not exist, ``path`` is a folder, or ``path`` is one of ``inputs``.
+        If the folder does not exist, ``path`` is a folder, a device, a pipe or a socket
+        (replacing one would break what uses it), or ``path`` is one of ``inputs``. A
+        symbolic link is checked as the file it names (see :func:`write_target`).
     """
     path = as_path(path, "path", "check_output_path")
     if path.is_dir():

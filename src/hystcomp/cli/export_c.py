@@ -2,14 +2,26 @@
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import click
 
 from hystcomp.cli import main
-from hystcomp.cli._options import method_option, method_options, positive
+from hystcomp.cli._options import method_option, method_options
 from hystcomp.codegen import DEFAULT_PREFIX, check_prefix, export_c
 from hystcomp.io import check_output_path, load_model
+
+
+def _rate(ctx, param, value):
+    """``--fs``: a finite rate > 0 (it divides the slew-rate limit and the period)."""
+    if not (math.isfinite(value) and value > 0):
+        raise click.BadParameter(
+            f"must be a finite number > 0 (Hz, the rate at which NAME_step is called); "
+            f"got {value!r}.",
+            param=param,
+        )
+    return value
 
 
 @main.command("export-c")
@@ -33,7 +45,6 @@ from hystcomp.io import check_output_path, load_model
     type=float,
     default=None,
     metavar="V_PER_S",
-    callback=positive("V/s"),
     help="Largest output slew rate in V/s, baked into the code (none by default).",
 )
 @click.option(
@@ -43,7 +54,7 @@ from hystcomp.io import check_output_path, load_model
     default=20_000.0,
     show_default=True,
     metavar="HZ",
-    callback=positive("Hz"),
+    callback=_rate,
     help="Sample rate at which NAME_step is called; sets the slew step per sample.",
 )
 @method_option

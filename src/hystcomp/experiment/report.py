@@ -22,7 +22,13 @@ from hystcomp.experiment import paper
 from hystcomp.experiment.figures import write_figures
 from hystcomp.experiment.metrics import SATURATION_ZONE
 from hystcomp.experiment.paper import LABELS, METHODS
-from hystcomp.io import atomic_path, check_output_path, replace_all, staging_folder
+from hystcomp.io import (
+    atomic_path,
+    check_output_path,
+    replace_all,
+    staging_folder,
+    write_target,
+)
 
 
 def table1_rows(comparison) -> list[dict]:
@@ -111,7 +117,7 @@ def write_outputs(comparison, out_dir) -> list[Path]:
         for name in names:
             check_output_path(out / name, what="output")
         try:
-            replace_all([(stage / n, out / n) for n in names])
+            replace_all([(stage / n, write_target(out / n)) for n in names])
         except OSError as exc:
             raise InvalidParameterError(
                 f"Cannot write into {str(out)!r}: {exc.strerror or exc}; the files of any "
