@@ -71,7 +71,7 @@ def export_c_command(model_file, directory, prefix, slew_rate, sample_rate, meth
     """
     check_prefix(prefix)
     for suffix in (".h", ".c") if directory.is_dir() else ():  # never overwrite the model
-        check_output_path(directory / f"{prefix}{suffix}", inputs=(model_file,), what="C file")
+        check_output_path(directory / f"{prefix}{suffix}", inputs=(model_file,))
     model = load_model(model_file)
     options = {"slew_rate": slew_rate, "sample_rate": sample_rate}
     compensator = model.inverse(**options, **method_options(model, model_file, method))

@@ -121,7 +121,7 @@ def export_c(
         directory.mkdir()
     paths = (directory / f"{prefix}.h", directory / f"{prefix}.c")
     for path in paths:
-        check_output_path(path, inputs=inputs, what="C file")
+        check_output_path(path, inputs=inputs)
     # both files checked before anything is written, renamed into place only once both are
     with atomic_paths(*paths) as (tmp_h, tmp_c):
         tmp_h.write_text(header, encoding="ascii")
