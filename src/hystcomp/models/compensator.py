@@ -44,6 +44,8 @@ def _checked_step(kernel, p):
             return kernel(p, u)
         return kernel(p, _sample(u))
 
+    step.func = kernel  # as functools.partial names them: what it calls, and on what
+    step.state = p
     return step
 
 
