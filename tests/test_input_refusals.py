@@ -5,8 +5,6 @@ from __future__ import annotations
 
 import json
 import math
-import subprocess
-import sys
 
 import numpy as np
 import pytest
@@ -133,14 +131,13 @@ def test_a_prefix_that_shadows_a_header_or_is_a_keyword_is_refused(tmp_path, pre
 
 
 def test_bare_hystcomp_prints_usage_and_commands():
-    done = subprocess.run(
-        [sys.executable, "-m", "hystcomp"], capture_output=True, text=True, check=False
-    )
-    assert done.returncode == 2
-    assert done.stderr.startswith("Usage:")
-    assert "Commands:" in done.stderr
-    assert "compensate" in done.stderr
-    assert "error" not in done.stderr
+    result = CliRunner().invoke(main, [], prog_name="hystcomp")
+    assert result.exit_code == 2  # as click does for a group called without a command
+    assert result.stderr.startswith("Usage: hystcomp [OPTIONS] COMMAND")
+    assert "Commands:" in result.stderr
+    assert "compensate" in result.stderr
+    assert "error" not in result.stderr
+    assert result.stdout == ""
 
 
 def test_saving_an_unfitted_model_says_it_is_not_fitted(tmp_path):

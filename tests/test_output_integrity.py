@@ -253,7 +253,35 @@ STALLED = textwrap.dedent(
 
 
 @pytest.mark.parametrize(("sig", "code"), [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
-def test_a_signal_exits_128_plus_its_number_and_removes_temporaries(files, sig, code):
+def test_a_signal_in_a_write_exits_128_plus_its_number_and_cleans_up(files, sig, code, monkeypatch):
+    out = files / "v.csv"
+    out.write_text("old\n")
+
+    def signalled_write(path, table):
+        with hystcomp.io.atomic_path(path) as tmp:
+            tmp.write_text("half")
+            assert len(_hidden(files)) == 1
+            os.kill(os.getpid(), sig)
+            time.sleep(5)  # the handler interrupts this
+            pytest.fail("the signal did not interrupt the command")
+
+    def not_the_command(signum, frame):  # SIGTERM must not end the test run itself
+        raise RuntimeError("the signal reached the test's own handler")
+
+    monkeypatch.setattr("hystcomp.cli.compensate.write_table", signalled_write)
+    previous = signal.signal(signal.SIGTERM, not_the_command)
+    try:
+        result = run("compensate", files / "m.json", files / "ref.csv", "-o", out)
+        assert signal.getsignal(signal.SIGTERM) is not_the_command  # restored after the command
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+    assert result.exit_code == code, result.output
+    assert out.read_text() == "old\n"
+    assert _hidden(files) == []
+
+
+def test_sigterm_to_a_running_command_exits_143_and_removes_temporaries(files):
+    sig, code = signal.SIGTERM, 143
     out = files / "v.csv"
     out.write_text("old\n")
     args = ["compensate", str(files / "m.json"), str(files / "ref.csv"), "-o", str(out)]
