@@ -366,6 +366,17 @@ def exact_input(p, target):
     return previous
 
 
+@_kernel
+def _count_clamped(p, s, u, v, h):
+    """Count a compensator's sample as clamped if ``v``, at an end of the range, leaves
+    ``x_0 + H(v)`` short of the reference ``u`` (eq. 10 may ask beyond a range end for a
+    reachable reference while it catches up: that is not counted)."""
+    target = u - p[OFFSET]
+    miss = CLAMP_TOLERANCE * (1.0 + abs(target))
+    if (v == p[HIGH] and target > h + miss) or (v == p[LOW] and target < h - miss):
+        p[s + ST_CLAMPED] += 1.0
+
+
 @step_kernel
 def preisach_step(p, u):
     """One sample through packed system ``p``; updates its state and returns the output.
@@ -379,8 +390,8 @@ def preisach_step(p, u):
     branch. Compensators slew-limit and clamp ``v``, then advance ``H``'s memory with it.
     A non-finite ``u`` holds the last output and increments the non-finite counter. A
     compensator's sample counts as clamped (out of reach) when ``v`` sits at an end of the
-    range (within :data:`~hystcomp.operators.CLAMP_TOLERANCE` of it) and ``x_0 + H(v)``
-    still falls short of ``x_ref`` there.
+    range and ``x_0 + H(v)`` still falls short of ``x_ref`` there by more than
+    :data:`~hystcomp.operators.CLAMP_TOLERANCE` of it.
     """
     s = state_start(p)
     if u - u != 0.0:  # NaN or +-inf
@@ -397,17 +408,10 @@ def preisach_step(p, u):
             v = exact_input(p, u - p[OFFSET])
         step = p[MAX_STEP]
         v = min(max(v, previous - step), previous + step)
-        low = p[LOW]
-        high = p[HIGH]
-        v = min(max(v, low), high)
+        v = min(max(v, p[LOW]), p[HIGH])
         h = preisach_apply(p, v)
-        # out of reach: at an end of the range and H there still short of the reference
-        # (eq. 10 may ask beyond a range end for a reachable reference, while it catches up)
-        tol = CLAMP_TOLERANCE * (high - low)
-        target = u - p[OFFSET]
-        miss = CLAMP_TOLERANCE * (1.0 + abs(target))
-        if (v >= high - tol and target > h + miss) or (v <= low + tol and target < h - miss):
-            p[s + ST_CLAMPED] += 1.0
+        if v == p[HIGH] or v == p[LOW]:  # rare: only then can the reference be out of reach
+            _count_clamped(p, s, u, v, h)
         out = v
     p[s + ST_LAST] = out
     return out
