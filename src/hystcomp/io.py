@@ -17,6 +17,7 @@ import contextlib
 import inspect
 import json
 import os
+import shutil
 import tempfile
 from pathlib import Path
 from typing import Any
@@ -68,7 +69,9 @@ def check_output_path(path: str | os.PathLike, *, inputs=(), what: str = "output
     Raises
     ------
     OutputPathError
-        If the folder does not exist, ``path`` is a folder, or ``path`` is one of ``inputs``.
+        If the folder does not exist, ``path`` is a folder, a device, a pipe or a socket
+        (replacing one would break what uses it), or ``path`` is one of ``inputs``. A
+        symbolic link is checked as the file it names (see :func:`write_target`).
     """
     path = as_path(path, "path", "check_output_path")
     if path.is_dir():
@@ -76,10 +79,16 @@ def check_output_path(path: str | os.PathLike, *, inputs=(), what: str = "output
             f"Cannot write the {what} {str(path)!r}: it is a folder. Give a file name, "
             f"e.g. {str(path / 'out')!r} with a suffix."
         )
-    if not path.parent.is_dir():
+    target = write_target(path)
+    if target.exists() and not target.is_file():
         raise OutputPathError(
-            f"Cannot write the {what} {str(path)!r}: the folder {str(path.parent)!r} does not "
-            "exist. Create it first or choose another output path."
+            f"Cannot write the {what} {str(path)!r}: it is a device, a pipe or a socket, not "
+            "a regular file, and replacing it would break whatever uses it. Choose a file."
+        )
+    if not target.parent.is_dir():
+        raise OutputPathError(
+            f"Cannot write the {what} {str(path)!r}: the folder {str(target.parent)!r} does "
+            "not exist. Create it first or choose another output path."
         )
     for source in inputs:
         if source is not None and _same_file(path, as_path(source, "inputs", "check_output_path")):
@@ -88,6 +97,48 @@ def check_output_path(path: str | os.PathLike, *, inputs=(), what: str = "output
                 f"{str(source)!r}, which would be overwritten. Choose another output path."
             )
     return path
+
+
+def write_target(path: Path) -> Path:
+    """The file a write to ``path`` replaces: ``path`` itself, or the file its symlink names.
+
+    An output path that is a symbolic link keeps the link: the new contents replace the
+    file it points to (atomically, in that file's folder), as ``open(path, "w")`` would,
+    and a link to a missing file creates that file.
+    """
+    return Path(os.path.realpath(path)) if path.is_symlink() else path
+
+
+#: Temporary files being written now (see :func:`atomic_paths`), for a signal handler that
+#: must remove them before the process ends (:func:`remove_pending`).
+_PENDING: set[Path] = set()
+
+
+def remove_pending() -> None:
+    """Remove every temporary output not yet renamed into place (for signal handlers)."""
+    for tmp in list(_PENDING):
+        with contextlib.suppress(OSError):
+            if tmp.is_dir() and not tmp.is_symlink():
+                shutil.rmtree(tmp)
+            else:
+                os.unlink(tmp)
+        _PENDING.discard(tmp)
+
+
+@contextlib.contextmanager
+def staging_folder(directory: Path):
+    """Yield a new hidden folder inside ``directory``, removed with all it holds on exit.
+
+    For a command that writes a set of files: write them there, then move them into place
+    with :func:`replace_all`.
+    """
+    stage = Path(tempfile.mkdtemp(prefix=".hystcomp-", suffix=".tmp", dir=directory))
+    _PENDING.add(stage)
+    try:
+        yield stage
+    finally:
+        shutil.rmtree(stage, ignore_errors=True)
+        _PENDING.discard(stage)
 
 
 def _same_file(a: Path, b: Path) -> bool:
@@ -122,7 +173,7 @@ def atomic_paths(*paths: str | os.PathLike):
     """
     if not paths:
         raise InvalidParameterError("atomic_paths needs at least one path to write.")
-    paths = [check_output_path(p) for p in paths]
+    paths = [write_target(check_output_path(p)) for p in paths]
     tmps: list[Path] = []
     current = paths[0]
     try:
@@ -133,11 +184,12 @@ def atomic_paths(*paths: str | os.PathLike):
                 )
                 os.close(fd)
                 tmps.append(Path(tmp))
+                _PENDING.add(Path(tmp))
                 os.chmod(tmp, _mode_for(current))
             current = None  # the caller writes any of them
             yield list(tmps)
-            for tmp, current in zip(tmps, paths, strict=True):
-                os.replace(tmp, current)
+            current = None
+            replace_all(list(zip(tmps, paths, strict=True)))
         except OSError as exc:
             names = ", ".join(repr(str(p)) for p in ([current] if current else paths))
             raise OutputPathError(
@@ -148,6 +200,58 @@ def atomic_paths(*paths: str | os.PathLike):
         for tmp in tmps:
             with contextlib.suppress(FileNotFoundError):
                 os.unlink(tmp)
+            _PENDING.discard(tmp)
+
+
+def replace_all(moves: list[tuple[Path, Path]]) -> None:
+    """Rename each ``(new, path)`` onto ``path``, all or none.
+
+    Each existing ``path`` is first kept under a hidden hard link (a copy where the file
+    system has no links); if any rename fails, or the process is interrupted, every
+    ``path`` already replaced gets its old file back (or is removed if it had none), so
+    the set of files is either all new or all as it was.
+
+    Raises
+    ------
+    OSError
+        From the rename that failed, after the rollback.
+    """
+    backups: dict[Path, Path | None] = {}
+    done: list[Path] = []
+    try:
+        for _new, path in moves:
+            backups[path] = _backup(path) if path.exists() else None
+        for new, path in moves:
+            os.replace(new, path)
+            done.append(path)
+    except BaseException:
+        for path in reversed(done):
+            with contextlib.suppress(OSError):
+                if backups[path] is None:
+                    os.unlink(path)
+                else:
+                    os.replace(backups.pop(path), path)
+        raise
+    finally:
+        for backup in backups.values():
+            if backup is not None:
+                with contextlib.suppress(OSError):
+                    os.unlink(backup)
+                _PENDING.discard(backup)
+
+
+def _backup(path: Path) -> Path:
+    """A hidden hard link (or copy) of ``path`` beside it; registered as pending."""
+    fd, name = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=".old", dir=path.parent)
+    os.close(fd)
+    backup = Path(name)
+    _PENDING.add(backup)
+    os.unlink(backup)
+    try:
+        os.link(path, backup)
+    except OSError:
+        shutil.copy2(path, backup)
+    return backup
 
 
 @contextlib.contextmanager
@@ -172,9 +276,18 @@ def model_to_dict(model: HysteresisModel) -> dict[str, Any]:
 
 
 def model_text(model: HysteresisModel) -> str:
-    """The model file's text (JSON) for ``model``."""
+    """The model file's text (JSON) for ``model``.
+
+    Raises
+    ------
+    NotFittedError
+        If the model has no parameters yet.
+    ModelFileError
+        If a parameter is not finite.
+    """
+    doc = model_to_dict(model)  # NotFittedError (a ValueError) before the JSON check
     try:
-        return json.dumps(model_to_dict(model), indent=2, allow_nan=False) + "\n"
+        return json.dumps(doc, indent=2, allow_nan=False) + "\n"
     except ValueError:
         raise ModelFileError(
             f"This {type(model).__name__} holds a non-finite number (NaN or infinity), which "

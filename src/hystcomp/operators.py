@@ -79,9 +79,21 @@ def step_function(kernel):
 # Layout of a packed chain: header slots, then parameters, then state.
 N_PRE, N_PLAY, N_POST, IN_OFFSET, OUT_OFFSET, LOW, HIGH, MAX_STEP = range(8)
 HEADER = 8
-# State slots, from chain_state_start(p): last output, count of non-finite inputs, three
-# scratch slots for chain_step (its input, output and work sample), then the play states.
-STATE_LAST, STATE_NONFINITE, STATE_INPUT, STATE_OUTPUT, STATE_WORK, STATE_PLAYS = range(6)
+# State slots, from chain_state_start(p): last output, count of non-finite inputs, count of
+# clamped outputs, three scratch slots for chain_step (its input, output and work sample),
+# then the play states.
+(
+    STATE_LAST,
+    STATE_NONFINITE,
+    STATE_CLAMPED,
+    STATE_INPUT,
+    STATE_OUTPUT,
+    STATE_WORK,
+    STATE_PLAYS,
+) = range(7)
+#: An output beyond the clamp by more than this fraction of the range counts as clamped
+#: (an exactly reachable reference may land a few roundings outside it).
+CLAMP_TOLERANCE = 1e-9
 # Samples per stage pass in a batch run: the block and the parameters stay in L1 cache.
 BLOCK = 256
 # pack_chain pads the plays to a multiple of this count (the vector loop's step on AVX2).
@@ -206,7 +218,9 @@ def chain_blocks(p, u, out, work):
     """Run every sample of ``u`` through packed chain ``p`` into ``out``; state kept in ``p``.
 
     A non-finite sample, or one whose result overflows, holds the last output and
-    increments the non-finite counter; the plays advance only on a finite input. Samples go through in blocks of :data:`BLOCK`, stage by stage: the stateless dead-zone
+    increments the non-finite counter; the plays advance only on a finite input. An output
+    that the clamp moves by more than :data:`CLAMP_TOLERANCE` of the range increments the
+    clamped counter. Samples go through in blocks of :data:`BLOCK`, stage by stage: the stateless dead-zone
     stages as passes over the block, the plays and the output limits sample by sample.
     ``out`` is the work buffer of the stages before the plays and ``work`` (at least
     ``min(BLOCK, u.size)`` long if the chain has dead-zones after the plays) that of the
@@ -229,6 +243,8 @@ def chain_blocks(p, u, out, work):
     ) = chain_parts(p)
     last = state[STATE_LAST]
     held = state[STATE_NONFINITE]
+    clamped = state[STATE_CLAMPED]
+    tol = CLAMP_TOLERANCE * (high - low)  # inf without a clamp: nothing counts
     slewing = max_step < np.inf  # a loop-invariant test: without a limit, no recurrence
     for start in range(0, u.size, BLOCK):
         ub = u[start : start + BLOCK]
@@ -256,10 +272,13 @@ def chain_blocks(p, u, out, work):
             else:
                 if slewing:
                     zk = min(max(zk, last - max_step), last + max_step)
+                if zk < low - tol or zk > high + tol:
+                    clamped += 1.0
                 last = min(max(zk, low), high)
             z[k] = last
     state[STATE_LAST] = last
     state[STATE_NONFINITE] = held
+    state[STATE_CLAMPED] = clamped
 
 
 @step_kernel
@@ -287,19 +306,19 @@ def chain_run(p, u, out):
     chain_blocks(p, u, out, work)
 
 
-StepKernels = namedtuple("StepKernels", "step run state_start last nonfinite")
+StepKernels = namedtuple("StepKernels", "step run state_start last nonfinite clamped")
 StepKernels.__doc__ = """What a streaming stepper needs to know of a kind of packed system.
 
 ``step`` is its :func:`step_kernel`, ``run(p, u, out)`` the batch kernel that the step equals
 bit for bit, ``state_start(p)`` a plain Python function giving the index of the first state
-slot, and ``last`` and ``nonfinite`` the offsets from there of the last output and of the
-count of non-finite inputs. :data:`CHAIN_KERNELS` is that of a packed chain; the Preisach
+slot, and ``last``, ``nonfinite`` and ``clamped`` the offsets from there of the last output,
+of the count of non-finite inputs and of the count of clamped outputs. :data:`CHAIN_KERNELS` is that of a packed chain; the Preisach
 kernels have theirs.
 """
 
 #: The :class:`StepKernels` of a packed chain.
 CHAIN_KERNELS = StepKernels(
-    chain_step, chain_run, chain_state_start.py_func, STATE_LAST, STATE_NONFINITE
+    chain_step, chain_run, chain_state_start.py_func, STATE_LAST, STATE_NONFINITE, STATE_CLAMPED
 )
 
 
@@ -357,7 +376,7 @@ def pack_chain(
         pad = np.zeros(-len(plays[0]) % PLAY_MULTIPLE)
         play_r, play_w, play_y0 = (np.concatenate([np.asarray(a, np.float64), pad]) for a in plays)
     header = [len(pre_r), len(play_r), len(post_r), in_offset, out_offset, low, high, max_step]
-    state = [min(max(0.0, low), high), 0.0, 0.0, 0.0, 0.0]
+    state = [min(max(0.0, low), high), 0.0, 0.0, 0.0, 0.0, 0.0]
     parts = [header, pre_r, pre_w, play_r, play_w, post_r, post_w, state, play_y0]
     return np.concatenate([np.asarray(a, dtype=np.float64) for a in parts])
 

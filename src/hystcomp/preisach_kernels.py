@@ -39,7 +39,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from hystcomp.operators import FASTMATH, StepKernels, step_kernel
+from hystcomp.operators import CLAMP_TOLERANCE, FASTMATH, StepKernels, step_kernel
 
 # Modes of a packed system: what a step maps.
 FORWARD, MULTIPLICATIVE, EXACT = 0, 1, 2
@@ -49,9 +49,10 @@ POLYNOMIAL, TABLE = 0, 1
 MODE, KIND, V_MIN, V_MAX, OFFSET, GRID_STEP, N_COEF, DEPTH, RHO, MAX_STEP, LOW, HIGH = range(12)
 HEADER = 12
 # State slots (from state_start(p)): stack top, last input, last H (without offset),
-# last output, count of non-finite inputs. The stack and its prefix sums follow.
-ST_TOP, ST_INPUT, ST_H, ST_LAST, ST_NONFINITE = range(5)
-N_STATE = 5
+# last output, count of non-finite inputs, count of clamped outputs. The stack and its
+# prefix sums follow.
+ST_TOP, ST_INPUT, ST_H, ST_LAST, ST_NONFINITE, ST_CLAMPED = range(6)
+N_STATE = 6
 #: Default bound on the stored extrema: 512 nested reversals, far beyond measured signals.
 DEFAULT_DEPTH = 1024
 
@@ -138,8 +139,10 @@ def pack_preisach(
         [mode, kind, v_min, v_max, offset, step, n, depth, rho, max_step, low, high],
         dtype=np.float64,
     )
-    last = offset if mode == FORWARD else v_min
-    state = np.array([0.0, v_min, 0.0, last, 0.0])
+    # a compensator holds (on a non-finite first sample) the start voltage v_min, inside
+    # its clamp: a narrowed range holds its nearest end
+    last = offset if mode == FORWARD else min(max(v_min, low), high)
+    state = np.array([0.0, v_min, 0.0, last, 0.0, 0.0])
     stack = np.zeros(depth)
     stack[0] = v_min
     parts = [header, np.ascontiguousarray(coef, dtype=np.float64).ravel(), state, stack]
@@ -363,6 +366,17 @@ def exact_input(p, target):
     return previous
 
 
+@_kernel
+def _count_clamped(p, s, u, v, h):
+    """Count a compensator's sample as clamped if ``v``, at an end of the range, leaves
+    ``x_0 + H(v)`` short of the reference ``u`` (eq. 10 may ask beyond a range end for a
+    reachable reference while it catches up: that is not counted)."""
+    target = u - p[OFFSET]
+    miss = CLAMP_TOLERANCE * (1.0 + abs(target))
+    if (v == p[HIGH] and target > h + miss) or (v == p[LOW] and target < h - miss):
+        p[s + ST_CLAMPED] += 1.0
+
+
 @step_kernel
 def preisach_step(p, u):
     """One sample through packed system ``p``; updates its state and returns the output.
@@ -374,7 +388,10 @@ def preisach_step(p, u):
     ``v[k] = v[k-1] + (x_ref[k] - x[k-1]) / rho``, i.e. ``(x_ref[k] - Gamma(v[k-1])) / rho``
     with ``Gamma(v) = H(v) - rho v``; EXACT solves ``x_0 + H(v) = x_ref`` on the current
     branch. Compensators slew-limit and clamp ``v``, then advance ``H``'s memory with it.
-    A non-finite ``u`` holds the last output and increments the non-finite counter.
+    A non-finite ``u`` holds the last output and increments the non-finite counter. A
+    compensator's sample counts as clamped (out of reach) when ``v`` sits at an end of the
+    range and ``x_0 + H(v)`` still falls short of ``x_ref`` there by more than
+    :data:`~hystcomp.operators.CLAMP_TOLERANCE` of it.
     """
     s = state_start(p)
     if u - u != 0.0:  # NaN or +-inf
@@ -392,7 +409,9 @@ def preisach_step(p, u):
         step = p[MAX_STEP]
         v = min(max(v, previous - step), previous + step)
         v = min(max(v, p[LOW]), p[HIGH])
-        preisach_apply(p, v)
+        h = preisach_apply(p, v)
+        if v == p[HIGH] or v == p[LOW]:  # rare: only then can the reference be out of reach
+            _count_clamped(p, s, u, v, h)
         out = v
     p[s + ST_LAST] = out
     return out
@@ -407,7 +426,7 @@ def preisach_run(p, u, out):
 
 #: The :class:`~hystcomp.operators.StepKernels` of a packed Preisach system.
 PREISACH_KERNELS = StepKernels(
-    preisach_step, preisach_run, state_start.py_func, ST_LAST, ST_NONFINITE
+    preisach_step, preisach_run, state_start.py_func, ST_LAST, ST_NONFINITE, ST_CLAMPED
 )
 
 

@@ -3,7 +3,9 @@
 Each subcommand lives in its own module of this package and registers itself on
 :data:`main`. Exit status: 0 on success, 2 on bad usage or bad input (one line on
 standard error that names the problem and the fix, no traceback), 1 on an internal fault,
-141 when standard output is closed early (``| head``).
+141 when standard output is closed early (``| head``), 130 on Ctrl-C (SIGINT) and 143 on
+SIGTERM; an interrupted command removes its temporary files and leaves its outputs as
+they were. ``hystcomp`` alone prints its usage and commands on standard error (exit 2).
 """
 
 from __future__ import annotations
@@ -11,6 +13,7 @@ from __future__ import annotations
 import contextlib
 import importlib
 import os
+import signal
 import sys
 
 import click
@@ -20,6 +23,37 @@ from hystcomp.errors import HystcompError
 EXIT_BAD_INPUT = 2
 EXIT_INTERNAL = 1
 EXIT_BROKEN_PIPE = 141  # 128 + SIGPIPE, as a shell reports a command killed by it
+EXIT_SIGINT = 130  # 128 + SIGINT
+EXIT_SIGTERM = 143  # 128 + SIGTERM
+
+
+def remove_pending() -> None:
+    """Remove the temporary outputs of an interrupted write (none if no file module ran)."""
+    io = sys.modules.get("hystcomp.io")  # not imported here: it pulls in the models
+    if io is not None:
+        io.remove_pending()
+
+
+class _Terminated(BaseException):
+    """SIGTERM, raised in the main thread so that cleanup code (finally) runs."""
+
+
+def _on_sigterm(signum, frame):
+    raise _Terminated
+
+
+@contextlib.contextmanager
+def _sigterm_unwinds():
+    """While a command runs, SIGTERM unwinds the stack (removing temporaries) as Ctrl-C does."""
+    try:
+        previous = signal.signal(signal.SIGTERM, _on_sigterm)
+    except ValueError:  # not the main thread: leave signals alone
+        yield
+        return
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
 
 
 def _one_line(text: str) -> str:
@@ -103,10 +137,22 @@ class _Group(click.Group):
 
     def main(self, args=None, prog_name=None, complete_var=None, standalone_mode=True, **extra):
         try:
-            return super().main(args, prog_name, complete_var, standalone_mode=False, **extra)
-        except click.exceptions.Abort:
+            with _sigterm_unwinds():
+                return super().main(args, prog_name, complete_var, standalone_mode=False, **extra)
+        except _Terminated:
+            remove_pending()
+            click.echo("hystcomp: terminated", err=True)
+            sys.exit(EXIT_SIGTERM)
+        except click.exceptions.Abort as exc:
+            remove_pending()
+            if isinstance(exc.__cause__, KeyboardInterrupt):  # click's wrapping of Ctrl-C
+                click.echo("hystcomp: interrupted", err=True)
+                sys.exit(EXIT_SIGINT)
             click.echo("hystcomp: aborted", err=True)
             sys.exit(EXIT_INTERNAL)
+        except click.exceptions.NoArgsIsHelpError as exc:  # plain `hystcomp`: usage, commands
+            click.echo(exc.ctx.get_help(), err=True)
+            sys.exit(EXIT_BAD_INPUT)
         except click.UsageError as exc:
             hint = f" (see '{exc.ctx.command_path} --help')" if exc.ctx is not None else ""
             click.echo(f"hystcomp: error: {_one_line(exc.format_message())}{hint}", err=True)
@@ -129,8 +175,9 @@ class _Group(click.Group):
                 os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
             sys.exit(EXIT_BROKEN_PIPE)
         except KeyboardInterrupt:
+            remove_pending()
             click.echo("hystcomp: interrupted", err=True)
-            sys.exit(130)
+            sys.exit(EXIT_SIGINT)
         except Exception as exc:  # noqa: BLE001 - an internal fault: say so, briefly
             click.echo(
                 f"hystcomp: internal error: {type(exc).__name__}: {_one_line(exc)} "

@@ -19,6 +19,7 @@ from hystcomp.cli._options import (
     voltage_range,
 )
 from hystcomp.data import read_table, write_table
+from hystcomp.errors import InvalidSignalError
 from hystcomp.io import load_model
 
 
@@ -80,6 +81,12 @@ def inverse_options(model, table, *, slew_rate, narrow_range) -> dict:
     help="Also invert the linear dynamics of this file (hystcomp identify --model "
     "dynamics): v = H^-1[D^-1[x_ref]], looking ahead in the reference (beyond the paper).",
 )
+@click.option(
+    "--strict",
+    is_flag=True,
+    help="Refuse (exit 2, nothing written) a reference that the clamp cuts anywhere, "
+    "instead of warning.",
+)
 def compensate(
     model_file,
     reference_file,
@@ -90,12 +97,15 @@ def compensate(
     narrow_range,
     method,
     dynamics_file,
+    strict,
 ):
     """Voltage that makes the actuator of MODEL.json follow REFERENCE (columns t, x).
 
     Uses the model's inverse (eqs. 23-26 for PI/MPI; for Preisach eq. 10 or, with
     --method exact, the exact inverse), clamped to the model's voltage range (or a narrower
-    --voltage-range). Writes t (s), v (V) and x_ref (µm).
+    --voltage-range). Writes t (s), v (V) and x_ref (µm). Samples whose reference lies out
+    of the actuator's reach are clamped and counted: a warning says how many (exit 0), or
+    with --strict the command refuses (exit 2) and writes nothing.
     """
     inputs = (model_file, reference_file) + ((dynamics_file,) if dynamics_file else ())
     check_data_output(output, inputs=inputs, what="voltage file")
@@ -107,12 +117,27 @@ def compensate(
     if dynamics_file is not None:
         options["dynamics"] = dynamics_for(load_dynamics(dynamics_file), table)
     compensator = model.inverse(**options, **chosen)
-    v = compensator.simulate(table["x"])
-    write_table(output, {"t": table["t"], "v": v, "x_ref": table["x"]})
+    result = compensator.run(table["x"])
+    v = result.v
     lo, hi = compensator.voltage_range
+    if result.clamped:
+        x_lo, x_hi = model.reachable_range(voltage_range=(lo, hi))
+        x = table["x"]
+        what = (
+            f"{result.clamped} of {v.size} samples ({100 * result.clamped_share:.3g} %) are "
+            f"out of reach and clamped to {lo:.4g} .. {hi:.4g} V: the reference spans "
+            f"{x.min():.4g} .. {x.max():.4g} µm, the model reaches {x_lo:.4g} .. {x_hi:.4g} µm"
+        )
+        if strict:
+            raise InvalidSignalError(
+                f"{what}. Nothing written (--strict); shift or scale the reference into "
+                "the reachable range, or drop --strict to accept the clamp."
+            )
+        click.echo(f"hystcomp: warning: {what}.", err=True)
+    write_table(output, {"t": table["t"], "v": v, "x_ref": table["x"]})
     click.echo(
         f"wrote {output}: {v.size} samples, v from {v.min():.4g} to {v.max():.4g} V "
-        f"(clamped to {lo:.4g} .. {hi:.4g} V)"
+        f"(range {lo:.4g} .. {hi:.4g} V, {result.clamped} clamped)"
     )
     if dynamics_file is not None:
         click.echo(

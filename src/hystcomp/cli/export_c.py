@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import click
@@ -10,8 +11,19 @@ from hystcomp import paper
 from hystcomp.cli import main
 from hystcomp.cli._dynamics import load_dynamics, refuse_dynamics_as_model
 from hystcomp.cli._options import method_option, method_options
-from hystcomp.codegen import DEFAULT_PREFIX, export_c
-from hystcomp.io import load_model
+from hystcomp.codegen import DEFAULT_PREFIX, check_prefix, export_c
+from hystcomp.io import check_output_path, load_model
+
+
+def _rate(ctx, param, value):
+    """``--fs``: a finite rate > 0 (it divides the slew-rate limit and the period)."""
+    if not (math.isfinite(value) and value > 0):
+        raise click.BadParameter(
+            f"must be a finite number > 0 (Hz, the rate at which NAME_step is called); "
+            f"got {value!r}.",
+            param=param,
+        )
+    return value
 
 
 @main.command("export-c")
@@ -44,6 +56,7 @@ from hystcomp.io import load_model
     default=paper.SAMPLE_RATE,
     show_default=True,
     metavar="HZ",
+    callback=_rate,
     help="Sample rate at which NAME_step is called; sets the slew step per sample.",
 )
 @method_option
@@ -66,6 +79,9 @@ def export_c_command(model_file, directory, prefix, slew_rate, sample_rate, meth
       void   NAME_reset(NAME_state *s);
       double NAME_step(NAME_state *s, double x_ref);   /* um in, V out */
     """
+    check_prefix(prefix)
+    for suffix in (".h", ".c") if directory.is_dir() else ():  # never overwrite the model
+        check_output_path(directory / f"{prefix}{suffix}", inputs=(model_file,))
     model = load_model(model_file)
     refuse_dynamics_as_model(model, model_file)
     options = {"slew_rate": slew_rate, "sample_rate": sample_rate}
@@ -80,6 +96,11 @@ def export_c_command(model_file, directory, prefix, slew_rate, sample_rate, meth
         options["dynamics"] = dynamics
     compensator = model.inverse(**options, **method_options(model, model_file, method))
     header, source = export_c(
-        compensator, directory, prefix=prefix, source=str(model_file), sample_rate=sample_rate
+        compensator,
+        directory,
+        prefix=prefix,
+        source=str(model_file),
+        sample_rate=sample_rate,
+        inputs=(model_file,),
     )
     click.echo(f"wrote {header} and {source}")

@@ -118,6 +118,29 @@ def _regularization(ctx, param, value):
     return number
 
 
+def _refuse_extrapolation(voltage_range, v) -> None:
+    """Refuse a --voltage-range that reaches beyond the input the model is fitted on."""
+    lo, hi = voltage_range
+    v_lo, v_hi = float(v.min()), float(v.max())
+    slack = 1e-9 * (v_hi - v_lo)
+    if lo < v_lo - slack or hi > v_hi + slack:
+        raise click.BadParameter(
+            f"{lo:g} {hi:g} V reaches beyond the record's input ({v_lo:.6g} .. {v_hi:.6g} V): "
+            "the compensator would command voltages the model never saw. Give a range "
+            "within the record, record over the whole range, or pass --allow-extrapolation.",
+            param_hint="'--voltage-range'",
+        )
+
+
+def _verdict(improvement: float) -> str:
+    """``line rms / model rms`` in words: "2.5x better", or "1.14x worse" below 1."""
+    if improvement >= 1.0:
+        return f"{improvement:.3g}x better"
+    if improvement > 0.0:
+        return f"{1.0 / improvement:.3g}x worse"
+    return "no better (the line fits the held-out part exactly)"
+
+
 def _sizes(model) -> str:
     parts = []
     if hasattr(model, "n_operators"):
@@ -206,7 +229,16 @@ def _sizes(model) -> str:
     default=None,
     metavar="LO HI",
     callback=voltage_range,
-    help="Amplifier range in V, the compensator's clamp [the record's range].",
+    help="Amplifier range in V, the compensator's clamp [the record's range]. A range "
+    "reaching beyond the record's input is refused, not capped (a cap would quietly give "
+    "another range than asked): the compensator would command voltages the model never "
+    "saw. --allow-extrapolation accepts it.",
+)
+@click.option(
+    "--allow-extrapolation",
+    is_flag=True,
+    help="Accept a --voltage-range wider than the record's input; the model then "
+    "extrapolates there.",
 )
 @click.option(
     "--holdout",
@@ -234,6 +266,7 @@ def identify(
     sample_rate,
     transient,
     voltage_range,
+    allow_extrapolation,
     holdout,
     plot,
     output,
@@ -294,6 +327,8 @@ def identify(
             "that keeps samples on both sides."
         )
     v, x = rec.v[:n_fit], rec.x[:n_fit]
+    if voltage_range is not None and not allow_extrapolation:
+        _refuse_extrapolation(voltage_range, v)
     if transient is None:
         start = transient_end(v)
     else:
@@ -345,7 +380,7 @@ def identify(
         click.echo(
             f"  hold-out:  last {held['n_holdout']} samples ({100 * holdout:g} %): model rms "
             f"{held['model_rms_um']:.4g} µm, straight line rms {held['line_rms_um']:.4g} µm: "
-            f"{held['improvement']:.3g}x better"
+            f"{_verdict(held['improvement'])}"
         )
         lo, hi = float(v.min()), float(v.max())
         held_v = rec.v[n_fit:]

@@ -19,11 +19,12 @@ from collections.abc import Callable
 from pathlib import Path
 
 from hystcomp import paper
+from hystcomp._validation import check_real
 from hystcomp.codegen.c99 import CTemplate, check_prefix, render
 from hystcomp.codegen.chain import chain_template
 from hystcomp.codegen.preisach import preisach_template
 from hystcomp.errors import InvalidParameterError, InvalidTypeError
-from hystcomp.io import atomic_paths
+from hystcomp.io import atomic_paths, check_output_path
 
 DEFAULT_PREFIX = "hystcomp_compensator"
 
@@ -63,6 +64,7 @@ def generate_c(
             f"Got a compensator of kind {kind!r}."
         )
     check_prefix(prefix)
+    sample_rate = check_real(sample_rate, "sample_rate", "generate_c", positive=True)
     inner = getattr(compensator, "hysteresis", compensator)  # a DynamicCompensator's
     template = TEMPLATES[kind](inner)
     if inner is not compensator:
@@ -79,6 +81,7 @@ def export_c(
     prefix: str = DEFAULT_PREFIX,
     source: str | None = None,
     sample_rate: float = paper.SAMPLE_RATE,
+    inputs=(),
 ) -> tuple[Path, Path]:
     """Write ``PREFIX.h`` and ``PREFIX.c``, a C99 version of ``compensator``, into ``directory``.
 
@@ -98,13 +101,17 @@ def export_c(
     source : str, optional
         The model file, named in the header comment.
     sample_rate : float, default 20000
-        Hz at which the code is meant to be called, for the header comment.
+        Hz at which the code is meant to be called, for the header comment (finite, > 0).
+    inputs : sequence of path, optional
+        Files the caller read (the model file): refused as outputs, never overwritten.
 
     Returns
     -------
     (Path, Path)
         The header and source written. Nothing is written if anything fails, and existing
-        files are replaced only once both new files are complete.
+        files are replaced only once both new files are complete (both, or neither). The
+        header defines ``PREFIX_PAIR_ID``, a hash of both files, which the source checks
+        with ``#error``: a pair mixed from two exports does not compile.
     """
     header, source_text = generate_c(
         compensator, prefix=prefix, source=source, sample_rate=sample_rate
@@ -119,6 +126,8 @@ def export_c(
             )
         directory.mkdir()
     paths = (directory / f"{prefix}.h", directory / f"{prefix}.c")
+    for path in paths:
+        check_output_path(path, inputs=inputs)
     # both files checked before anything is written, renamed into place only once both are
     with atomic_paths(*paths) as (tmp_h, tmp_c):
         tmp_h.write_text(header, encoding="ascii")

@@ -20,6 +20,7 @@ exactly the value the Python compensator uses.
 
 from __future__ import annotations
 
+import hashlib
 import re
 from dataclasses import dataclass, field
 
@@ -30,6 +31,96 @@ from hystcomp.errors import InvalidParameterError
 
 # A C identifier that does not start with '_' (reserved at file scope, C99 7.1.3).
 _PREFIX = re.compile(r"[A-Za-z][A-Za-z0-9_]*\Z")
+#: The standard headers of C99 and C11: a NAME.h of one of these names (in any case, for
+#: file systems that ignore it) would shadow it for every file of the build that includes it.
+STANDARD_HEADERS = frozenset(
+    [
+        "assert",
+        "complex",
+        "ctype",
+        "errno",
+        "fenv",
+        "float",
+        "inttypes",
+        "iso646",
+        "limits",
+        "locale",
+        "math",
+        "setjmp",
+        "signal",
+        "stdalign",
+        "stdarg",
+        "stdatomic",
+        "stdbool",
+        "stddef",
+        "stdint",
+        "stdio",
+        "stdlib",
+        "stdnoreturn",
+        "string",
+        "tgmath",
+        "threads",
+        "time",
+        "uchar",
+        "wchar",
+        "wctype",
+    ]
+)
+#: The keywords of C99 and C11 (those without a leading '_'), and C++'s, since the header
+#: is meant to be included from C++ too.
+C_KEYWORDS = frozenset(
+    [
+        "auto",
+        "break",
+        "case",
+        "char",
+        "const",
+        "continue",
+        "default",
+        "do",
+        "double",
+        "else",
+        "enum",
+        "extern",
+        "float",
+        "for",
+        "goto",
+        "if",
+        "inline",
+        "int",
+        "long",
+        "register",
+        "restrict",
+        "return",
+        "short",
+        "signed",
+        "sizeof",
+        "static",
+        "struct",
+        "switch",
+        "typedef",
+        "union",
+        "unsigned",
+        "void",
+        "volatile",
+        "while",
+        "bool",
+        "class",
+        "delete",
+        "new",
+        "namespace",
+        "operator",
+        "private",
+        "protected",
+        "public",
+        "template",
+        "this",
+        "throw",
+        "try",
+        "catch",
+        "virtual",
+    ]
+)
 
 
 @dataclass
@@ -87,6 +178,17 @@ def check_prefix(prefix: str) -> str:
             f"or '_'), as it names the C files, type and functions. Got {prefix!r}; "
             "for example 'stage_x' or 'piezo_comp'."
         )
+    if prefix.lower() in STANDARD_HEADERS:
+        raise InvalidParameterError(
+            f"The prefix {prefix!r} would name the file {prefix}.h after the standard header "
+            f"<{prefix.lower()}.h>, which it would shadow in the build. Choose another name, "
+            f"for example '{prefix.lower()}_comp'."
+        )
+    if prefix in C_KEYWORDS:
+        raise InvalidParameterError(
+            f"The prefix {prefix!r} is a C (or C++) keyword. Choose another name, for example "
+            f"'{prefix}_comp'."
+        )
     return prefix
 
 
@@ -127,6 +229,7 @@ def render(
     """
     p = check_prefix(prefix)
     guard = f"{p.upper()}_H"
+    pair_id = f"{p.upper()}_PAIR_ID"
     comment = _header_comment(template, p, source, sample_rate)
     fields = [
         "double last; /* last output, V (held while x_ref is not finite) */",
@@ -166,11 +269,18 @@ def render(
             "",
         ]
     )
+    check = [
+        f"#if !defined({pair_id}) || {pair_id} != PAIR_ID_VALUE",
+        f'#error "{p}.h and {p}.c come from different exports: export them again together"',
+        "#endif",
+    ]
     local_lines = [f"    {line}" for line in template.locals]
     source_text = "\n".join(
         [
             comment,
             f'#include "{p}.h"',
+            "",
+            *check,
             "",
             "#include <math.h>",
             "",
@@ -207,7 +317,19 @@ def render(
             "",
         ]
     )
-    return header.replace("{p}", p), source_text.replace("{p}", p)
+    header, source_text = header.replace("{p}", p), source_text.replace("{p}", p)
+    # A hash of both texts, defined in the header and checked in the source: a NAME.h and a
+    # NAME.c from two different exports (two runs into one folder) do not compile together.
+    digest = hashlib.sha256((header + "\0" + source_text).encode()).hexdigest()[:12]
+    value = f"0x{digest}"
+    marker = f"#define {guard}\n"
+    header = header.replace(
+        marker,
+        f"{marker}\n/* identifies this export; {p}.c checks it (do not edit) */\n"
+        f"#define {pair_id} {value}\n",
+        1,
+    )
+    return header, source_text.replace("PAIR_ID_VALUE", value)
 
 
 def _overflow_hold() -> list[str]:

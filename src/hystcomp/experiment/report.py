@@ -1,6 +1,6 @@
 """Tables and the written report of the comparison, beside the paper's numbers.
 
-Files written by :func:`write_outputs` (each atomically):
+Files written by :func:`write_outputs` (as one set: all new, or all as they were):
 
 * ``table1.csv``: ``frequency_hz, method, rms_um, max_um`` (the paper's Table I);
 * ``hysteresis.csv``: ``method, hysteresis_pct, saturation_zone_pct`` at the lowest
@@ -21,7 +21,13 @@ from hystcomp import paper
 from hystcomp.errors import InvalidParameterError
 from hystcomp.experiment.figures import write_figures
 from hystcomp.experiment.metrics import SATURATION_ZONE
-from hystcomp.io import atomic_path
+from hystcomp.io import (
+    atomic_path,
+    check_output_path,
+    replace_all,
+    staging_folder,
+    write_target,
+)
 from hystcomp.paper import LABELS, METHODS
 
 
@@ -101,29 +107,42 @@ def prepare_output_dir(out_dir) -> Path:
 
 
 def write_outputs(comparison, out_dir) -> list[Path]:
-    """Write tables, figures and ``report.md`` into ``out_dir``; return the files written."""
-    out = prepare_output_dir(out_dir)
-    _write_text(out / "table1.csv", _csv_text(table1_rows(comparison)))
-    _write_text(out / "hysteresis.csv", _csv_text(hysteresis_rows(comparison)))
-    notes = write_figures(comparison, out)
-    text = report_markdown(comparison, notes)
-    extra = []
-    if getattr(comparison, "dynamics", None) is not None:  # beyond the paper
-        from hystcomp.experiment.compare_dynamics import dynamics_markdown, dynamics_rows
-        from hystcomp.experiment.fig_dynamics import plot_step
+    """Write tables, figures and ``report.md`` into ``out_dir``; return the files written.
 
-        dc = comparison.dynamics
-        _write_text(out / "dynamics.csv", _csv_text(dynamics_rows(dc)))
-        t = next(iter(dc.step.values()))[0]
-        x_ref = next(iter(dc.step.values()))[1]
-        plot_step(t, x_ref, {k: run[2] for k, run in dc.step.items()}, out / "step_creep.png")
-        text += "\n" + "\n".join(dynamics_markdown(dc, comparison.results))
-        text += "\n![Step and hold](step_creep.png)\n"
-        extra = ["dynamics.csv", "step_creep.png"]
-    _write_text(out / "report.md", text)
-    names = ["table1.csv", "hysteresis.csv", *(n for n, why in notes.items() if why is None)]
-    names += extra
-    return [out / n for n in [*names, "report.md"]]
+    Every file is first written into a hidden folder inside ``out_dir``, then all are
+    renamed into place together (:func:`hystcomp.io.replace_all`): a failure or an
+    interruption leaves the files of an earlier run as they were, never a mix of two runs.
+    """
+    out = prepare_output_dir(out_dir)
+    with staging_folder(out) as stage:
+        _write_text(stage / "table1.csv", _csv_text(table1_rows(comparison)))
+        _write_text(stage / "hysteresis.csv", _csv_text(hysteresis_rows(comparison)))
+        notes = write_figures(comparison, stage)
+        text = report_markdown(comparison, notes)
+        names = ["table1.csv", "hysteresis.csv", *(n for n, why in notes.items() if why is None)]
+        if getattr(comparison, "dynamics", None) is not None:  # beyond the paper
+            from hystcomp.experiment.compare_dynamics import dynamics_markdown, dynamics_rows
+            from hystcomp.experiment.fig_dynamics import plot_step
+
+            dc = comparison.dynamics
+            _write_text(stage / "dynamics.csv", _csv_text(dynamics_rows(dc)))
+            t, x_ref = next(iter(dc.step.values()))[:2]
+            plot_step(t, x_ref, {k: run[2] for k, run in dc.step.items()}, stage / "step_creep.png")
+            text += "\n" + "\n".join(dynamics_markdown(dc, comparison.results))
+            text += "\n![Step and hold](step_creep.png)\n"
+            names += ["dynamics.csv", "step_creep.png"]
+        _write_text(stage / "report.md", text)
+        names.append("report.md")
+        for name in names:
+            check_output_path(out / name, what="output")
+        try:
+            replace_all([(stage / n, write_target(out / n)) for n in names])
+        except OSError as exc:
+            raise InvalidParameterError(
+                f"Cannot write into {str(out)!r}: {exc.strerror or exc}; the files of any "
+                "earlier run are unchanged. Check the permissions and the free space."
+            ) from None
+    return [out / n for n in names]
 
 
 # ----------------------------------------------------------------------------- report text

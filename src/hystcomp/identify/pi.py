@@ -42,7 +42,7 @@ from hystcomp._validation import as_signal, check_int, check_real
 from hystcomp.errors import IdentificationError, InvalidParameterError, InvalidSignalError
 from hystcomp.identify import scoring
 from hystcomp.identify.lsq import constrained_lsq, normal_equations
-from hystcomp.identify.scoring import check_transient, thin
+from hystcomp.identify.scoring import check_response, check_transient, thin
 
 DEFAULT_MARGIN = 1e-3
 
@@ -114,28 +114,19 @@ def prepare_record(v, x, *, n_weights: int, transient, owner: str) -> PreparedRe
             "such as 'hystcomp excite pi'."
         )
     start = check_transient(transient, v, owner, min_used=2 * n_weights)
-    x_span = float(np.ptp(x[start:]))
-    if x_span <= 0.0:
-        raise IdentificationError(
-            f"{owner}: the displacement 'x' is constant after sample {start}; the sensor "
-            "recorded no motion. Check the displacement column."
-        )
     u_fit, x_fit = u[start:], x[start:]
     if np.ptp(u_fit) <= 0.0:
         raise IdentificationError(
             f"{owner}: the input 'v' is constant after the start-up transient (sample "
             f"{start} on). Set a shorter transient."
         )
-    # scaled by the spans, so that the sign survives records of any magnitude; on a strided
-    # subset of a long record (the sign of a correlation needs no ten million samples)
-    step = max(1, u_fit.size // 1_000_000)
-    u_s, x_s = u_fit[::step], x_fit[::step]
-    if np.dot((u_s - u_s.mean()) / span, (x_s - x_s.mean()) / x_span) <= 0.0:
+    x_span = float(np.ptp(x_fit))
+    if x_span <= 0.0:
         raise IdentificationError(
-            f"{owner}: the displacement 'x' falls as the voltage 'v' rises. The models "
-            "describe an actuator whose displacement rises with its voltage: flip the sign "
-            "of the displacement (a negative sensor gain) or check the columns."
+            f"{owner}: the displacement 'x' is constant after sample {start}; the sensor "
+            "recorded no motion. Check the displacement column."
         )
+    check_response(u_fit, x_fit, owner)  # rising, and more than noise
     return PreparedRecord(v, x, v0, u, start, span, x_span / span)
 
 

@@ -33,6 +33,7 @@ from hystcomp.errors import (
     InvalidTypeError,
 )
 from hystcomp.identify.preisach_lsq import MAX_LSQ_GRID, fit_preisach_lsq
+from hystcomp.identify.scoring import check_response
 
 MAX_DEGREE = 8
 EVERETT_KINDS = ("polynomial", "table")
@@ -311,7 +312,8 @@ def fit_everett_table(alpha, beta, value, *, grid_size: int, voltage_range) -> n
     return pk.antisymmetric_table(lower)
 
 
-def _check_options(degree, everett, grid_size, zero_diagonal, owner):
+def check_options(degree, everett, grid_size, zero_diagonal, owner):
+    """Validate the fit options of a Preisach identification; returns ``(degree, grid_size)``."""
     degree = check_int(degree, "degree", owner)
     if not isinstance(zero_diagonal, bool | np.bool_):
         raise InvalidTypeError(
@@ -394,13 +396,14 @@ def identify_preisach(
         curve or too few; for least squares, an input that does not move.
     """
     owner = "identify_preisach"
-    degree, grid_size = _check_options(degree, everett, grid_size, zero_diagonal, owner)
+    degree, grid_size = check_options(degree, everett, grid_size, zero_diagonal, owner)
     if fit_method not in FIT_METHODS:
         raise InvalidParameterError(
             f"The 'fit_method' parameter of {owner} must be one of "
             f"{', '.join(map(repr, FIT_METHODS))}. Got {fit_method!r} instead."
         )
     curves = find_reversal_curves(v, x, tolerance=tolerance)
+    check_response(v, x, owner)  # rising, and more than noise
     v = np.ascontiguousarray(v, dtype=np.float64).reshape(-1)
     x = np.ascontiguousarray(x, dtype=np.float64).reshape(-1)
     data_range = (float(v.min()), float(v.max()))

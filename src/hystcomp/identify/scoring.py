@@ -98,6 +98,86 @@ def thin(v, start: int = 0, max_samples: int = MAX_SAMPLES) -> np.ndarray:
     return np.flatnonzero(keep)
 
 
+#: Least share of the displacement's variance that a straight line in the voltage must
+#: explain for a record to count as a response. Real records explain 0.95 and more; a
+#: loop that turns back (a partial sum of PI weights below 0) still about 0.2; noise
+#: about 1 / (number of samples).
+MIN_EXPLAINED = 0.1
+#: Least Fisher statistic ``(n - 2) R^2 / (1 - R^2)`` of that line: the share must also be
+#: beyond chance (noise reaches 30 with a probability near 1e-5 at 20 samples, far less
+#: with more), so that a short noise-only record is refused too.
+MIN_F_STATISTIC = 30.0
+
+
+def check_response(v, x, owner: str) -> float:
+    """Refuse a record whose displacement does not respond to its input.
+
+    The one check every fit goes through (PI, MPI, Preisach) before it identifies
+    anything: the least-squares line ``x = a v + b`` (:func:`straight_line`) must rise
+    (``a > 0``) and explain at least :data:`MIN_EXPLAINED` of the variance of ``x``,
+    significantly (Fisher statistic at least :data:`MIN_F_STATISTIC`). A hysteretic
+    actuator's loop is close to its line (R^2 of 0.95-0.98 on the real and simulated
+    records of the tests); a record of sensor noise, of a constant, or of a column that
+    is not the displacement explains next to nothing, and a short one that explains more
+    by chance fails the F test. A line and not a monotone fit: a monotone fit explains
+    much of any noise sorted by the input.
+
+    Parameters
+    ----------
+    v, x : array_like
+        Input (V) and displacement (µm) over the samples the fit uses.
+    owner : str
+        Names the fit in messages.
+
+    Returns
+    -------
+    float
+        The explained share R^2.
+
+    Raises
+    ------
+    IdentificationError
+        Naming what was found and what to record.
+
+    Examples
+    --------
+    >>> v = np.linspace(0.0, 100.0, 50)
+    >>> round(check_response(v, 0.3 * v + 2.0, "fit"), 6)
+    1.0
+    """
+    v, x = as_signal_pair(v, x, ("v", "x"), owner)
+    if np.ptp(x) == 0.0:
+        raise IdentificationError(
+            f"{owner}: the displacement 'x' is constant ({float(x[0])!r} µm); the sensor "
+            "recorded no motion. Check the displacement column and the sensor."
+        )
+    if np.ptp(v) == 0.0:
+        raise IdentificationError(
+            f"{owner}: the input 'v' is constant ({float(v[0])!r} V); it shows no hysteresis "
+            "to identify. Record the response to an input that sweeps the actuator's range."
+        )
+    vc = (v - v.mean()) / np.ptp(v)  # scaled: the products stay finite at any magnitude
+    xc = (x - x.mean()) / np.ptp(x)
+    r2 = float(np.dot(vc, xc) ** 2 / (np.dot(vc, vc) * np.dot(xc, xc)))
+    slope = float(np.dot(vc, xc))
+    f_stat = (v.size - 2) * r2 / (1.0 - r2) if r2 < 1.0 else np.inf
+    if slope <= 0.0 and r2 >= MIN_EXPLAINED:
+        raise IdentificationError(
+            f"{owner}: the displacement 'x' falls as the voltage 'v' rises. The models "
+            "describe an actuator whose displacement rises with its voltage: flip the sign "
+            "of the displacement (a negative sensor gain) or check the columns."
+        )
+    if slope <= 0.0 or r2 < MIN_EXPLAINED or f_stat < MIN_F_STATISTIC:
+        raise IdentificationError(
+            f"{owner}: the displacement 'x' does not respond to the voltage 'v': a straight "
+            f"line in v explains {100 * r2:.3g} % of its variance over {v.size} samples "
+            f"(a response explains at least {100 * MIN_EXPLAINED:g} %, beyond chance). "
+            "It looks like noise or the wrong column: check the displacement column, "
+            "the sensor, and that the record sweeps the actuator's range."
+        )
+    return r2
+
+
 def error_report(x, x_model, start: int = 0) -> dict:
     """Errors of a model output against the measured displacement over samples ``start..``.
 

@@ -73,6 +73,20 @@ class HysteresisModel(ChainSystem):
                 "hystcomp.load_model(path)."
             )
 
+    def _derived_hyperparameters(self) -> dict[str, Any]:
+        """Hyperparameters that the learned parameters determine (e.g. the operator count
+        from the thresholds), with their values; a model file must agree with them."""
+        return {}
+
+    def _check_hyperparameters(self) -> None:
+        """Validate every hyperparameter's type and value, as ``fit`` does (and raise).
+
+        Subclasses extend it for their own; ``fit`` and ``from_dict`` both call it, so a
+        new hyperparameter is checked on both paths once it is checked here.
+        """
+        if self.voltage_range is not None:
+            check_range(self.voltage_range, "voltage_range", type(self).__name__)
+
     def get_params(self, deep: bool = True) -> dict[str, Any]:
         """The hyperparameters, as given to ``__init__`` (scikit-learn's contract).
 
@@ -176,9 +190,18 @@ class HysteresisModel(ChainSystem):
                 f"by to_dict). Got {type(data).__name__}."
             )
         model = cls.from_parameters(**data["parameters"])
+        derived = model._derived_hyperparameters()
         for name, value in data.get("hyperparameters", {}).items():
-            if name in cls._get_param_names():
-                setattr(model, name, value)
+            if name not in cls._get_param_names():
+                continue
+            if name in derived and not _same_value(value, derived[name]):
+                raise InvalidParameterError(
+                    f"The hyperparameter {name!r} of this {cls.__name__} is {value!r}, but its "
+                    f"parameters give {derived[name]!r}: the two disagree. The file was "
+                    f"edited by hand; set {name!r} to {derived[name]!r} or identify again."
+                )
+            setattr(model, name, value)
+        model._check_hyperparameters()  # every value, as fit() would check it
         if "fit_report" in data:
             model.fit_report_ = dict(data["fit_report"])
         return model
@@ -219,6 +242,29 @@ class HysteresisModel(ChainSystem):
             )
         return low, high
 
+    def reachable_range(self, voltage_range=None) -> tuple[float, float]:
+        """The displacements (µm) the model reaches with voltages inside a range.
+
+        The extremes of the major loop: the model run from its initial state over
+        ``lo -> hi -> lo -> hi`` (its branches are monotone, so the extremes lie at the
+        ends). A compensator clamps every reference beyond this range
+        (:meth:`Compensator.run <hystcomp.models.compensator.Compensator.run>` counts them).
+
+        Parameters
+        ----------
+        voltage_range : (float, float), optional
+            A range in V inside ``voltage_range_`` (default: ``voltage_range_``).
+
+        Returns
+        -------
+        (float, float)
+            Lowest and highest displacement in µm.
+        """
+        self._check_fitted()
+        lo, hi = self._clamp_range(voltage_range, f"{type(self).__name__}.reachable_range")
+        x = self.simulate(np.array([lo, hi, lo, hi]))
+        return float(x.min()), float(x.max())
+
     def _adopt(self, fitted: HysteresisModel, fit_report: dict) -> None:
         """Take the learned parameters of ``fitted`` (built by ``from_parameters``, so validated)."""
         for name in self._learned:
@@ -244,6 +290,18 @@ def _differs(value, default) -> bool:
         return not bool(value == default)
     except (TypeError, ValueError):  # e.g. an array's ambiguous truth value
         return True
+
+
+def _same_value(value, expected) -> bool:
+    """Equal and of the same JSON type (3 is not 3.0, "3" or True)."""
+    return type(value) is type(expected) and value == expected
+
+
+def check_play_hyperparameters(model) -> None:
+    """The hyperparameters of every PI-type model: operator count, range, transient, margin."""
+    owner = type(model).__name__
+    check_int(model.n_operators, "n_operators", owner)
+    check_fit_options(model, owner)
 
 
 def set_common_parameters(model, owner, *, voltage_range, input_offset, output_offset):

@@ -10,13 +10,43 @@ the same answer; a :class:`Stepper` owns its own copy and can be reset or copied
 
 from __future__ import annotations
 
-import functools
+import numbers
 from abc import ABC, abstractmethod
+from typing import NamedTuple
 
 import numpy as np
 
 from hystcomp import operators
 from hystcomp._validation import as_signal
+from hystcomp.errors import InvalidSignalError, InvalidTypeError
+
+
+def _sample(u) -> float:
+    """One input sample as a float: a real number (not a bool, text or array), else raise."""
+    if isinstance(u, numbers.Real | np.floating | np.integer) and not isinstance(
+        u, bool | np.bool_
+    ):
+        return float(u)
+    raise InvalidTypeError(
+        f"Stepper.step takes one sample, a real number. Got {u!r:.40} of type "
+        f"{type(u).__name__}; convert it with float(...), or pass a block of samples to "
+        "step_block."
+    )
+
+
+def _checked_step(kernel, p):
+    """``step(u) = kernel(p, u)`` for a float ``u`` (the fast path: one type test), and
+    for any other real number after conversion; text, bools and arrays are refused (the
+    compiled kernel alone would parse a string)."""
+
+    def step(u):
+        if u.__class__ is float:
+            return kernel(p, u)
+        return kernel(p, _sample(u))
+
+    step.func = kernel  # as functools.partial names them: what it calls, and on what
+    step.state = p
+    return step
 
 
 class Stepper:
@@ -26,12 +56,14 @@ class Stepper:
     is counted in :attr:`nonfinite_count`; nothing is raised inside a real-time loop.
 
     For speed, each stepper binds :meth:`step` to the compiled step kernel and its own state
-    when it is made (no method frame, no dispatch on argument types): a call from Python
+    when it is made (no method lookup, no dispatch on argument types): a call from Python
     costs about a quarter of a microsecond, 0.5 % of a 20 kHz period, for the play chains
     and for the Preisach model and its multiplicative inverse; the exact Preisach inverse
     adds its root search per sample (``python benchmarks/run.py realtime`` and ``...
-    preisach``). A loop that has its samples in blocks can use :meth:`step_block`, faster
-    per sample.
+    preisach``). One test that the sample is a float guards it (the compiled kernel alone
+    would parse the text ``"1.0"``); that small Python frame is the only cost above the
+    bare kernel (the ``realtime`` benchmark gives the ratio). A loop that has its samples
+    in blocks can use :meth:`step_block`, faster per sample.
 
     The same class serves every kind of packed system: the class attribute ``kernels``
     (:class:`~hystcomp.operators.StepKernels`) names its step and batch kernels and where
@@ -47,7 +79,7 @@ class Stepper:
         self._start = int(self.kernels.state_start(packed))
         self._run = self.kernels.run  # looked up once: a block call is short too
         # an instance attribute hides the method below, which documents it
-        self.step = functools.partial(operators.step_function(self.kernels.step), self._p)
+        self.step = _checked_step(operators.step_function(self.kernels.step), self._p)
 
     def step(self, u: float) -> float:
         """Advance one sample and return the output.
@@ -66,8 +98,32 @@ class Stepper:
         return self.kernels.step(self._p, u)
 
     def step_block(self, u) -> np.ndarray:
-        """Advance over a block of samples and return the outputs (non-finite samples held)."""
-        u = np.ascontiguousarray(u, dtype=np.float64).reshape(-1)
+        """Advance over a block of samples and return the outputs (non-finite samples held).
+
+        Parameters
+        ----------
+        u : array_like
+            A 1-D block of real samples (a single number is a block of one).
+
+        Raises
+        ------
+        InvalidSignalError
+            If ``u`` has more than one dimension (one channel at a time).
+        InvalidTypeError
+            If ``u`` holds text, booleans or objects.
+        """
+        arr = np.asarray(u)
+        if arr.dtype.kind not in "fiu":
+            raise InvalidTypeError(
+                f"Stepper.step_block takes real numbers. Got an array of {arr.dtype} "
+                f"({type(u).__name__}); convert it with np.asarray(u, dtype=float)."
+            )
+        if arr.ndim > 1:
+            raise InvalidSignalError(
+                f"Stepper.step_block takes a 1-D block of samples. Got shape {arr.shape}; "
+                "pass one channel at a time (for example u[:, 0])."
+            )
+        u = np.ascontiguousarray(arr, dtype=np.float64).reshape(-1)
         out = np.empty_like(u)
         self._run(self._p, u, out)
         return out
@@ -86,6 +142,17 @@ class Stepper:
     def nonfinite_count(self) -> int:
         """How many non-finite input samples were held since the last reset."""
         return int(self._p[self._start + self.kernels.nonfinite])
+
+    @property
+    def clamped_count(self) -> int:
+        """How many outputs the voltage range clamped since the last reset.
+
+        An output counts when the compensator asked for a voltage beyond the range by more
+        than :data:`~hystcomp.operators.CLAMP_TOLERANCE` of it (or, for the exact Preisach
+        inverse, stopped at a range end short of the reference): the reference was out of
+        the actuator's reach there. Always 0 for a forward model.
+        """
+        return int(self._p[self._start + self.kernels.clamped])
 
     @property
     def last_output(self) -> float:
@@ -126,6 +193,29 @@ class ChainSystem(ABC):
         return Stepper(self._packed())
 
 
+class CompensatorRun(NamedTuple):
+    """The result of :meth:`Compensator.run`: the voltage and what the clamp did to it.
+
+    Attributes
+    ----------
+    v : ndarray
+        The voltage in V, one sample per reference sample (as ``simulate`` gives).
+    clamped : int
+        Samples whose voltage the range clamped: the reference was out of reach there.
+    nonfinite : int
+        Non-finite reference samples (each held the last output).
+    """
+
+    v: np.ndarray
+    clamped: int
+    nonfinite: int
+
+    @property
+    def clamped_share(self) -> float:
+        """``clamped`` as a fraction of the samples (0 for an empty run)."""
+        return self.clamped / self.v.size if self.v.size else 0.0
+
+
 class Compensator(ChainSystem):
     """Inverse-based feedforward: reference displacement (µm) in, voltage (V) out.
 
@@ -153,6 +243,28 @@ class Compensator(ChainSystem):
 
     def _packed(self) -> np.ndarray:
         return self._chain
+
+    def run(self, x_ref) -> CompensatorRun:
+        """Like :meth:`simulate`, and also count the samples the voltage range clamped.
+
+        A clamped sample is one whose reference the actuator cannot reach inside the range
+        (``model.reachable_range()`` tells the reachable displacements): the voltage then
+        stays at the end of the range, and the tracking error there is the model's gap.
+
+        Parameters
+        ----------
+        x_ref : array_like
+            1-D finite reference in µm.
+
+        Returns
+        -------
+        CompensatorRun
+            ``(v, clamped, nonfinite)``; ``v`` equals ``simulate(x_ref)`` bit for bit.
+        """
+        u = as_signal(x_ref, self._input_name)
+        s = self.stepper()
+        v = s.step_block(u)
+        return CompensatorRun(v, s.clamped_count, s.nonfinite_count)
 
     @property
     def packed(self) -> np.ndarray:

@@ -186,6 +186,15 @@ class DynamicCompensator:
         """
         return self.hysteresis.simulate(self.dynamics_inverse.simulate(x_ref))
 
+    def run(self, x_ref):
+        """Like :meth:`simulate`, and also count the samples the voltage range clamped.
+
+        Returns the hysteresis compensator's ``CompensatorRun`` (see
+        :meth:`hystcomp.models.compensator.Compensator.run`) for the reference that the
+        inverse of the dynamics hands it.
+        """
+        return self.hysteresis.run(self.dynamics_inverse.simulate(x_ref))
+
     def stepper(self) -> DynamicStepper:
         """Streaming: ``step(x_ref[k + preview])`` returns the voltage to apply at sample ``k``.
 

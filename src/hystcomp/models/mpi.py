@@ -13,7 +13,7 @@ from hystcomp.identify.scoring import error_report
 from hystcomp.models.base import (
     DEFAULT_VOLTAGE_RANGE,
     HysteresisModel,
-    check_fit_options,
+    check_play_hyperparameters,
     fit_voltage_range,
     inverse_play_compensator,
     set_common_parameters,
@@ -141,9 +141,9 @@ class ModifiedPrandtlIshlinskii(HysteresisModel):
             ``self``, fitted.
         """
         owner = type(self).__name__
+        self._check_hyperparameters()
         n = check_int(self.n_operators, "n_operators", owner)
         m = check_int(self.n_deadzones, "n_deadzones", owner)
-        check_fit_options(self, owner)
         penalties = self._penalties(owner)
         fits = fit_mpi_path(
             v,
@@ -226,6 +226,19 @@ class ModifiedPrandtlIshlinskii(HysteresisModel):
             output_offset=output_offset,
         )
         return model
+
+    def _derived_hyperparameters(self) -> dict:
+        return {
+            "n_operators": int(self.thresholds_.size),
+            "n_deadzones": int(self.deadzone_thresholds_.size),
+        }
+
+    def _check_hyperparameters(self) -> None:
+        super()._check_hyperparameters()
+        check_play_hyperparameters(self)
+        owner = type(self).__name__
+        check_int(self.n_deadzones, "n_deadzones", owner)
+        self._penalties(owner)
 
     def _packed(self) -> np.ndarray:
         self._check_fitted()

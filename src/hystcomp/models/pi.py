@@ -12,7 +12,7 @@ from hystcomp.identify.scoring import error_report
 from hystcomp.models.base import (
     DEFAULT_VOLTAGE_RANGE,
     HysteresisModel,
-    check_fit_options,
+    check_play_hyperparameters,
     fit_voltage_range,
     inverse_play_compensator,
     set_common_parameters,
@@ -127,6 +127,7 @@ class PrandtlIshlinskii(HysteresisModel):
             ``self``, fitted.
         """
         owner = type(self).__name__
+        self._check_hyperparameters()
         n = check_int(self.n_operators, "n_operators", owner)
         check_fit_options(self, owner)
         fit = fit_pi(
@@ -176,6 +177,13 @@ class PrandtlIshlinskii(HysteresisModel):
             output_offset=output_offset,
         )
         return model
+
+    def _derived_hyperparameters(self) -> dict:
+        return {"n_operators": int(self.thresholds_.size)}
+
+    def _check_hyperparameters(self) -> None:
+        super()._check_hyperparameters()
+        check_play_hyperparameters(self)
 
     def _packed(self) -> np.ndarray:
         self._check_fitted()

@@ -13,7 +13,7 @@ from hystcomp import paper
 from hystcomp import preisach_kernels as pk
 from hystcomp._validation import as_signal, as_vector, check_int, check_range, check_real
 from hystcomp.errors import InvalidParameterError, InvalidTypeError
-from hystcomp.identify.preisach import MAX_DEGREE, identify_preisach
+from hystcomp.identify.preisach import MAX_DEGREE, check_options, identify_preisach
 from hystcomp.models.base import DEFAULT_VOLTAGE_RANGE, HysteresisModel, slew_to_step
 from hystcomp.models.compensator import Compensator, Stepper
 from hystcomp.models.dynamic_compensator import with_dynamics
@@ -188,7 +188,7 @@ class Preisach(HysteresisModel):
         Preisach
             ``self``, fitted; ``fit_report_`` holds the fit's figures.
         """
-        check_int(self.max_extrema, "max_extrema", type(self).__name__, minimum=3)
+        self._check_hyperparameters()
         result = identify_preisach(
             v,
             x,
@@ -205,6 +205,17 @@ class Preisach(HysteresisModel):
         self.output_offset_ = result.output_offset
         self.fit_report_ = result.report
         return self
+
+    def _derived_hyperparameters(self) -> dict:
+        if self.theta_ is not None:
+            return {"everett": "polynomial", "degree": self.degree}
+        return {"everett": "table", "grid_size": int(self.table_.shape[0])}
+
+    def _check_hyperparameters(self) -> None:
+        super()._check_hyperparameters()
+        owner = type(self).__name__
+        check_options(self.degree, self.everett, self.grid_size, self.zero_diagonal, owner)
+        check_int(self.max_extrema, "max_extrema", owner, minimum=3)
 
     def parameters(self) -> dict:
         """The learned parameters as plain Python values (``theta`` or ``table``)."""
