@@ -17,7 +17,7 @@ from hystcomp._validation import (
     check_thresholds,
 )
 from hystcomp.errors import InvalidParameterError, NotFittedError
-from hystcomp.identify.pi import check_margin
+from hystcomp.identify.pi import check_constraints, check_margin
 from hystcomp.models.compensator import ChainSystem, Compensator
 from hystcomp.models.inversion import inverse_initial_state, invert_superposition
 
@@ -298,10 +298,12 @@ def _same_value(value, expected) -> bool:
 
 
 def check_play_hyperparameters(model) -> None:
-    """The hyperparameters of every PI-type model: operator count, range, transient, margin."""
+    """The hyperparameters of every PI-type model: operator count, transient, margin,
+    constraints (the range is checked by ``HysteresisModel._check_hyperparameters``)."""
     owner = type(model).__name__
     check_int(model.n_operators, "n_operators", owner)
     check_fit_options(model, owner)
+    check_constraints(model.constraints, owner)
 
 
 def set_common_parameters(model, owner, *, voltage_range, input_offset, output_offset):

@@ -129,7 +129,6 @@ class PrandtlIshlinskii(HysteresisModel):
         owner = type(self).__name__
         self._check_hyperparameters()
         n = check_int(self.n_operators, "n_operators", owner)
-        check_fit_options(self, owner)
         fit = fit_pi(
             v,
             x,
