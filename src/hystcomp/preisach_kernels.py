@@ -60,6 +60,13 @@ def _kernel(func):
     return numba.njit(cache=True, fastmath=FASTMATH, nogil=True)(func)
 
 
+def _inline_kernel(func):
+    # Inlined into its callers at numba-IR level, as the chain's stages are: a call per
+    # evaluation of X (several per sample) cost more than the evaluation, and LLVM does not
+    # inline across numba's separately compiled functions.
+    return numba.njit(cache=True, fastmath=FASTMATH, nogil=True, inline="always")(func)
+
+
 def monomial_exponents(degree: int) -> list[tuple[int, int]]:
     """Exponents ``(i, j)`` of the monomials ``beta**i * alpha**j`` of X, in eq. (5)'s order.
 
@@ -146,14 +153,14 @@ def pack_preisach(
     return np.concatenate([*parts, np.zeros(depth)])
 
 
-@_kernel
+@_inline_kernel
 def state_start(p):
     """Index of the first state slot of packed system ``p``."""
     n = int(p[N_COEF])
     return HEADER + n * n
 
 
-@_kernel
+@_inline_kernel
 def everett(p, alpha, beta):
     """``X(alpha, beta)`` of eq. (2) in µm, for voltages inside the plane."""
     a = alpha - p[V_MIN]
@@ -188,7 +195,7 @@ def everett_many(p, alpha, beta, out):
         out[k] = everett(p, alpha[k], beta[k])
 
 
-@_kernel
+@_inline_kernel
 def _push(p, e, q, top, value):
     """Push a turning point (a maximum on an even top, a minimum on an odd one)."""
     if top + 1 >= int(p[DEPTH]):
@@ -202,7 +209,7 @@ def _push(p, e, q, top, value):
     return top + 1
 
 
-@_kernel
+@_inline_kernel
 def preisach_apply(p, v):
     """Apply input ``v`` (clamped to the plane) and return ``H(v)`` without offset, eqs. (3)-(4)."""
     s = state_start(p)
@@ -230,7 +237,7 @@ def preisach_apply(p, v):
     return h
 
 
-@_kernel
+@_inline_kernel
 def _branch(p, base, pivot, rising, v):
     """A monotone branch: ``base + X(v, pivot)`` rising, ``base - X(pivot, v)`` falling."""
     if rising:
@@ -363,19 +370,9 @@ def exact_input(p, target):
     return previous
 
 
-@step_kernel
-def preisach_step(p, u):
-    """One sample through packed system ``p``; updates its state and returns the output.
-
-    The streaming step (a :func:`~hystcomp.operators.step_kernel`) and the body of the batch
-    :func:`preisach_run`, so the two agree bit for bit.
-
-    FORWARD maps a voltage to ``x_0 + H(v)``; MULTIPLICATIVE is eq. (10),
-    ``v[k] = v[k-1] + (x_ref[k] - x[k-1]) / rho``, i.e. ``(x_ref[k] - Gamma(v[k-1])) / rho``
-    with ``Gamma(v) = H(v) - rho v``; EXACT solves ``x_0 + H(v) = x_ref`` on the current
-    branch. Compensators slew-limit and clamp ``v``, then advance ``H``'s memory with it.
-    A non-finite ``u`` holds the last output and increments the non-finite counter.
-    """
+@_inline_kernel
+def _step(p, u):
+    """The body of :func:`preisach_step`, inlined into it and into :func:`preisach_run`."""
     s = state_start(p)
     if u - u != 0.0:  # NaN or +-inf
         p[s + ST_NONFINITE] += 1.0
@@ -398,11 +395,27 @@ def preisach_step(p, u):
     return out
 
 
+@step_kernel
+def preisach_step(p, u):
+    """One sample through packed system ``p``; updates its state and returns the output.
+
+    The streaming step (a :func:`~hystcomp.operators.step_kernel`) and the body of the batch
+    :func:`preisach_run`, so the two agree bit for bit.
+
+    FORWARD maps a voltage to ``x_0 + H(v)``; MULTIPLICATIVE is eq. (10),
+    ``v[k] = v[k-1] + (x_ref[k] - x[k-1]) / rho``, i.e. ``(x_ref[k] - Gamma(v[k-1])) / rho``
+    with ``Gamma(v) = H(v) - rho v``; EXACT solves ``x_0 + H(v) = x_ref`` on the current
+    branch. Compensators slew-limit and clamp ``v``, then advance ``H``'s memory with it.
+    A non-finite ``u`` holds the last output and increments the non-finite counter.
+    """
+    return _step(p, u)
+
+
 @_kernel
 def preisach_run(p, u, out):
     """Run every sample of ``u`` through packed system ``p`` into ``out`` (state kept in ``p``)."""
     for k in range(u.size):
-        out[k] = preisach_step(p, u[k])
+        out[k] = _step(p, u[k])
 
 
 #: The :class:`~hystcomp.operators.StepKernels` of a packed Preisach system.
