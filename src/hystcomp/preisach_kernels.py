@@ -38,6 +38,8 @@ from __future__ import annotations
 
 import numba
 import numpy as np
+from llvmlite import ir
+from numba.extending import intrinsic
 
 from hystcomp.operators import FASTMATH, StepKernels, step_kernel
 
@@ -63,8 +65,29 @@ def _kernel(func):
 def _inline_kernel(func):
     # Inlined into its callers at numba-IR level, as the chain's stages are: a call per
     # evaluation of X (several per sample) cost more than the evaluation, and LLVM does not
-    # inline across numba's separately compiled functions.
+    # inline across numba's separately compiled functions. Only small functions: each
+    # inlined copy is compiled again, and the first run's compile time grows with them
+    # (preisach_apply stays a call: inlined, it made preisach_run take minutes to compile).
     return numba.njit(cache=True, fastmath=FASTMATH, nogil=True, inline="always")(func)
+
+
+@intrinsic
+def _fma(typingctx, x, y, z):
+    """``x * y + z`` rounded once (LLVM's ``llvm.fma``), as C99's ``fma()``.
+
+    Written out rather than left to the compiler's contraction, so that the order and the
+    rounding of X's multiply-adds are fixed whatever the fast-math flags let LLVM
+    reassociate, and the generated C (which calls ``fma()``) rounds alike.
+    """
+    sig = numba.types.float64(numba.types.float64, numba.types.float64, numba.types.float64)
+
+    def codegen(context, builder, signature, args):
+        double = ir.DoubleType()
+        fnty = ir.FunctionType(double, [double, double, double])
+        fma = builder.module.declare_intrinsic("llvm.fma", [double], fnty)
+        return builder.call(fma, args)
+
+    return sig, codegen
 
 
 def monomial_exponents(degree: int) -> list[tuple[int, int]]:
@@ -167,14 +190,20 @@ def everett(p, alpha, beta):
     b = beta - p[V_MIN]
     n = int(p[N_COEF])
     if p[KIND] == POLYNOMIAL:
-        # sum_i b^i (sum_j C[i, j] a^j), Horner in both variables
+        # sum_i b^i (sum_j C[i, j] a^j), Horner in both variables, with fused multiply-adds
+        if n == 4:  # the cubic of eq. (5): the loop below unrolled (its first terms are C[i, 0])
+            c = HEADER
+            acc = _fma(p[c + 12], b, _fma(p[c + 9], a, p[c + 8]))
+            acc = _fma(acc, b, _fma(_fma(p[c + 6], a, p[c + 5]), a, p[c + 4]))
+            inner = _fma(_fma(_fma(p[c + 3], a, p[c + 2]), a, p[c + 1]), a, p[c])
+            return _fma(acc, b, inner)
         acc = 0.0
         for i in range(n - 1, -1, -1):
             row = HEADER + i * n
             inner = 0.0
             for j in range(n - 1 - i, -1, -1):
-                inner = inner * a + p[row + j]
-            acc = acc * b + inner
+                inner = _fma(inner, a, p[row + j])
+            acc = _fma(acc, b, inner)
         return acc
     u = a / p[GRID_STEP]
     w = b / p[GRID_STEP]
@@ -200,16 +229,18 @@ def _push(p, e, q, top, value):
     """Push a turning point (a maximum on an even top, a minimum on an odd one)."""
     if top + 1 >= int(p[DEPTH]):
         top -= 2  # full: wipe out the innermost stored pair first
+    # X(value, e[top]) added on an even top, X(e[top], value) subtracted on an odd one: one
+    # call site of X (each is an inlined copy), the sign exact
     if top % 2 == 0:
-        c = everett(p, value, p[e + top])
+        alpha, beta, sign = value, p[e + top], 1.0
     else:
-        c = -everett(p, p[e + top], value)
+        alpha, beta, sign = p[e + top], value, -1.0
     p[e + top + 1] = value
-    p[q + top + 1] = p[q + top] + c
+    p[q + top + 1] = p[q + top] + sign * everett(p, alpha, beta)
     return top + 1
 
 
-@_inline_kernel
+@_kernel
 def preisach_apply(p, v):
     """Apply input ``v`` (clamped to the plane) and return ``H(v)`` without offset, eqs. (3)-(4)."""
     s = state_start(p)
@@ -218,19 +249,17 @@ def preisach_apply(p, v):
     v = min(max(v, p[V_MIN]), p[V_MAX])
     top = int(p[s + ST_TOP])
     previous = p[s + ST_INPUT]
-    if top % 2 == 0:
-        if v < previous:
-            top = _push(p, e, q, top, previous)
-    elif v > previous:
-        top = _push(p, e, q, top, previous)
+    if (v < previous) if top % 2 == 0 else (v > previous):
+        top = _push(p, e, q, top, previous)  # a reversal
     if top % 2 == 0:
         while top >= 2 and v >= p[e + top - 1]:
             top -= 2  # wipe-out: the input passed the maximum alpha_N
-        h = p[q + top] + everett(p, v, p[e + top])
+        alpha, beta, sign = v, p[e + top], 1.0  # H = P[top] + X(v, e[top])
     else:
         while top >= 3 and v <= p[e + top - 1]:
             top -= 2  # wipe-out: the input passed the minimum beta_N
-        h = p[q + top] - everett(p, p[e + top], v)
+        alpha, beta, sign = p[e + top], v, -1.0  # H = P[top] - X(e[top], v)
+    h = p[q + top] + sign * everett(p, alpha, beta)
     p[s + ST_TOP] = top
     p[s + ST_INPUT] = v
     p[s + ST_H] = h
@@ -240,20 +269,20 @@ def preisach_apply(p, v):
 @_inline_kernel
 def _branch(p, base, pivot, rising, v):
     """A monotone branch: ``base + X(v, pivot)`` rising, ``base - X(pivot, v)`` falling."""
-    if rising:
-        return base + everett(p, v, pivot)
-    return base - everett(p, pivot, v)
+    alpha, beta, sign = (v, pivot, 1.0) if rising else (pivot, v, -1.0)
+    return base + sign * everett(p, alpha, beta)  # one inlined copy of X; the sign is exact
 
 
 @_kernel
-def _root(p, base, pivot, rising, lo, hi, target):
+def _root(p, base, pivot, rising, lo, hi, target, b_lo, b_hi):
     """``v`` in ``[lo, hi]`` with branch(v) = target, given branch(lo) < target <= branch(hi).
 
     Illinois (modified regula falsi) with a bisection every fourth step: the bracket
-    always shrinks, and smooth branches converge superlinearly.
+    always shrinks, and smooth branches converge superlinearly. ``b_lo`` and ``b_hi`` are
+    the branch at ``lo`` and ``hi``, which the caller has evaluated already.
     """
-    g_lo = _branch(p, base, pivot, rising, lo) - target
-    g_hi = _branch(p, base, pivot, rising, hi) - target
+    g_lo = b_lo - target
+    g_hi = b_hi - target
     if g_lo >= 0.0:
         return lo
     if g_hi <= 0.0:
@@ -304,10 +333,12 @@ def _solve_up(p, e, q, top, previous, target):
     lo = previous
     first = True
     while True:
-        if target <= _branch(p, base, pivot, True, hi):
-            if first and _branch(p, base, pivot, True, lo) >= target:
+        b_hi = _branch(p, base, pivot, True, hi)
+        if target <= b_hi:
+            b_lo = _branch(p, base, pivot, True, lo)
+            if first and b_lo >= target:
                 return previous  # in the gap a non-zero X(v, v) opens at a reversal: hold
-            return _root(p, base, pivot, True, lo, hi, target)
+            return _root(p, base, pivot, True, lo, hi, target, b_lo, b_hi)
         if k < 0:
             return p[V_MAX]
         first = False
@@ -335,10 +366,12 @@ def _solve_down(p, e, q, top, previous, target):
     hi = previous
     first = True
     while True:
-        if target >= _branch(p, base, pivot, False, lo):
-            if first and _branch(p, base, pivot, False, hi) <= target:
+        b_lo = _branch(p, base, pivot, False, lo)
+        if target >= b_lo:
+            b_hi = _branch(p, base, pivot, False, hi)
+            if first and b_hi <= target:
                 return previous  # in the gap a non-zero X(v, v) opens at a reversal: hold
-            return _root(p, base, pivot, False, lo, hi, target)
+            return _root(p, base, pivot, False, lo, hi, target, b_lo, b_hi)
         if k < 1:
             return p[V_MIN]
         first = False

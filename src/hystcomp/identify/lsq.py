@@ -47,11 +47,11 @@ def _regressor_rows(u, r, y, z, rs, begin, rows):
     for i in range(rows.shape[0]):
         k = begin + i
         operators.play_update(u[k], r, y)
-        row = rows[i]
-        row[:n] = y
-        operators.deadzone_values(z[k], rs, row[n : n + m])  # negated after the sums
-        row[n + m] = 1.0
-        row[n + m + 1] = z[k]
+        for j in range(n):  # a loop, not row[:n] = y: slice assignment compiles slowly
+            rows[i, j] = y[j]
+        operators.deadzone_values(z[k], rs, rows[i, n : n + m])  # negated after the sums
+        rows[i, n + m] = 1.0
+        rows[i, n + m + 1] = z[k]
 
 
 def normal_equations(u, thresholds, initial_state, z, deadzone_thresholds, start) -> np.ndarray:
