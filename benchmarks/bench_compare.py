@@ -1,53 +1,75 @@
 """Speed of the main job: ``hystcomp compare``, the paper's whole experiment on the twin.
 
-Target: under 20 s with the kernels already compiled (warm: the on-disk cache filled by a
-first run) on 2 cores. The first run of this benchmark fills the cache if it is empty, so
-the first row is the cold figure only on a fresh checkout. Each run is a fresh process,
-as a user would start it; the output folder is a temporary one.
+Two runs, each a fresh process as a user would start it, writing into a temporary folder:
+
+* cold: an empty numba kernel cache, in a new temporary folder (``NUMBA_CACHE_DIR``), so
+  every kernel the command needs is compiled (a first run after installing);
+* warm: the same command again, the kernels loaded from the cache the first run filled.
+
+Targets: under 8 s cold and 3 s warm. The machine's load counts in these wall-clock
+figures, so the process's own CPU time is given beside each.
 
 Run alone with ``python benchmarks/bench_compare.py``.
 """
 
 from __future__ import annotations
 
+import os
+import resource
 import subprocess
 import sys
 import tempfile
 import time
+from pathlib import Path
 
-TARGET_S = 20.0
+TARGET_WARM_S = 3.0
+TARGET_COLD_S = 8.0
 
 
-def _run_compare() -> float:
+def _run_compare(cache: Path) -> tuple[float, float]:
+    """Wall-clock and CPU seconds of one ``hystcomp compare`` with kernel cache ``cache``."""
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(cache))
     with tempfile.TemporaryDirectory() as folder:
+        before = resource.getrusage(resource.RUSAGE_CHILDREN)
         start = time.perf_counter()
         subprocess.run(
             [sys.executable, "-m", "hystcomp", "compare", "--out", folder],
             check=True,
             capture_output=True,
+            env=env,
         )
-        return time.perf_counter() - start
+        wall = time.perf_counter() - start
+        after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    return wall, cpu
+
+
+def _row(name, value, unit, target=None):
+    ok = None if target is None else value < target
+    return {
+        "name": name,
+        "value": value,
+        "unit": unit,
+        "target": None if target is None else f"< {target:g}",
+        "ok": ok,
+    }
 
 
 def run() -> list[dict]:
     """Measure and return one row per figure: name, value, unit, target, ok."""
-    first = _run_compare()
-    warm = _run_compare()
+    with tempfile.TemporaryDirectory() as cache:
+        cold, cold_cpu = _run_compare(Path(cache))
+        warm, warm_cpu = _run_compare(Path(cache))
     return [
-        {
-            "name": "hystcomp compare, first run (cold if the kernel cache was empty)",
-            "value": first,
-            "unit": "s",
-            "target": None,
-            "ok": None,
-        },
-        {
-            "name": "hystcomp compare, warm kernel cache",
-            "value": warm,
-            "unit": "s",
-            "target": f"< {TARGET_S:g}",
-            "ok": warm < TARGET_S,
-        },
+        _row(
+            "hystcomp compare, empty kernel cache (fresh temporary folder)",
+            cold,
+            "s",
+            TARGET_COLD_S,
+        ),
+        _row("  its CPU time (user + system)", cold_cpu, "s"),
+        _row("hystcomp compare, warm kernel cache", warm, "s", TARGET_WARM_S),
+        _row("  its CPU time (user + system)", warm_cpu, "s"),
     ]
 
 

@@ -7,7 +7,9 @@
   of evaluating eqs. (3)-(4) by summing over the memory at every sample (a compiled loop) on
   the same signal.
 * The compensators per sample: the inverse multiplicative structure (eq. 10) and the exact
-  inverse, on a triangle reference.
+  inverse, on a triangle reference, against the same compensator exported as C
+  (``hystcomp.codegen``), built with ``cc -O3 -march=native`` (numba compiles for the host
+  CPU too) and run over the same reference by a C loop: target at most 1.5x the C time.
 * Streaming: the cost of one ``Stepper.step`` call in a Python loop, written as in
   ``bench_realtime.py`` (``for xk in samples: stepper.step(xk)``), for the forward model and
   both compensators; target < 300 ns, as for the PI/MPI stepper. The call includes the
@@ -21,18 +23,27 @@ Rows: ``name``, ``value``, ``unit``, ``target`` (``"<= x"`` or None), ``ok`` (bo
 
 from __future__ import annotations
 
+import ctypes
+import shutil
+import subprocess
+import tempfile
 import time
+from pathlib import Path
 
 import numba
 import numpy as np
 
 from hystcomp import preisach_kernels as pk
 from hystcomp import presets
+from hystcomp.codegen import export_c
 
 N_SAMPLES = 1_000_000
 REPEAT = 7
 STEP_SAMPLES = 100_000  # 2.5 periods of the triangle
 SAMPLE_PERIOD_NS = 50_000.0  # 20 kHz
+CC = shutil.which("cc")
+C_FLAGS = ["-O3", "-march=native"]
+C_TARGET = 1.5  # numba kernel time / exported C time
 
 
 def run() -> list[dict]:
@@ -55,10 +66,71 @@ def run() -> list[dict]:
     x_ref = 1.0 + model.simulate(triangle) * 0.9
     for method in ("multiplicative", "exact"):
         comp = model.inverse(method=method)
-        t = _per_sample(comp.packed, x_ref)
-        rows.append(_row(f"compensator '{method}', batch", t, "ns/sample", SAMPLE_PERIOD_NS / 50))
+        rows += _compensator_rows(comp, method, x_ref)
     rows += _stepper_rows(model, triangle, x_ref)
     return rows
+
+
+DRIVER = """#include "bench_preisach.h"
+void bench_run(const double *x_ref, double *v, long n)
+{
+    static bench_preisach_state s; /* about 16 kB: not on the stack */
+    long k;
+    bench_preisach_init(&s);
+    for (k = 0; k < n; k++) {
+        v[k] = bench_preisach_step(&s, x_ref[k]);
+    }
+}
+"""
+
+
+def _compensator_rows(comp, method: str, x_ref: np.ndarray) -> list[dict]:
+    """Batch cost per sample of the numba kernel and, if there is a C compiler, of the
+    exported C over the same reference, timed in interleaved rounds."""
+    out = np.empty_like(x_ref)
+    funcs = {"numba": lambda: pk.preisach_run(comp.packed.copy(), x_ref, out)}
+    with tempfile.TemporaryDirectory() as tmp:
+        if CC is not None:
+            run_c = _exported_c(comp, Path(tmp))
+            out_c = np.empty_like(x_ref)
+            funcs["c"] = lambda: run_c(x_ref.ctypes.data, out_c.ctypes.data, x_ref.size)
+        t = {name: value / x_ref.size * 1e9 for name, value in _best_of(funcs).items()}
+    rows = [_row(f"compensator '{method}', batch", t["numba"], "ns/sample", SAMPLE_PERIOD_NS / 50)]
+    if CC is None:
+        return [*rows, _row("exported C reference: skipped, no C compiler 'cc'", np.nan, "")]
+    ratio = t["numba"] / t["c"]
+    dv = float(np.abs(out - out_c).max())
+    return [
+        _row(f"compensator '{method}', exported C, cc -O3 -march=native", t["c"], "ns/sample"),
+        *rows,
+        _row(f"compensator '{method}', numba time / exported C time", ratio, "x", C_TARGET),
+        _row(f"compensator '{method}', max |v| difference numba vs C", dv, "V", 1e-9),
+    ]
+
+
+def _exported_c(comp, tmp: Path):
+    _, source = export_c(comp, tmp, prefix="bench_preisach")
+    driver = tmp / "driver.c"
+    driver.write_text(DRIVER)
+    lib = tmp / "bench_preisach.so"
+    cmd = [CC, "-std=c99", *C_FLAGS, "-shared", "-fPIC", "-o", str(lib), str(source), str(driver)]
+    subprocess.run([*cmd, "-lm"], check=True, capture_output=True, text=True)
+    run = ctypes.CDLL(str(lib)).bench_run
+    run.argtypes = [ctypes.c_void_p, ctypes.c_void_p, ctypes.c_long]
+    return run
+
+
+def _best_of(funcs: dict, repeat: int = REPEAT) -> dict:
+    """Shortest time in s of each callable, the rounds interleaved so that load hits all."""
+    for func in funcs.values():
+        func()  # compile, or load from the cache
+    best = dict.fromkeys(funcs, np.inf)
+    for _ in range(repeat):
+        for name, func in funcs.items():
+            start = time.perf_counter()
+            func()
+            best[name] = min(best[name], time.perf_counter() - start)
+    return best
 
 
 def _stepper_rows(model, v: np.ndarray, x_ref: np.ndarray) -> list[dict]:

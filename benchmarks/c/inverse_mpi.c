@@ -1,8 +1,10 @@
 /*
  * Plain C99 reference of the inverse MPI compensator (paper eq. 23), written as an embedded
  * engineer would: fixed operator counts, parameters in a struct, one scalar loop per stage,
- * the same hold / slew-limit / clamp semantics as hystcomp's chain. No intrinsics, no
- * fast-math. benchmarks/bench_realtime.py compiles it with `cc -O3` and times ref_run.
+ * the same hold / slew-limit / clamp semantics as hystcomp's chain. No intrinsics.
+ * benchmarks/bench_realtime.py compiles it with the licences numba has (-O3 -march=native and
+ * the fast-math subset of the package's kernels) as the reference, and with plain `cc -O3`
+ * for information, and times ref_run.
  *
  *   x_ref -> (x_ref - x0) -> inverse dead-zones (eq. 14 with eqs. 24-25)
  *         -> inverse plays (eq. 12 with eqs. 24-26) -> (+ v0) -> slew limit -> clamp

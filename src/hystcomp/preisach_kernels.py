@@ -38,6 +38,8 @@ from __future__ import annotations
 
 import numba
 import numpy as np
+from llvmlite import ir
+from numba.extending import intrinsic
 
 from hystcomp.operators import CLAMP_TOLERANCE, FASTMATH, StepKernels, step_kernel
 
@@ -59,6 +61,34 @@ DEFAULT_DEPTH = 1024
 
 def _kernel(func):
     return numba.njit(cache=True, fastmath=FASTMATH, nogil=True)(func)
+
+
+def _inline_kernel(func):
+    # Inlined into its callers at numba-IR level, as the chain's stages are: a call per
+    # evaluation of X (several per sample) cost more than the evaluation, and LLVM does not
+    # inline across numba's separately compiled functions. Only small functions: each
+    # inlined copy is compiled again, and the first run's compile time grows with them
+    # (preisach_apply stays a call: inlined, it made preisach_run take minutes to compile).
+    return numba.njit(cache=True, fastmath=FASTMATH, nogil=True, inline="always")(func)
+
+
+@intrinsic
+def _fma(typingctx, x, y, z):
+    """``x * y + z`` rounded once (LLVM's ``llvm.fma``), as C99's ``fma()``.
+
+    Written out rather than left to the compiler's contraction, so that the order and the
+    rounding of X's multiply-adds are fixed whatever the fast-math flags let LLVM
+    reassociate, and the generated C (which calls ``fma()``) rounds alike.
+    """
+    sig = numba.types.float64(numba.types.float64, numba.types.float64, numba.types.float64)
+
+    def codegen(context, builder, signature, args):
+        double = ir.DoubleType()
+        fnty = ir.FunctionType(double, [double, double, double])
+        fma = builder.module.declare_intrinsic("llvm.fma", [double], fnty)
+        return builder.call(fma, args)
+
+    return sig, codegen
 
 
 def monomial_exponents(degree: int) -> list[tuple[int, int]]:
@@ -149,28 +179,34 @@ def pack_preisach(
     return np.concatenate([*parts, np.zeros(depth)])
 
 
-@_kernel
+@_inline_kernel
 def state_start(p):
     """Index of the first state slot of packed system ``p``."""
     n = int(p[N_COEF])
     return HEADER + n * n
 
 
-@_kernel
+@_inline_kernel
 def everett(p, alpha, beta):
     """``X(alpha, beta)`` of eq. (2) in µm, for voltages inside the plane."""
     a = alpha - p[V_MIN]
     b = beta - p[V_MIN]
     n = int(p[N_COEF])
     if p[KIND] == POLYNOMIAL:
-        # sum_i b^i (sum_j C[i, j] a^j), Horner in both variables
+        # sum_i b^i (sum_j C[i, j] a^j), Horner in both variables, with fused multiply-adds
+        if n == 4:  # the cubic of eq. (5): the loop below unrolled (its first terms are C[i, 0])
+            c = HEADER
+            acc = _fma(p[c + 12], b, _fma(p[c + 9], a, p[c + 8]))
+            acc = _fma(acc, b, _fma(_fma(p[c + 6], a, p[c + 5]), a, p[c + 4]))
+            inner = _fma(_fma(_fma(p[c + 3], a, p[c + 2]), a, p[c + 1]), a, p[c])
+            return _fma(acc, b, inner)
         acc = 0.0
         for i in range(n - 1, -1, -1):
             row = HEADER + i * n
             inner = 0.0
             for j in range(n - 1 - i, -1, -1):
-                inner = inner * a + p[row + j]
-            acc = acc * b + inner
+                inner = _fma(inner, a, p[row + j])
+            acc = _fma(acc, b, inner)
         return acc
     u = a / p[GRID_STEP]
     w = b / p[GRID_STEP]
@@ -191,17 +227,19 @@ def everett_many(p, alpha, beta, out):
         out[k] = everett(p, alpha[k], beta[k])
 
 
-@_kernel
+@_inline_kernel
 def _push(p, e, q, top, value):
     """Push a turning point (a maximum on an even top, a minimum on an odd one)."""
     if top + 1 >= int(p[DEPTH]):
         top -= 2  # full: wipe out the innermost stored pair first
+    # X(value, e[top]) added on an even top, X(e[top], value) subtracted on an odd one: one
+    # call site of X (each is an inlined copy), the sign exact
     if top % 2 == 0:
-        c = everett(p, value, p[e + top])
+        alpha, beta, sign = value, p[e + top], 1.0
     else:
-        c = -everett(p, p[e + top], value)
+        alpha, beta, sign = p[e + top], value, -1.0
     p[e + top + 1] = value
-    p[q + top + 1] = p[q + top] + c
+    p[q + top + 1] = p[q + top] + sign * everett(p, alpha, beta)
     return top + 1
 
 
@@ -214,42 +252,40 @@ def preisach_apply(p, v):
     v = min(max(v, p[V_MIN]), p[V_MAX])
     top = int(p[s + ST_TOP])
     previous = p[s + ST_INPUT]
-    if top % 2 == 0:
-        if v < previous:
-            top = _push(p, e, q, top, previous)
-    elif v > previous:
-        top = _push(p, e, q, top, previous)
+    if (v < previous) if top % 2 == 0 else (v > previous):
+        top = _push(p, e, q, top, previous)  # a reversal
     if top % 2 == 0:
         while top >= 2 and v >= p[e + top - 1]:
             top -= 2  # wipe-out: the input passed the maximum alpha_N
-        h = p[q + top] + everett(p, v, p[e + top])
+        alpha, beta, sign = v, p[e + top], 1.0  # H = P[top] + X(v, e[top])
     else:
         while top >= 3 and v <= p[e + top - 1]:
             top -= 2  # wipe-out: the input passed the minimum beta_N
-        h = p[q + top] - everett(p, p[e + top], v)
+        alpha, beta, sign = p[e + top], v, -1.0  # H = P[top] - X(e[top], v)
+    h = p[q + top] + sign * everett(p, alpha, beta)
     p[s + ST_TOP] = top
     p[s + ST_INPUT] = v
     p[s + ST_H] = h
     return h
 
 
-@_kernel
+@_inline_kernel
 def _branch(p, base, pivot, rising, v):
     """A monotone branch: ``base + X(v, pivot)`` rising, ``base - X(pivot, v)`` falling."""
-    if rising:
-        return base + everett(p, v, pivot)
-    return base - everett(p, pivot, v)
+    alpha, beta, sign = (v, pivot, 1.0) if rising else (pivot, v, -1.0)
+    return base + sign * everett(p, alpha, beta)  # one inlined copy of X; the sign is exact
 
 
 @_kernel
-def _root(p, base, pivot, rising, lo, hi, target):
+def _root(p, base, pivot, rising, lo, hi, target, b_lo, b_hi):
     """``v`` in ``[lo, hi]`` with branch(v) = target, given branch(lo) < target <= branch(hi).
 
     Illinois (modified regula falsi) with a bisection every fourth step: the bracket
-    always shrinks, and smooth branches converge superlinearly.
+    always shrinks, and smooth branches converge superlinearly. ``b_lo`` and ``b_hi`` are
+    the branch at ``lo`` and ``hi``, which the caller has evaluated already.
     """
-    g_lo = _branch(p, base, pivot, rising, lo) - target
-    g_hi = _branch(p, base, pivot, rising, hi) - target
+    g_lo = b_lo - target
+    g_hi = b_hi - target
     if g_lo >= 0.0:
         return lo
     if g_hi <= 0.0:
@@ -300,10 +336,12 @@ def _solve_up(p, e, q, top, previous, target):
     lo = previous
     first = True
     while True:
-        if target <= _branch(p, base, pivot, True, hi):
-            if first and _branch(p, base, pivot, True, lo) >= target:
+        b_hi = _branch(p, base, pivot, True, hi)
+        if target <= b_hi:
+            b_lo = _branch(p, base, pivot, True, lo)
+            if first and b_lo >= target:
                 return previous  # in the gap a non-zero X(v, v) opens at a reversal: hold
-            return _root(p, base, pivot, True, lo, hi, target)
+            return _root(p, base, pivot, True, lo, hi, target, b_lo, b_hi)
         if k < 0:
             return p[V_MAX]
         first = False
@@ -331,10 +369,12 @@ def _solve_down(p, e, q, top, previous, target):
     hi = previous
     first = True
     while True:
-        if target >= _branch(p, base, pivot, False, lo):
-            if first and _branch(p, base, pivot, False, hi) <= target:
+        b_lo = _branch(p, base, pivot, False, lo)
+        if target >= b_lo:
+            b_hi = _branch(p, base, pivot, False, hi)
+            if first and b_hi <= target:
                 return previous  # in the gap a non-zero X(v, v) opens at a reversal: hold
-            return _root(p, base, pivot, False, lo, hi, target)
+            return _root(p, base, pivot, False, lo, hi, target, b_lo, b_hi)
         if k < 1:
             return p[V_MIN]
         first = False
@@ -377,22 +417,9 @@ def _count_clamped(p, s, u, v, h):
         p[s + ST_CLAMPED] += 1.0
 
 
-@step_kernel
-def preisach_step(p, u):
-    """One sample through packed system ``p``; updates its state and returns the output.
-
-    The streaming step (a :func:`~hystcomp.operators.step_kernel`) and the body of the batch
-    :func:`preisach_run`, so the two agree bit for bit.
-
-    FORWARD maps a voltage to ``x_0 + H(v)``; MULTIPLICATIVE is eq. (10),
-    ``v[k] = v[k-1] + (x_ref[k] - x[k-1]) / rho``, i.e. ``(x_ref[k] - Gamma(v[k-1])) / rho``
-    with ``Gamma(v) = H(v) - rho v``; EXACT solves ``x_0 + H(v) = x_ref`` on the current
-    branch. Compensators slew-limit and clamp ``v``, then advance ``H``'s memory with it.
-    A non-finite ``u`` holds the last output and increments the non-finite counter. A
-    compensator's sample counts as clamped (out of reach) when ``v`` sits at an end of the
-    range and ``x_0 + H(v)`` still falls short of ``x_ref`` there by more than
-    :data:`~hystcomp.operators.CLAMP_TOLERANCE` of it.
-    """
+@_inline_kernel
+def _step(p, u):
+    """The body of :func:`preisach_step`, inlined into it and into :func:`preisach_run`."""
     s = state_start(p)
     if u - u != 0.0:  # NaN or +-inf
         p[s + ST_NONFINITE] += 1.0
@@ -417,11 +444,30 @@ def preisach_step(p, u):
     return out
 
 
+@step_kernel
+def preisach_step(p, u):
+    """One sample through packed system ``p``; updates its state and returns the output.
+
+    The streaming step (a :func:`~hystcomp.operators.step_kernel`) and the body of the batch
+    :func:`preisach_run`, so the two agree bit for bit.
+
+    FORWARD maps a voltage to ``x_0 + H(v)``; MULTIPLICATIVE is eq. (10),
+    ``v[k] = v[k-1] + (x_ref[k] - x[k-1]) / rho``, i.e. ``(x_ref[k] - Gamma(v[k-1])) / rho``
+    with ``Gamma(v) = H(v) - rho v``; EXACT solves ``x_0 + H(v) = x_ref`` on the current
+    branch. Compensators slew-limit and clamp ``v``, then advance ``H``'s memory with it.
+    A non-finite ``u`` holds the last output and increments the non-finite counter. A
+    compensator's sample counts as clamped (out of reach) when ``v`` sits at an end of the
+    range and ``x_0 + H(v)`` still falls short of ``x_ref`` there by more than
+    :data:`~hystcomp.operators.CLAMP_TOLERANCE` of it.
+    """
+    return _step(p, u)
+
+
 @_kernel
 def preisach_run(p, u, out):
     """Run every sample of ``u`` through packed system ``p`` into ``out`` (state kept in ``p``)."""
     for k in range(u.size):
-        out[k] = preisach_step(p, u[k])
+        out[k] = _step(p, u[k])
 
 
 #: The :class:`~hystcomp.operators.StepKernels` of a packed Preisach system.

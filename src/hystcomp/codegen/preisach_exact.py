@@ -45,12 +45,13 @@ static double {p}_branch(double base, double pivot, int rising, double v)
 
 _ROOT = """\
 /* v in [lo, hi] with branch(v) = target, given branch(lo) < target <= branch(hi): Illinois
-   (modified regula falsi) with a bisection every fourth step. */
+   (modified regula falsi) with a bisection every fourth step. b_lo and b_hi are the branch
+   at lo and hi, evaluated by the caller. */
 static double {p}_root(double base, double pivot, int rising, double lo, double hi,
-                       double target)
+                       double target, double b_lo, double b_hi)
 {
-    double g_lo = {p}_branch(base, pivot, rising, lo) - target;
-    double g_hi = {p}_branch(base, pivot, rising, hi) - target;
+    double g_lo = b_lo - target;
+    double g_hi = b_hi - target;
     double f_lo, f_hi, tol_x, m, g, scale;
     int side = 0;
     int it;
@@ -108,7 +109,7 @@ _SOLVE_UP = """\
 /* Smallest rise of the input whose branch output reaches target (> h). */
 static double {p}_solve_up(const {p}_state *s, long top, double previous, double target)
 {
-    double base, pivot, lo, hi;
+    double base, pivot, lo, hi, b_lo, b_hi;
     long k;
     int first = 1;
     if (top % 2 == 1) { /* a reversal: the branch starts at a new minimum beta = previous */
@@ -124,11 +125,13 @@ static double {p}_solve_up(const {p}_state *s, long top, double previous, double
     }
     lo = previous;
     for (;;) {
-        if (target <= {p}_branch(base, pivot, 1, hi)) {
-            if (first && {p}_branch(base, pivot, 1, lo) >= target) {
+        b_hi = {p}_branch(base, pivot, 1, hi);
+        if (target <= b_hi) {
+            b_lo = {p}_branch(base, pivot, 1, lo);
+            if (first && b_lo >= target) {
                 return previous; /* in the step a non-zero X(v, v) opens at a reversal */
             }
-            return {p}_root(base, pivot, 1, lo, hi, target);
+            return {p}_root(base, pivot, 1, lo, hi, target, b_lo, b_hi);
         }
         if (k < 0) {
             return V_MAX;
@@ -146,7 +149,7 @@ _SOLVE_DOWN = """\
 /* Smallest fall of the input whose branch output reaches target (< h). */
 static double {p}_solve_down(const {p}_state *s, long top, double previous, double target)
 {
-    double base, pivot, lo, hi;
+    double base, pivot, lo, hi, b_lo, b_hi;
     long k;
     int first = 1;
     if (top % 2 == 0) { /* a reversal: the branch starts at a new maximum alpha = previous */
@@ -162,11 +165,13 @@ static double {p}_solve_down(const {p}_state *s, long top, double previous, doub
     }
     hi = previous;
     for (;;) {
-        if (target >= {p}_branch(base, pivot, 0, lo)) {
-            if (first && {p}_branch(base, pivot, 0, hi) <= target) {
+        b_lo = {p}_branch(base, pivot, 0, lo);
+        if (target >= b_lo) {
+            b_hi = {p}_branch(base, pivot, 0, hi);
+            if (first && b_hi <= target) {
                 return previous; /* in the step a non-zero X(v, v) opens at a reversal */
             }
-            return {p}_root(base, pivot, 0, lo, hi, target);
+            return {p}_root(base, pivot, 0, lo, hi, target, b_lo, b_hi);
         }
         if (k < 1) {
             return V_MIN;

@@ -10,6 +10,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from hystcomp.errors import InvalidParameterError
+from hystcomp.experiment.figures import _thin, fixed_layout
 from hystcomp.io import atomic_path
 
 FORMATS = (".png", ".pdf", ".svg")
@@ -42,8 +43,9 @@ def plot_identification(v, x, before, after, path, *, model_name: str = "model")
             f"Cannot save a figure as {str(path)!r}: use a name ending in {', '.join(FORMATS)}."
         )
     v, x = np.asarray(v, dtype=np.float64), np.asarray(x, dtype=np.float64)
-    fig = Figure(figsize=(10.0, 4.2), layout="constrained")
+    fig = Figure(figsize=(10.0, 4.2))
     FigureCanvasAgg(fig)
+    fixed_layout(fig, left=0.75, right=0.15, top=0.4, bottom=0.6, wgap=0.3, cols=2)
     axes = fig.subplots(1, 2, sharey=True)
     panels = [
         ("(a) before identification (straight line)", before),
@@ -52,8 +54,10 @@ def plot_identification(v, x, before, after, path, *, model_name: str = "model")
     for ax, (title, model_x) in zip(axes, panels, strict=True):
         model_x = np.asarray(model_x, dtype=np.float64)
         rms = float(np.sqrt(np.mean((model_x - x) ** 2)))
-        ax.plot(v, x, color="0.55", lw=1.6, label="measured")
-        ax.plot(v, model_x, color="tab:red", lw=0.9, label=f"model (rms error {rms:.3g} µm)")
+        thin = _thin(v.size)  # the drawn lines only; the rms is over every sample
+        ax.plot(v[thin], x[thin], color="0.55", lw=1.6, label="measured")
+        label = f"model (rms error {rms:.3g} µm)"
+        ax.plot(v[thin], model_x[thin], color="tab:red", lw=0.9, label=label)
         ax.set_title(title)
         ax.set_xlabel("voltage v (V)")
         ax.grid(alpha=0.3)

@@ -9,6 +9,7 @@ from matplotlib.figure import Figure
 
 from hystcomp._validation import as_signal, check_real
 from hystcomp.errors import InvalidParameterError, InvalidSignalError
+from hystcomp.experiment.figures import fixed_layout
 from hystcomp.identify.excitation import scaled_amplitudes, sinusoid_sequence
 from hystcomp.io import atomic_path
 from hystcomp.paper import FIG5_AMPLITUDES
@@ -54,8 +55,9 @@ def plot_preisach_loops(
     x = model.simulate(v)
     per_period = round(sample_rate / frequency)
 
-    fig = Figure(figsize=(6.4, 4.8), layout="constrained")
+    fig = Figure(figsize=(6.4, 4.8))
     FigureCanvasAgg(fig)
+    fixed_layout(fig, left=0.75, right=0.15, top=0.4, bottom=0.6)
     ax = fig.add_subplot()
     if measured is not None:
         v_meas, x_meas = (
@@ -71,8 +73,9 @@ def plot_preisach_loops(
     for i, amplitude in enumerate(amplitudes):
         seg = slice(i * per_period, (i + 1) * per_period + 1)
         ax.plot(v[seg], x[seg], lw=1.2, label=f"model, {amplitude:g} V")
-    ax.set_xlabel("Voltage $v_{px}$ (V)")
-    ax.set_ylabel("Displacement $x_p$ (µm)")
+    # plain text, as in the other figures: mathtext would build its parser (0.4 s) for this
+    ax.set_xlabel("Voltage v_px (V)")
+    ax.set_ylabel("Displacement x_p (µm)")
     ax.set_title(f"Preisach model, {frequency:g} Hz sinusoids of growing amplitude")
     ax.grid(True, alpha=0.3)
     ax.legend(loc="upper left")

@@ -34,34 +34,24 @@ _BLOCK = 256  # rows per BLAS update of the Gram matrix (larger blocks gain noth
 
 
 @numba.njit(cache=True, nogil=True)
-def _accumulate_gram(u, r, y0, z, rs, start, gram):
-    """Add ``[Phi | z]^T [Phi | z]`` over samples ``start..`` to ``gram``, dead-zones positive.
+def _regressor_rows(u, r, y, z, rs, begin, rows):
+    """Regressor rows ``[plays | dead-zones (positive) | 1 | z]`` of samples ``begin..``.
 
-    The plays run over every sample from ``y0`` (their state must be right at ``start``);
-    only samples ``k >= start`` enter the sums.
+    Fills ``rows[i]`` for sample ``begin + i`` (as many as ``rows`` has), advancing the
+    play states ``y`` over those samples in place. No matrix product here: the Gram update
+    is NumPy's (BLAS) in :func:`normal_equations`, so that this kernel compiles without
+    numba's linear algebra (which took most of a first run's compile time).
     """
     n = r.size
     m = rs.size
-    p = n + m + 2
-    rows = np.empty((_BLOCK, p))
-    y = y0.copy()
-    fill = 0
-    for k in range(u.size):
+    for i in range(rows.shape[0]):
+        k = begin + i
         operators.play_update(u[k], r, y)
-        if k < start:
-            continue
-        row = rows[fill]
-        row[:n] = y
-        operators.deadzone_values(z[k], rs, row[n : n + m])  # negated after the sums
-        row[n + m] = 1.0
-        row[n + m + 1] = z[k]
-        fill += 1
-        if fill == _BLOCK:
-            gram += rows.T @ rows
-            fill = 0
-    if fill > 0:
-        part = rows[:fill]
-        gram += part.T @ part
+        for j in range(n):  # a loop, not row[:n] = y: slice assignment compiles slowly
+            rows[i, j] = y[j]
+        operators.deadzone_values(z[k], rs, rows[i, n : n + m])  # negated after the sums
+        rows[i, n + m] = 1.0
+        rows[i, n + m + 1] = z[k]
 
 
 def normal_equations(u, thresholds, initial_state, z, deadzone_thresholds, start) -> np.ndarray:
@@ -87,16 +77,19 @@ def normal_equations(u, thresholds, initial_state, z, deadzone_thresholds, start
         dead-zones, constant) and the target last.
     """
     n, m = len(thresholds), len(deadzone_thresholds)
+    u = np.ascontiguousarray(u, dtype=np.float64)
+    r = np.ascontiguousarray(thresholds, dtype=np.float64)
+    y = np.array(initial_state, dtype=np.float64)  # the play states, advanced block by block
+    z = np.ascontiguousarray(z, dtype=np.float64)
+    rs = np.ascontiguousarray(deadzone_thresholds, dtype=np.float64)
+    start = int(start)
     gram = np.zeros((n + m + 2, n + m + 2))
-    _accumulate_gram(
-        np.ascontiguousarray(u, dtype=np.float64),
-        np.ascontiguousarray(thresholds, dtype=np.float64),
-        np.array(initial_state, dtype=np.float64),
-        np.ascontiguousarray(z, dtype=np.float64),
-        np.ascontiguousarray(deadzone_thresholds, dtype=np.float64),
-        int(start),
-        gram,
-    )
+    rows = np.empty((max(_BLOCK, start), n + m + 2))
+    _regressor_rows(u, r, y, z, rs, 0, rows[:start])  # the plays' state at `start`
+    for begin in range(start, u.size, _BLOCK):
+        part = rows[: min(_BLOCK, u.size - begin)]
+        _regressor_rows(u, r, y, z, rs, begin, part)
+        gram += part.T @ part
     sign = np.r_[np.ones(n), -np.ones(m), 1.0, 1.0]  # the dead-zone regressors are negated
     return gram * np.outer(sign, sign)
 
