@@ -10,8 +10,9 @@ import math
 
 import click
 
+from hystcomp._progress import Progress
 from hystcomp._validation import MAX_MAGNITUDE
-from hystcomp.data import check_writable, parse_columns
+from hystcomp.data import X_UNITS, check_writable, parse_columns, x_unit_warning
 from hystcomp.errors import InvalidParameterError
 from hystcomp.io import check_output_path
 from hystcomp.models.preisach import INVERSE_METHODS
@@ -124,9 +125,42 @@ def output_option(required: bool = True, what: str = "output"):
     )
 
 
-def read_options(columns: dict | None, sample_rate: float | None) -> dict:
+x_unit_option = click.option(
+    "--x-unit",
+    type=click.Choice(X_UNITS),
+    default=None,
+    help="Unit of the displacement in the file, converted to µm [the file's units row, else um].",
+)
+quiet_option = click.option(
+    "--quiet",
+    "-q",
+    is_flag=True,
+    help="No progress line and no unit-guess warning. Warnings about safety (clamping, "
+    "leaving the model's range) are always shown. Progress is shown only on a terminal, "
+    "for steps over 2 s.",
+)
+
+
+def read_options(
+    columns: dict | None, sample_rate: float | None, x_unit=None, quiet: bool = False, path=""
+) -> dict:
     """Keyword arguments for :func:`hystcomp.data.read_table` from the shared options."""
-    return {"columns": columns, "sample_rate": sample_rate}
+    options = {"columns": columns, "sample_rate": sample_rate, "x_unit": x_unit}
+    if not quiet:
+        options["progress"] = Progress(f"reading {click.format_filename(str(path))}")
+    return options
+
+
+def progress(label: str, quiet: bool):
+    """A progress line for a step (see :mod:`hystcomp._progress`); silent with --quiet."""
+    return Progress(label, enabled=False if quiet else None)
+
+
+def warn_x_unit(x, source, quiet: bool) -> None:
+    """The one-line warning of :func:`hystcomp.data.x_unit_warning`, unless --quiet."""
+    message = x_unit_warning(x, str(source))
+    if message and not quiet:
+        click.echo(f"hystcomp: warning: {message}", err=True)
 
 
 def check_data_output(path, *, inputs=(), what: str = "output"):

@@ -14,8 +14,12 @@ from hystcomp.cli._options import (
     method_options,
     output_option,
     positive,
+    progress,
+    quiet_option,
     read_options,
     voltage_range,
+    warn_x_unit,
+    x_unit_option,
 )
 from hystcomp.data import read_table, write_table
 from hystcomp.io import load_model
@@ -50,6 +54,8 @@ def inverse_options(model, table, *, slew_rate, narrow_range) -> dict:
 @output_option(what="voltage: t, v, x_ref")
 @columns_option
 @fs_option
+@x_unit_option
+@quiet_option
 @click.option(
     "--slew-rate",
     type=float,
@@ -72,7 +78,16 @@ def inverse_options(model, table, *, slew_rate, narrow_range) -> dict:
 )
 @method_option
 def compensate(
-    model_file, reference_file, output, columns, sample_rate, slew_rate, narrow_range, method
+    model_file,
+    reference_file,
+    output,
+    columns,
+    sample_rate,
+    x_unit,
+    quiet,
+    slew_rate,
+    narrow_range,
+    method,
 ):
     """Voltage that makes the actuator of MODEL.json follow REFERENCE (columns t, x).
 
@@ -83,11 +98,14 @@ def compensate(
     check_data_output(output, inputs=(model_file, reference_file), what="voltage file")
     model = load_model(model_file)
     chosen = method_options(model, model_file, method)
-    table = read_table(reference_file, ("x",), **read_options(columns, sample_rate))
+    options = read_options(columns, sample_rate, x_unit, quiet, reference_file)
+    table = read_table(reference_file, ("x",), **options)
+    warn_x_unit(table["x"], reference_file, quiet)
     options = inverse_options(model, table, slew_rate=slew_rate, narrow_range=narrow_range)
     compensator = model.inverse(**options, **chosen)
     v = compensator.simulate(table["x"])
-    write_table(output, {"t": table["t"], "v": v, "x_ref": table["x"]})
+    written = progress(f"writing {output}", quiet)
+    write_table(output, {"t": table["t"], "v": v, "x_ref": table["x"]}, progress=written)
     lo, hi = compensator.voltage_range
     click.echo(
         f"wrote {output}: {v.size} samples, v from {v.min():.4g} to {v.max():.4g} V "
