@@ -34,6 +34,7 @@ from pathlib import Path
 
 import numpy as np
 
+from hystcomp._floattext import WIDTH, format_rows
 from hystcomp.errors import DataFileError
 
 #: Bytes of data rows parsed at once (and written at once).
@@ -254,18 +255,16 @@ def _reason(exc: Exception, before: int) -> str:
 def write_csv(file, columns: dict[str, np.ndarray], progress=None) -> None:
     """Write ``columns`` to the binary ``file`` as CSV with a header row, in chunks.
 
-    Every value is written as Python's ``repr`` (the shortest text that reads back as the
-    same float64), as :func:`hystcomp.data.format_csv` writes it; chunks of rows keep the
-    memory bounded whatever the length.
+    Every value is written as Python's ``repr`` writes it (the shortest text that reads
+    back as the same float64), by the compiled formatter of :mod:`hystcomp._floattext`;
+    chunks of rows keep the memory bounded whatever the length.
     """
     names = list(columns)
     file.write((",".join(names) + "\n").encode())
     arrays = [columns[k] for k in names]
     n = arrays[0].size if arrays else 0
-    step = max(1, CHUNK_BYTES // (24 * max(len(arrays), 1)))
+    step = max(1, CHUNK_BYTES // (WIDTH * max(len(arrays), 1)))
     for start in range(0, n, step):
-        parts = [map(repr, a[start : start + step].tolist()) for a in arrays]
-        lines = map(",".join, zip(*parts, strict=True)) if len(parts) > 1 else parts[0]
-        file.write(("\n".join(lines) + "\n").encode())
+        file.write(format_rows(np.column_stack([a[start : start + step] for a in arrays])))
         if progress is not None:
             progress(min(1.0, (start + step) / n))
