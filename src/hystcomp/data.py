@@ -2,17 +2,21 @@
 
 Formats, chosen by the file's suffix:
 
-* ``.csv``: comma-separated, a header row naming the columns (``t`` in s, ``v`` in V,
-  ``x`` in µm; extra columns are ignored);
-* ``.npz`` (NumPy) and ``.mat`` (MATLAB, read with :func:`scipy.io.loadmat`): the same names
-  as keys or variables;
-* anything else (``.dat``, ``.txt``, ...): whitespace-separated numbers, with or without a
-  header row, as many lab programs write them.
+* ``.npz`` (NumPy) and ``.mat`` (MATLAB, read with :func:`scipy.io.loadmat`): the names
+  ``t``, ``v``, ``x`` as keys or variables, or one matrix whose columns are numbered;
+* anything else (``.csv``, ``.dat``, ``.txt``, ...): a text table, with a header row
+  naming the columns (``t`` in s, ``v`` in V, ``x`` in µm; any case; extra columns are
+  ignored) or none. Separators, decimal commas, comment lines, ``# t,v,x`` headers and a
+  units row are recognised by the rules of :mod:`hystcomp._text`.
 
 Columns can be named explicitly: ``{"v": 1, "x": 5}`` (1-based column numbers, for text
-files) or ``{"v": "volts", "x": "disp"}`` (header names or keys); on the command line
-``--columns v=1,x=5``. A file without a time column needs the sample rate. Writes go through
-:func:`hystcomp.io.atomic_path`: a failing write never truncates an existing file.
+files and one-matrix files) or ``{"v": "volts", "x": "disp"}`` (header names or keys); on
+the command line ``--columns v=1,x=5``. A file without a time column needs the sample rate.
+Displacements in other units are converted with ``x_unit`` (``--x-unit``). A record has at
+most :data:`hystcomp._formats.MAX_SAMPLES` samples (``HYSTCOMP_MAX_SAMPLES``), checked
+before a large array is loaded. CSV is written in chunks with every value as its
+``repr``; writes go through :func:`hystcomp.io.atomic_path`: a failing write never
+truncates an existing file. See ``docs/data-files.md``.
 
 Files are untrusted input: every problem (not a regular file, not text, a corrupt archive,
 text or complex numbers in a column, NaN or inf, a value beyond
@@ -25,6 +29,7 @@ is reported as a corrupt file.
 
 from __future__ import annotations
 
+import io as _io
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -529,10 +534,9 @@ def format_csv(table: dict) -> str:
     cols = _columns(table, "format_csv")
     if len({c.size for c in cols.values()}) != 1:
         raise InvalidParameterError("The columns given to format_csv have different lengths.")
-    keys = list(cols)
-    rows = np.column_stack([cols[k] for k in keys]).tolist()
-    lines = [",".join(keys), *(",".join(map(repr, row)) for row in rows)]
-    return "\n".join(lines) + "\n"
+    buffer = _io.BytesIO()
+    write_csv(buffer, cols)
+    return buffer.getvalue().decode()
 
 
 def check_writable(path) -> Path:

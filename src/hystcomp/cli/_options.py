@@ -99,8 +99,9 @@ columns_option = click.option(
     default=None,
     callback=columns,
     help=(
-        "Which file columns hold t, v, x: 1-based numbers for text tables (v=1,x=5) or "
-        "names (v=volts,x=disp). Default: columns named t, v, x."
+        "Which file columns hold t, v, x: 1-based numbers for text tables or the one matrix "
+        "of a MAT/NPZ file (v=1,x=5), or names in any case (v=volts,x=disp). Default: "
+        "columns named t, v, x."
     ),
 )
 fs_option = click.option(

@@ -1,0 +1,122 @@
+"""Speed and peak memory of writing and reading a long CSV record (t, v, x).
+
+Each step runs in a fresh process that measures its own wall time and the growth of its
+peak resident memory (``ru_maxrss``) during the step, so steps do not share a heap. The
+references run in the same benchmark on the same array and file:
+
+* writing: :func:`numpy.savetxt` with ``%.17g`` (numpy's writer at round-trip precision),
+  and the former writer (a list of every value's ``repr``, joined; on a tenth of the
+  samples, as it needs about 400 bytes a sample, and scaled per sample);
+* reading: :func:`numpy.loadtxt` of the same file (the whole table at once).
+
+Targets: writing in under 1 GB and at least 5x faster per sample than the former writer;
+reading in less than 4x the memory of the values. Timings on a shared machine are noisy:
+read the ratios, which come from one run.
+
+Run alone with ``python benchmarks/bench_io.py``; ``BENCH_IO_SAMPLES`` sets the length
+(default 1e7).
+"""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import tempfile
+
+SAMPLES = int(float(os.environ.get("BENCH_IO_SAMPLES", "1e7")))
+
+_SETUP = """
+import resource, sys, time
+import numpy as np
+from hystcomp.data import format_csv, read_record, write_table
+n, path = int(sys.argv[1]), sys.argv[2]
+def peak():
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+def table():
+    t = np.arange(n) / 2e4
+    rng = np.random.default_rng(0)
+    return {"t": t, "v": 60 + 50 * np.sin(t) + rng.standard_normal(n),
+            "x": 12 * np.cos(t) + 0.01 * rng.standard_normal(n)}
+"""
+
+_STEPS = {
+    "write": "cols = table(); base = peak(); start = time.perf_counter()\n"
+    "write_table(path, cols)\n",
+    "savetxt": "cols = table(); base = peak(); start = time.perf_counter()\n"
+    "np.savetxt(path, np.column_stack(list(cols.values())), fmt='%.17g', delimiter=',',"
+    " header='t,v,x', comments='')\n",
+    "former": "cols = table(); base = peak(); start = time.perf_counter()\n"
+    "rows = np.column_stack(list(cols.values())).tolist()\n"
+    "text = '\\n'.join(['t,v,x', *(','.join(map(repr, row)) for row in rows)]) + '\\n'\n"
+    "open(path, 'w').write(text)\n",
+    "read": "base = peak(); start = time.perf_counter()\nrec = read_record(path)\n",
+    "loadtxt": "base = peak(); start = time.perf_counter()\n"
+    "data = np.loadtxt(path, delimiter=',', skiprows=1)\n",
+}
+
+
+def _step(name: str, n: int, path: str) -> tuple[float, float]:
+    """Seconds and MB of peak memory growth of one step in a fresh process."""
+    code = _SETUP + _STEPS[name] + "print(time.perf_counter() - start, peak() - base)\n"
+    out = subprocess.run(
+        [sys.executable, "-c", code, str(n), path], capture_output=True, text=True, check=True
+    )
+    seconds, mb = map(float, out.stdout.split())
+    return seconds, mb
+
+
+def _row(name, value, unit, target=None, ok=None) -> dict:
+    return {"name": name, "value": value, "unit": unit, "target": target, "ok": ok}
+
+
+def run() -> list[dict]:
+    """Measure and return one row per figure: name, value, unit, target, ok."""
+    n = SAMPLES
+    label = f"{n:.0e}-sample CSV"
+    values_mb = 3 * 8 * n / 2**20
+    with tempfile.TemporaryDirectory() as folder:
+        ours, theirs = f"{folder}/ours.csv", f"{folder}/savetxt.csv"
+        write_s, write_mb = _step("write", n, ours)
+        savetxt_s, savetxt_mb = _step("savetxt", n, theirs)
+        former_s, former_mb = _step("former", n // 10, f"{folder}/former.csv")
+        former_s *= 10  # per sample, at the full length
+        read_s, read_mb = _step("read", n, ours)
+        loadtxt_s, loadtxt_mb = _step("loadtxt", n, ours)
+    speedup = former_s / write_s
+    return [
+        _row(f"write {label}: write_table", write_s, "s"),
+        _row(
+            f"write {label}: write_table peak memory growth",
+            write_mb,
+            "MB",
+            "< 1024",
+            write_mb < 1024,
+        ),
+        _row(f"write {label}: numpy.savetxt %.17g", savetxt_s, "s"),
+        _row(f"write {label}: numpy.savetxt peak memory growth", savetxt_mb, "MB"),
+        _row("write: numpy.savetxt time / write_table time", savetxt_s / write_s, "x"),
+        _row("write: former writer (repr list, 1/10 length) time, scaled", former_s, "s"),
+        _row("write: former writer (1/10 length) peak memory growth, x10", 10 * former_mb, "MB"),
+        _row("write: former writer time / write_table time", speedup, "x", ">= 5", speedup >= 5),
+        _row(f"read {label}: read_record", read_s, "s"),
+        _row(
+            f"read {label}: read_record peak memory growth / values ({values_mb:.0f} MB)",
+            read_mb / values_mb,
+            "x",
+            "< 4",
+            read_mb / values_mb < 4,
+        ),
+        _row(f"read {label}: numpy.loadtxt", loadtxt_s, "s"),
+        _row(
+            f"read {label}: numpy.loadtxt peak memory growth / values",
+            loadtxt_mb / values_mb,
+            "x",
+        ),
+        _row("read: numpy.loadtxt time / read_record time", loadtxt_s / read_s, "x"),
+    ]
+
+
+if __name__ == "__main__":
+    for row in run():
+        print(f"{row['name']}: {row['value']:.4g} {row['unit']}")
