@@ -194,6 +194,7 @@ def test_chunked_read_and_write_round_trip_across_chunks(tmp_path, rng, monkeypa
     from hystcomp._formats import read_raw
 
     monkeypatch.setattr(text, "CHUNK_BYTES", 1000)  # many chunks, rows cut anywhere
+    monkeypatch.setattr(text, "SMALL_TABLE", 0)  # the compiled formatter, even for few rows
     n = 2000
     table = {
         "t": np.arange(n) / 3e3,

@@ -39,6 +39,9 @@ from hystcomp.errors import DataFileError
 
 #: Bytes of data rows parsed at once (and written at once).
 CHUNK_BYTES = 1 << 23
+#: Values up to which CSV is formatted by ``repr`` in the interpreter (the compiled
+#: formatter costs a fraction of a second to load, as much as ~100 000 reprs).
+SMALL_TABLE = 30_000
 #: Bytes read to recognise the layout; the header and first data row must lie within them.
 HEAD_BYTES = 1 << 16
 #: Units understood in a units row or ``--x-unit``, per column, as factors to s, V, µm.
@@ -263,6 +266,10 @@ def write_csv(file, columns: dict[str, np.ndarray], progress=None) -> None:
     file.write((",".join(names) + "\n").encode())
     arrays = [columns[k] for k in names]
     n = arrays[0].size if arrays else 0
+    if n * len(arrays) <= SMALL_TABLE:  # not worth loading the compiled formatter
+        rows = zip(*(map(repr, a.tolist()) for a in arrays), strict=True)
+        file.write("".join(",".join(row) + "\n" for row in rows).encode())
+        return
     step = max(1, CHUNK_BYTES // (WIDTH * max(len(arrays), 1)))
     for start in range(0, n, step):
         file.write(format_rows(np.column_stack([a[start : start + step] for a in arrays])))
