@@ -50,11 +50,12 @@ def _same(path, record, **kwargs):
         ("upper.csv", ["T,V,X"], ",", "."),
         ("mixed.csv", ['"Time","v","X"'], ",", "."),
         ("crlf.csv", ["t,v,x"], ",", "."),
+        ("cr.csv", ["t,v,x"], ",", "."),
     ],
 )
 def test_lab_text_layouts_read_as_the_canonical_csv(tmp_path, record, name, head, sep, decimal):
     path = tmp_path / name
-    newline = "\r\n" if name.startswith("crlf") else "\n"
+    newline = {"crlf.csv": "\r\n", "cr.csv": "\r"}.get(name, "\n")
     path.write_text(newline.join([*head, *_rows(record, sep, decimal)]) + newline, "utf-8")
     columns = {"t": "time"} if name.startswith("mixed") else None
     _same(path, record, columns=columns)

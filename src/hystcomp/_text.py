@@ -26,7 +26,6 @@ samples (:func:`hystcomp._formats.max_samples`) is refused before any large allo
 
 from __future__ import annotations
 
-import io as _io
 import re
 import warnings
 from dataclasses import dataclass
@@ -212,7 +211,10 @@ def read_rows(path: Path, layout: Layout, limit: int, progress=None) -> np.ndarr
                         "(HYSTCOMP_MAX_SAMPLES raises the limit). Split the record or lower "
                         "its sample rate."
                     )
-                out[:, n : n + rows.shape[0]] = rows.T
+                if n + rows.shape[0] > out.shape[1]:  # lines not ended by "\n" (old Macs)
+                    out = np.concatenate([out[:, :n], rows.T], axis=1)
+                else:
+                    out[:, n : n + rows.shape[0]] = rows.T
                 n += rows.shape[0]
             done += len(block)
             if progress is not None:
@@ -228,7 +230,7 @@ def _parse(text: str, layout: Layout, where: str, before: int) -> np.ndarray:
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", UserWarning)  # "input contained no data"
-            rows = np.loadtxt(_io.StringIO(text), delimiter=layout.delimiter, comments="#", ndmin=2)
+            rows = np.loadtxt(text.splitlines(), delimiter=layout.delimiter, comments="#", ndmin=2)
     except (ValueError, IndexError, OverflowError) as exc:
         raise DataFileError(
             f"{where} is not a table of numbers ({_reason(exc, before)}). Every row after "

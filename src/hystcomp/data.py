@@ -392,7 +392,11 @@ def read_table(
             f"The 'x_unit' parameter of read_table must be one of {', '.join(X_UNITS)}. "
             f"Got {x_unit!r} instead."
         )
-    raw = _raw(path, columns, keys, progress)
+    try:
+        raw = _raw(path, columns, keys, progress)
+    finally:
+        if progress is not None:
+            progress(1.0)  # done, or failed: either way the progress line goes
     out = {}
     for key in ("t", *keys):
         index, label = _pick(path, raw, key, columns.get(key), key != "t")
@@ -583,7 +587,11 @@ def write_table(path, table: dict, *, progress=None) -> None:
         )
     with atomic_path(path) as tmp, tmp.open("wb") as file:
         if suffix == ".csv":
-            write_csv(file, cols, progress)
+            try:
+                write_csv(file, cols, progress)
+            finally:
+                if progress is not None:
+                    progress(1.0)
         elif suffix == ".npz":
             np.savez(file, **cols)
         else:
