@@ -103,7 +103,8 @@ def compensate(
     warn_x_unit(table["x"], reference_file, quiet)
     options = inverse_options(model, table, slew_rate=slew_rate, narrow_range=narrow_range)
     compensator = model.inverse(**options, **chosen)
-    v = compensator.simulate(table["x"])
+    with progress("computing the voltage", quiet).ticking():
+        v = compensator.simulate(table["x"])
     written = progress(f"writing {output}", quiet)
     write_table(output, {"t": table["t"], "v": v, "x_ref": table["x"]}, progress=written)
     lo, hi = compensator.voltage_range

@@ -43,7 +43,8 @@ def simulate(model_file, input_file, output, columns, sample_rate, quiet):
             f"model's voltage range ({lo:.4g} .. {hi:.4g} V); the model extrapolates there.",
             err=True,
         )
-    x = model.simulate(v)
+    with progress("simulating", quiet).ticking():
+        x = model.simulate(v)
     written = progress(f"writing {output}", quiet)
     write_table(output, {"t": table["t"], "v": v, "x": x}, progress=written)
     click.echo(f"wrote {output}: {x.size} samples, x from {x.min():.4g} to {x.max():.4g} µm")
