@@ -48,6 +48,7 @@ def _same(path, record, **kwargs):
         ("units-brackets.csv", ["t;v;x", "[s];[V];[µm]"], ";", ","),
         ("comment-units.dat", ["# t v x", "# (s) (V) (um)"], " ", "."),
         ("upper.csv", ["T,V,X"], ",", "."),
+        ("names-units.csv", ["t [s];V (V);x [µm]"], ";", ","),
         ("mixed.csv", ['"Time","v","X"'], ",", "."),
         ("crlf.csv", ["t,v,x"], ",", "."),
         ("cr.csv", ["t,v,x"], ",", "."),
@@ -81,6 +82,8 @@ def test_units_row_in_mm_is_converted(tmp_path, record):
     np.testing.assert_allclose(rec.x, record["x"], rtol=1e-15)
     with pytest.raises(DataFileError, match=r"units row .* says the displacement is in mm"):
         read_record(path, x_unit="um")
+    path.write_text("\n".join(["Time (s),v [V],x [mm]", *_rows(mm)]) + "\n")
+    np.testing.assert_allclose(read_record(path, columns={"t": "time"}).x, record["x"], rtol=1e-15)
     path.write_text("\n".join(["t,v,x", "s,V,furlong", *_rows(record)]) + "\n")
     with pytest.raises(DataFileError, match=r"no column 'x'.*columns are s, V, furlong"):
         read_record(path)  # not a units row: the header is the last text line

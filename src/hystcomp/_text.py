@@ -15,8 +15,9 @@ guessing from statistics, unlike :class:`csv.Sniffer`):
    comment line (``# t,v,x``, as ``numpy.savetxt(..., header=...)`` writes it) directly
    above the data or the units row is the header. Lines above the header (other comments,
    a preamble) are ignored. Without any of these the table has no header.
-5. Header names and units lose surrounding quotes and brackets; the header and the units
-   row must have as many fields as the data rows.
+5. Header names and units lose surrounding quotes (units also brackets); a name such as
+   ``x [um]`` or ``t (s)`` gives the column's name and unit when there is no units row.
+   The header and the units row must have as many fields as the data rows.
 
 The data rows are parsed in chunks of :data:`CHUNK_BYTES` by :func:`numpy.loadtxt` (its C
 parser) into one preallocated array, so a read needs about the memory of the values
@@ -51,6 +52,7 @@ UNITS = {
 }
 _ALL_UNITS = {u for units in UNITS.values() for u in units} | {"a.u.", "%", "°c", "c", "k", "a"}
 _STRIP = " \t\"'[]()"
+_NAME_UNIT = re.compile(r"\s*(.*?)\s*[\[(]([^\])]*)[\])]\s*")
 
 
 @dataclass(frozen=True)
@@ -146,7 +148,12 @@ def _header(path: Path, above, delimiter, n: int):
     units = None
     if len(rows) == 2 and _is_units(rows[1]) and not _is_units(rows[0]):
         units = [tok.strip(_STRIP) for tok in rows[1]]
-    names = [tok.strip(_STRIP) for tok in (rows[0] if units is not None else rows[-1])]
+    names = [tok.strip(" \t\"'") for tok in (rows[0] if units is not None else rows[-1])]
+    split = [_NAME_UNIT.fullmatch(name) for name in names]
+    if any(split):  # "t [s]", "x (um)": the name and its unit
+        names = [m[1] if m else name for m, name in zip(split, names, strict=True)]
+        if units is None:
+            units = [m[2].strip() if m else "" for m in split]
     if not plain and (len(names) != n or _numbers(names, False)):
         return None, None  # a comment that is no header
     where = f"Data file {str(path)!r}"
@@ -168,7 +175,8 @@ def _describe(delimiter: str | None) -> str:
 
 
 def count_rows(path: Path, offset: int, limit: int) -> int:
-    """Lines from ``offset`` on (an upper bound of the data rows); refuse more than ``limit``."""
+    """Lines from ``offset`` on (an upper bound of the data rows); counting stops past
+    ``limit``."""
     rows, last = 0, b"\n"
     with path.open("rb") as f:
         f.seek(offset)
