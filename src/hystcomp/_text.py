@@ -46,8 +46,8 @@ SMALL_TABLE = 30_000
 HEAD_BYTES = 1 << 16
 #: Units understood in a units row or ``--x-unit``, per column, as factors to s, V, µm.
 UNITS = {
-    "t": {"s": 1.0, "ms": 1e-3, "us": 1e-6, "µs": 1e-6, "μs": 1e-6},
-    "v": {"v": 1.0, "mv": 1e-3, "kv": 1e3},
+    "t": {"s": 1.0, "sec": 1.0, "ms": 1e-3, "us": 1e-6, "µs": 1e-6, "μs": 1e-6},
+    "v": {"v": 1.0, "volt": 1.0, "volts": 1.0, "mv": 1e-3, "kv": 1e3},
     "x": {"m": 1e6, "mm": 1e3, "um": 1.0, "µm": 1.0, "μm": 1.0, "micron": 1.0, "nm": 1e-3},
 }
 _ALL_UNITS = {u for units in UNITS.values() for u in units} | {"a.u.", "%", "°c", "c", "k", "a"}

@@ -296,7 +296,7 @@ def _units(path: Path, raw: _Raw, key: str, index: int | None, x_unit) -> float:
         raise DataFileError(
             f"The units row of {str(path)!r} gives {given!r} for {key!r} ({MEANINGS[key]}); "
             f"known units are {', '.join(UNITS[key])}. Convert the column, or correct the "
-            "units row."
+            "unit in the file" + (", or give --x-unit." if key == "x" else ".")
         )
     return factor
 
