@@ -39,9 +39,9 @@ from hystcomp.errors import DataFileError
 
 #: Bytes of data rows parsed at once (and written at once).
 CHUNK_BYTES = 1 << 23
-#: Values up to which CSV is formatted by ``repr`` in the interpreter (the compiled
-#: formatter costs a fraction of a second to load, as much as ~100 000 reprs).
-SMALL_TABLE = 30_000
+#: Values up to which CSV is formatted by ``repr`` in the interpreter, in one piece: loading
+#: the compiled formatter costs about as much as formatting this many values so.
+SMALL_TABLE = 200_000
 #: Bytes read to recognise the layout; the header and first data row must lie within them.
 HEAD_BYTES = 1 << 16
 #: Units understood in a units row or ``--x-unit``, per column, as factors to s, V, µm.
