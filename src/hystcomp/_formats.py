@@ -1,8 +1,9 @@
 """Parsing data files into columns, treating every file as untrusted input.
 
-Text tables (:mod:`hystcomp._text`: layout rules, chunked ``np.loadtxt``), NPZ (``np.load`` without pickle) and MAT files. A MAT file is
-parsed by scipy in a child process: scipy's MAT reader is not hardened against corrupt files
-(a wrong type code in a numeric element crashes the interpreter), so a crash there becomes a
+Text tables (:mod:`hystcomp._text`: layout rules, chunked ``np.loadtxt``), NPZ
+(``np.load`` without pickle) and MAT files. A MAT file is parsed by scipy in a child
+process: scipy's MAT reader is not hardened against corrupt files (a wrong type code in a
+numeric element crashes the interpreter), so a crash there becomes a
 :class:`~hystcomp.errors.DataFileError` instead of the end of the caller's process.
 :mod:`hystcomp.data` picks and checks the columns.
 """
