@@ -38,7 +38,7 @@ from hystcomp._floattext import WIDTH, format_rows
 from hystcomp.errors import DataFileError
 
 #: Bytes of data rows parsed at once (and written at once).
-CHUNK_BYTES = 1 << 23
+CHUNK_BYTES = 1 << 21
 #: Values up to which CSV is formatted by ``repr`` in the interpreter, in one piece: loading
 #: the compiled formatter costs about as much as formatting this many values so.
 SMALL_TABLE = 200_000
