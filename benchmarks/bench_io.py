@@ -3,9 +3,9 @@
 Each step runs in a fresh process that reads the same table from a raw file (in place, no
 temporaries) and measures its own wall time and peak resident memory (``VmHWM``, Linux);
 memory is given as the growth over a process that only imports (and, for writing, reads the
-table). Writing, reading and
-``numpy.loadtxt`` and the former writer run twice, alternating, and the faster run counts (the machine may be
-shared). The references run in the same benchmark on the same array and file:
+table). Writing, the former writer, reading and ``numpy.loadtxt`` run twice, alternating,
+and the faster run counts (the machine may be shared). The references run in the same
+benchmark on the same array and file:
 
 * writing: :func:`numpy.savetxt` with ``%.17g`` (numpy's writer at round-trip precision),
   and the former writer (a list of every value's ``repr``, joined; on a tenth of the
