@@ -1,8 +1,9 @@
 """Parsing data files into columns, treating every file as untrusted input.
 
-Text tables (``np.loadtxt``), NPZ (``np.load`` without pickle) and MAT files. A MAT file is
-parsed by scipy in a child process: scipy's MAT reader is not hardened against corrupt files
-(a wrong type code in a numeric element crashes the interpreter), so a crash there becomes a
+Text tables (:mod:`hystcomp._text`: layout rules, chunked ``np.loadtxt``), NPZ
+(``np.load`` without pickle) and MAT files. A MAT file is parsed by scipy in a child
+process: scipy's MAT reader is not hardened against corrupt files (a wrong type code in a
+numeric element crashes the interpreter), so a crash there becomes a
 :class:`~hystcomp.errors.DataFileError` instead of the end of the caller's process.
 :mod:`hystcomp.data` picks and checks the columns.
 """
@@ -10,79 +11,107 @@ parsed by scipy in a child process: scipy's MAT reader is not hardened against c
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
 import tempfile
-import warnings
+import zipfile
 from pathlib import Path
 
 import numpy as np
 
+from hystcomp._text import read_rows, sniff
 from hystcomp.errors import DataFileError
 
 #: Longest time a MAT file may take to parse (s).
 MAT_TIMEOUT = 120.0
+#: The most samples (rows) a record may have, unless ``HYSTCOMP_MAX_SAMPLES`` says otherwise.
+#: Arrays are checked against it before they are loaded: NPZ members by their .npy header,
+#: MAT variables by :func:`scipy.io.whosmat`, text tables by counting lines.
+MAX_SAMPLES = 100_000_000
+#: The most columns of a matrix in an NPZ or MAT file (its shorter side).
+MAX_MATRIX_COLUMNS = 64
 
 
-def _is_header(tokens: list[str]) -> bool:
+def max_samples() -> int:
+    """The most samples a record may have: ``HYSTCOMP_MAX_SAMPLES`` if set, else
+    :data:`MAX_SAMPLES`."""
+    text = os.environ.get("HYSTCOMP_MAX_SAMPLES", "").strip()
+    if not text:
+        return MAX_SAMPLES
     try:
-        [float(tok) for tok in tokens]
-    except ValueError:
-        return True
-    return False
-
-
-def _first_line(path: Path) -> str:
-    with path.open(encoding="utf-8-sig") as f:
-        for line in f:
-            if line.strip() and not line.lstrip().startswith("#"):
-                return line
-    raise DataFileError(f"Data file {str(path)!r} is empty: it has no data rows.")
-
-
-def _read_text(path: Path, delimiter: str | None):
-    """Header names (or None) and the columns of a text table (``None``: by whitespace)."""
-    first = _first_line(path)
-    if delimiter is None and "," in first:
-        delimiter = ","
-    tokens = [tok.strip() for tok in (first.split(delimiter) if delimiter else first.split())]
-    names = tokens if _is_header(tokens) else None
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", UserWarning)  # "input contained no data"
-            table = np.loadtxt(
-                path,
-                delimiter=delimiter,
-                skiprows=1 if names else 0,
-                comments="#",
-                ndmin=2,
-                encoding="utf-8-sig",
-            )
-    except (ValueError, IndexError, OverflowError) as exc:
+        value = int(float(text))
+    except (ValueError, OverflowError):
+        value = 0
+    if value < 1:
         raise DataFileError(
-            f"Data file {str(path)!r} is not a table of numbers ({_reason(exc)}). Every row "
-            "after the header must hold the same number of numeric columns."
-        ) from None
-    if table.shape[0] == 0:
-        raise DataFileError(f"Data file {str(path)!r} has a header but no data rows.")
-    if names is not None and len(names) != table.shape[1]:
-        raise DataFileError(
-            f"Data file {str(path)!r} has {len(names)} names in its header row but "
-            f"{table.shape[1]} columns of data. Make them agree."
+            f"HYSTCOMP_MAX_SAMPLES must be a whole number >= 1 (samples); got {text!r}. "
+            "Unset it for the default limit."
         )
-    return names, list(table.T)
+    return value
+
+
+def _too_large(path: Path, name: str, shape: tuple, limit: int) -> DataFileError:
+    return DataFileError(
+        f"Data file {str(path)!r} declares an array {name!r} of shape {shape}, more than "
+        f"{limit} samples, the most a record may have (HYSTCOMP_MAX_SAMPLES raises the "
+        "limit); it is corrupt or too large. Split the record or lower its sample rate."
+    )
+
+
+def check_shape(path: Path, name: str, shape: tuple, limit: int) -> None:
+    """Refuse an array of more than ``limit`` samples: a vector's length or a matrix's
+    longer side, with at most :data:`MAX_MATRIX_COLUMNS` on the other side."""
+    shape = tuple(int(n) for n in shape)
+    size = int(np.prod(shape, dtype=object))
+    rows = max(shape, default=1)
+    if rows > limit or size // max(rows, 1) > MAX_MATRIX_COLUMNS:
+        raise _too_large(path, name, shape, limit)
+
+
+def _check_npz_headers(path: Path, file, limit: int) -> None:
+    """Read each member's .npy header (shape and dtype, not the data) and refuse one too large."""
+    try:
+        archive = zipfile.ZipFile(file)
+    except (zipfile.BadZipFile, OSError, ValueError, EOFError):
+        return  # not a zip: np.load says what it is
+    with archive:
+        for info in archive.infolist():
+            try:
+                with archive.open(info) as member:
+                    version = np.lib.format.read_magic(member)
+                    read = (
+                        np.lib.format.read_array_header_1_0
+                        if version == (1, 0)
+                        else np.lib.format.read_array_header_2_0
+                    )
+                    shape, _, _ = read(member, max_header_size=10_000)
+            except Exception:  # noqa: BLE001, S112 - np.load reports a broken member
+                continue
+            check_shape(path, info.filename.removesuffix(".npy"), shape, limit)
+    file.seek(0)
+
+
+def _read_text(path: Path, progress=None):
+    """Header names (or None), units (or None) and the columns of a text table."""
+    layout = sniff(path)
+    table = read_rows(path, layout, max_samples(), progress)
+    if table.shape[1] == 0:
+        raise DataFileError(f"Data file {str(path)!r} has a header but no data rows.")
+    return layout.names, list(table), layout.units
 
 
 def _read_npz(path: Path):
     """Names and arrays of an NPZ file (never unpickling)."""
     try:
         with path.open("rb") as file:  # our handle: closed whatever numpy does
+            _check_npz_headers(path, file, max_samples())
             loaded = np.load(file, allow_pickle=False)
             if not isinstance(loaded, np.lib.npyio.NpzFile):
                 raise TypeError("it holds a single .npy array, not named arrays")
             with loaded as npz:
                 arrays = {name: npz[name] for name in npz.files}
-    except MemoryError:
+    except (MemoryError, DataFileError):
         raise
     except Exception as exc:  # noqa: BLE001 - any failure to parse foreign bytes
         raise DataFileError(
@@ -97,6 +126,12 @@ import json, sys
 import numpy as np
 import scipy.io
 try:
+    limit, columns = int(sys.argv[3]), int(sys.argv[4])
+    for name, shape, _ in scipy.io.whosmat(sys.argv[1]):
+        rows = max(shape, default=1)
+        if rows > limit or int(np.prod(shape, dtype=object)) // max(rows, 1) > columns:
+            sys.stdout.write(json.dumps([name, list(shape)]))
+            sys.exit(5)
     variables = scipy.io.loadmat(sys.argv[1])
 except NotImplementedError:
     sys.exit(4)
@@ -124,13 +159,17 @@ def _read_mat(path: Path):
     as "does not hold numbers".
     """
     where = f"Data file {str(path)!r}"
+    limit = max_samples()
     with tempfile.TemporaryDirectory(prefix="hystcomp-mat-") as folder:
         out = Path(folder) / "variables.npz"
         try:
             child = subprocess.run(
                 # -P: the working folder is not on the child's path (no module of it shadows
                 # numpy or scipy), while PYTHONPATH still applies
-                [sys.executable, "-P", "-c", _MAT_CHILD, str(path.resolve()), str(out)],
+                [
+                    *(sys.executable, "-P", "-c", _MAT_CHILD, str(path.resolve()), str(out)),
+                    *(str(limit), str(MAX_MATRIX_COLUMNS)),
+                ],
                 capture_output=True,
                 text=True,
                 timeout=MAT_TIMEOUT,
@@ -152,6 +191,12 @@ def _read_mat(path: Path):
                 f"{where} is a MATLAB v7.3 (HDF5) file, which scipy cannot read. "
                 "Save it from MATLAB with save(..., '-v7')."
             )
+        if child.returncode == 5:
+            try:
+                name, shape = json.loads(child.stdout)
+            except (ValueError, TypeError):
+                name, shape = "?", "?"
+            raise _too_large(path, str(name), tuple(shape), limit)
         if child.returncode != 0:
             reason = (
                 child.stderr.strip().splitlines()[-1][:200]
@@ -175,8 +220,10 @@ def _reason(exc: Exception) -> str:
     return f"{type(exc).__name__}: {text}" if text else type(exc).__name__
 
 
-def read_raw(path: Path):
-    """Names (or None) and columns of a data file, and whether columns are numbered.
+def read_raw(path: Path, progress=None):
+    """Names (or None), columns, whether columns are numbered, and units (or None).
+
+    ``progress``, if given, is called with the fraction read so far (text tables).
 
     Raises
     ------
@@ -195,10 +242,11 @@ def read_raw(path: Path):
     suffix = path.suffix.lower()
     try:
         if suffix == ".npz":
-            return (*_read_npz(path), False)
+            return (*_read_npz(path), False, None)
         if suffix == ".mat":
-            return (*_read_mat(path), False)
-        return (*_read_text(path, "," if suffix == ".csv" else None), True)
+            return (*_read_mat(path), False, None)
+        names, columns, units = _read_text(path, progress)
+        return names, columns, True, units
     except UnicodeDecodeError:
         raise DataFileError(
             f"Data file {str(path)!r} is not text; use .csv, .npz, .mat or a text table."

@@ -2,17 +2,21 @@
 
 Formats, chosen by the file's suffix:
 
-* ``.csv``: comma-separated, a header row naming the columns (``t`` in s, ``v`` in V,
-  ``x`` in µm; extra columns are ignored);
-* ``.npz`` (NumPy) and ``.mat`` (MATLAB, read with :func:`scipy.io.loadmat`): the same names
-  as keys or variables;
-* anything else (``.dat``, ``.txt``, ...): whitespace-separated numbers, with or without a
-  header row, as many lab programs write them.
+* ``.npz`` (NumPy) and ``.mat`` (MATLAB, read with :func:`scipy.io.loadmat`): the names
+  ``t``, ``v``, ``x`` as keys or variables, or one matrix whose columns are numbered;
+* anything else (``.csv``, ``.dat``, ``.txt``, ...): a text table, with a header row
+  naming the columns (``t`` in s, ``v`` in V, ``x`` in µm; any case; extra columns are
+  ignored) or none. Separators, decimal commas, comment lines, ``# t,v,x`` headers and a
+  units row are recognised by the rules of :mod:`hystcomp._text`.
 
 Columns can be named explicitly: ``{"v": 1, "x": 5}`` (1-based column numbers, for text
-files) or ``{"v": "volts", "x": "disp"}`` (header names or keys); on the command line
-``--columns v=1,x=5``. A file without a time column needs the sample rate. Writes go through
-:func:`hystcomp.io.atomic_path`: a failing write never truncates an existing file.
+files and one-matrix files) or ``{"v": "volts", "x": "disp"}`` (header names or keys); on
+the command line ``--columns v=1,x=5``. A file without a time column needs the sample rate.
+Displacements in other units are converted with ``x_unit`` (``--x-unit``). A record has at
+most :data:`hystcomp._formats.MAX_SAMPLES` samples (``HYSTCOMP_MAX_SAMPLES``), checked
+before a large array is loaded. CSV is written in chunks with every value as its
+``repr``; writes go through :func:`hystcomp.io.atomic_path`: a failing write never
+truncates an existing file. See ``docs/data-files.md``.
 
 Files are untrusted input: every problem (not a regular file, not text, a corrupt archive,
 text or complex numbers in a column, NaN or inf, a value beyond
@@ -32,6 +36,7 @@ from pathlib import Path
 import numpy as np
 
 from hystcomp._formats import read_raw
+from hystcomp._text import UNITS, write_csv
 from hystcomp._validation import MAX_MAGNITUDE, as_path, as_signal, check_int, check_real
 from hystcomp.errors import DataFileError, InvalidParameterError, InvalidSignalError
 
@@ -40,6 +45,11 @@ MEANINGS = {"t": "time in s", "v": "voltage in V", "x": "displacement in µm"}
 WRITABLE = (".csv", ".npz", ".mat")
 #: Largest relative disagreement between a time column and a given sample rate.
 RATE_TOLERANCE = 0.01
+#: Displacement units of ``x_unit`` / ``--x-unit``, converted to µm.
+X_UNITS = ("m", "mm", "um", "nm")
+#: Displacement spans (µm) below or above which :func:`x_unit_warning` suspects m or nm.
+SPAN_METRES = 0.01
+SPAN_NANOMETRES = 5000.0
 
 
 @dataclass(frozen=True, eq=False)
@@ -153,7 +163,21 @@ def parse_columns(text: str | None) -> dict[str, int | str] | None:
             mapping[key] = int(value)
         else:
             mapping[key] = value
+    _distinct(mapping, f"The 'columns' option {text!r}")
     return mapping
+
+
+def _distinct(mapping: dict, what: str) -> None:
+    """Refuse one column named for two of t, v, x (``v=1,x=1``)."""
+    seen: dict = {}
+    for key, spec in mapping.items():
+        ident = spec.casefold() if isinstance(spec, str) else spec
+        if ident in seen:
+            raise InvalidParameterError(
+                f"{what} names column {spec!r} for both {seen[ident]!r} and {key!r}; each of "
+                "t, v, x needs its own column."
+            )
+        seen[ident] = key
 
 
 def _check_columns(columns) -> dict:
@@ -171,14 +195,32 @@ def _check_columns(columns) -> dict:
                 "The 'columns' parameter of read_table must map 't', 'v' or 'x' to a "
                 f"1-based column number or a column name. Got {key!r}: {spec!r}."
             )
+    _distinct(columns, "The 'columns' parameter of read_table")
     return columns
 
 
-def _pick(path: Path, names, arrays, positional, key: str, spec, required: bool):
-    """The column for ``key`` (``None`` if absent and not required)."""
+def _find(path: Path, names, label: str) -> int | None:
+    """The index of the column named ``label``: exactly, else in any case; None if absent."""
+    exact = [i for i, name in enumerate(names) if name == label]
+    if len(exact) == 1:
+        return exact[0]
+    folded = [i for i, name in enumerate(names) if str(name).casefold() == label.casefold()]
+    if len(exact) > 1 or len(folded) > 1:
+        found = ", ".join(repr(names[i]) for i in (exact if len(exact) > 1 else folded))
+        raise DataFileError(
+            f"Data file {str(path)!r} has {len(exact) or len(folded)} columns named like "
+            f"{label!r} ({found}), so which one is meant is unclear. Rename them apart in "
+            "the file, or name the right one by number, e.g. --columns x=3."
+        )
+    return folded[0] if folded else None
+
+
+def _pick(path: Path, raw: _Raw, key: str, spec, required: bool):
+    """The column for ``key`` (``None`` if absent and not required) and its label."""
     where = f"Data file {str(path)!r}"
+    names, arrays = raw.names, raw.arrays
     if isinstance(spec, int):
-        if not positional:
+        if not raw.positional:
             raise DataFileError(
                 f"{where} has named arrays ({', '.join(names) or 'none'}), not numbered "
                 f"columns: name the array for {key!r} instead of {spec} (for example "
@@ -188,24 +230,90 @@ def _pick(path: Path, names, arrays, positional, key: str, spec, required: bool)
             raise DataFileError(
                 f"{where} has {len(arrays)} columns; column {spec} for {key!r} does not exist."
             )
-        return arrays[spec - 1], f"column {spec}"
+        return spec - 1, f"column {spec}"
     if names is None:
         if spec is None and not required:
             return None, ""
         raise DataFileError(
-            f"{where} has no header row, so its columns have no names: say which column "
-            f"holds {key!r} ({MEANINGS[key]}), e.g. --columns v=1,x=2 on the command line "
-            "(columns={'v': 1, 'x': 2} in Python; 1-based)."
+            f"{where} {raw.nameless}, so its columns have no names: say which column "
+            f"holds {key!r} ({MEANINGS[key]}), e.g. --columns {raw.example} on the command "
+            "line (columns={'v': 1, 'x': 2} in Python; 1-based)."
         )
     label = spec if spec is not None else key
-    if label not in names:
+    index = _find(path, names, label)
+    if index is None:
         if not required and spec is None:
             return None, ""
         raise DataFileError(
             f"{where} has no column {label!r} for {key!r} ({MEANINGS[key]}); its columns "
             f"are {', '.join(map(str, names))}. Name the right one, e.g. --columns {key}=NAME."
         )
-    return arrays[names.index(label)], f"column {label!r}"
+    return index, f"column {names[index]!r}"
+
+
+@dataclass
+class _Raw:
+    """What a file holds: column names (None: numbered only), arrays, units (None: unknown)."""
+
+    names: list | None
+    arrays: list
+    positional: bool
+    units: list | None
+    nameless: str = "has no header row"
+    example: str = "v=1,x=2"
+
+
+def _raw(path: Path, columns: dict, keys, progress) -> _Raw:
+    """Read the file; a NPZ/MAT file of one matrix becomes numbered columns."""
+    names, arrays, positional, units = read_raw(path, progress)
+    raw = _Raw(names, arrays, positional, units)
+    if positional and names is not None:
+        folded = [str(name).casefold() for name in names]
+        twice = sorted({name for name in names if folded.count(str(name).casefold()) > 1})
+        if twice:
+            raise DataFileError(
+                f"Data file {str(path)!r} names more than one column {' and '.join(twice)} in "
+                "its header row, so which one is meant is unclear. Give each column its own "
+                "name."
+            )
+    matrices = [
+        (name, arr)
+        for name, arr in zip(names or (), arrays, strict=False)
+        if arr.dtype.kind in "iuf" and arr.ndim == 2 and min(arr.shape) >= 2
+    ]
+    named = {str(name).casefold() for name in names or ()} & {"t", *keys}
+    numbered = any(isinstance(spec, int) for spec in columns.values())
+    if not positional and len(matrices) == 1 and (numbered or not named):
+        name, matrix = matrices[0]
+        if matrix.shape[0] < matrix.shape[1]:
+            matrix = matrix.T  # samples along the longer side
+        raw = _Raw(None, list(np.asarray(matrix).T), True, None)
+        raw.nameless = f"holds one matrix {name!r} ({matrix.shape[0]} x {matrix.shape[1]})"
+        raw.example = ",".join(f"{k}={i}" for i, k in enumerate(("t", *keys), 1))
+    return raw
+
+
+def _units(path: Path, raw: _Raw, key: str, index: int | None, x_unit) -> float:
+    """The factor to s, V or µm of column ``index`` for ``key``, from its units row or
+    ``x_unit``."""
+    given = None if raw.units is None or index is None else raw.units[index]
+    if key == "x" and x_unit is not None:
+        if given and UNITS["x"].get(given.lower()) not in (None, UNITS["x"][x_unit]):
+            raise DataFileError(
+                f"The units row of {str(path)!r} says the displacement is in {given}, but "
+                f"--x-unit says {x_unit}. Drop --x-unit, or correct the units row."
+            )
+        return UNITS["x"][x_unit]
+    if not given:
+        return 1.0
+    factor = UNITS[key].get(given.lower())
+    if factor is None:
+        raise DataFileError(
+            f"The units row of {str(path)!r} gives {given!r} for {key!r} ({MEANINGS[key]}); "
+            f"known units are {', '.join(UNITS[key])}. Convert the column, or correct the "
+            "unit in the file" + (", or give --x-unit." if key == "x" else ".")
+        )
+    return factor
 
 
 def _as_column(arr, path: Path, key: str, label: str) -> np.ndarray:
@@ -238,23 +346,39 @@ def _as_column(arr, path: Path, key: str, label: str) -> np.ndarray:
     return out
 
 
-def read_table(path, keys=("v", "x"), *, columns=None, sample_rate=None, min_samples=2):
+def read_table(
+    path,
+    keys=("v", "x"),
+    *,
+    columns=None,
+    sample_rate=None,
+    min_samples=2,
+    x_unit=None,
+    progress=None,
+):
     """Read time and the columns ``keys`` from a data file, validated.
 
     Parameters
     ----------
     path : str or path-like
-        The data file (``.csv``, ``.npz``, ``.mat`` or a whitespace-separated text table).
+        The data file (``.csv``, ``.npz``, ``.mat`` or a text table; see the module's notes
+        and :mod:`hystcomp._text` for the text layouts understood).
     keys : sequence of str
         The columns needed besides time, among ``"v"`` and ``"x"``.
     columns : dict, optional
-        Which column holds which key: 1-based numbers (text files) or names. By default each
-        key is the column of the same name.
+        Which column holds which key: 1-based numbers (text files, or the columns of the one
+        matrix of an NPZ/MAT file) or names. By default each key is the column of the same
+        name, in any case (``T``, ``V``, ``X`` do).
     sample_rate : float, optional
         Samples per second (Hz). Needed when the file has no time column ``t``; if both are
         given they must agree within 1 %.
     min_samples : int, default 2
         Fewest samples accepted.
+    x_unit : {"m", "mm", "um", "nm"}, optional
+        The unit of the displacement in the file; it is converted to µm. By default that of
+        the file's units row, else µm.
+    progress : callable, optional
+        Called with the fraction read so far (0..1), for a progress line.
 
     Returns
     -------
@@ -278,12 +402,26 @@ def read_table(path, keys=("v", "x"), *, columns=None, sample_rate=None, min_sam
     columns = _check_columns(columns)
     if sample_rate is not None:
         sample_rate = check_real(sample_rate, "sample_rate", "read_table", positive=True)
-    names, arrays, positional = read_raw(path)
+    if x_unit is not None and x_unit not in X_UNITS:
+        raise InvalidParameterError(
+            f"The 'x_unit' parameter of read_table must be one of {', '.join(X_UNITS)}. "
+            f"Got {x_unit!r} instead."
+        )
+    try:
+        raw = _raw(path, columns, keys, progress)
+    finally:
+        if progress is not None:
+            progress(1.0)  # done, or failed: either way the progress line goes
     out = {}
     for key in ("t", *keys):
-        arr, label = _pick(path, names, arrays, positional, key, columns.get(key), key != "t")
-        if arr is not None:
-            out[key] = _as_column(arr, path, key, label)
+        index, label = _pick(path, raw, key, columns.get(key), key != "t")
+        if index is not None:
+            arr = _as_column(raw.arrays[index], path, key, label)
+            factor = _units(path, raw, key, index, x_unit)
+            if factor != 1.0:
+                arr = _as_column(arr * factor, path, key, f"{label} (in {MEANINGS[key]})")
+            out[key] = arr
+    raw = None  # the other columns are no longer needed
     lengths = {key: arr.size for key, arr in out.items()}
     if len(set(lengths.values())) > 1:
         raise DataFileError(
@@ -299,6 +437,31 @@ def read_table(path, keys=("v", "x"), *, columns=None, sample_rate=None, min_sam
     for arr in out.values():
         arr.setflags(write=False)
     return {"t": out["t"], **{key: out[key] for key in keys}}
+
+
+def x_unit_warning(x, source: str) -> str | None:
+    """A warning if the span of displacements ``x`` (µm) looks like metres or nanometres.
+
+    A piezo actuator's stroke is between about 0.01 µm and a few mm: a span below
+    :data:`SPAN_METRES` µm is likely metres, one above :data:`SPAN_NANOMETRES` µm likely
+    nanometres (give ``--x-unit``). Returns the message, or None if the span is plausible.
+
+    Examples
+    --------
+    >>> x_unit_warning([0.0, 2e-5], "rec.csv")[:52]
+    'the displacement in rec.csv spans 2e-05 µm, which lo'
+    >>> x_unit_warning([0.0, 20.0], "rec.csv") is None
+    True
+    """
+    span = float(np.ptp(np.asarray(x, dtype=np.float64)))
+    for unit, looks in (("m", 0 < span < SPAN_METRES), ("nm", span > SPAN_NANOMETRES)):
+        if looks:
+            name = {"m": "metres", "nm": "nanometres"}[unit]
+            return (
+                f"the displacement in {source} spans {span:.4g} µm, which looks like {name} "
+                f"read as µm; if it is, give --x-unit {unit}."
+            )
+    return None
 
 
 def _time(path: Path, t, n: int, sample_rate):
@@ -336,7 +499,7 @@ def _time(path: Path, t, n: int, sample_rate):
     return t
 
 
-def read_record(path, *, columns=None, sample_rate=None) -> Record:
+def read_record(path, *, columns=None, sample_rate=None, x_unit=None, progress=None) -> Record:
     """Read an identification record ``(t, v, x)`` and check that its input varies.
 
     Parameters are those of :func:`read_table`.
@@ -345,7 +508,14 @@ def read_record(path, *, columns=None, sample_rate=None) -> Record:
     -------
     Record
     """
-    table = read_table(path, ("v", "x"), columns=columns, sample_rate=sample_rate)
+    table = read_table(
+        path,
+        ("v", "x"),
+        columns=columns,
+        sample_rate=sample_rate,
+        x_unit=x_unit,
+        progress=progress,
+    )
     v = table["v"]
     if np.ptp(v) <= 0:
         raise DataFileError(
@@ -383,10 +553,9 @@ def format_csv(table: dict) -> str:
     cols = _columns(table, "format_csv")
     if len({c.size for c in cols.values()}) != 1:
         raise InvalidParameterError("The columns given to format_csv have different lengths.")
-    keys = list(cols)
-    rows = np.column_stack([cols[k] for k in keys]).tolist()
-    lines = [",".join(keys), *(",".join(map(repr, row)) for row in rows)]
-    return "\n".join(lines) + "\n"
+    buffer = _io.BytesIO()
+    write_csv(buffer, cols)
+    return buffer.getvalue().decode()
 
 
 def check_writable(path) -> Path:
@@ -407,8 +576,12 @@ def check_writable(path) -> Path:
     return path
 
 
-def write_table(path, table: dict) -> None:
+def write_table(path, table: dict, *, progress=None) -> None:
     """Write equally long columns to ``path`` as CSV, NPZ or MAT (by suffix), atomically.
+
+    CSV is written in chunks of rows, each value as its shortest round-trip text
+    (``repr``), so memory stays bounded whatever the length and the file reads back
+    bit for bit.
 
     Parameters
     ----------
@@ -416,6 +589,8 @@ def write_table(path, table: dict) -> None:
         Output file ending in ``.csv``, ``.npz`` or ``.mat``.
     table : dict of str to array_like
         Column name to values, e.g. ``{"t": t, "v": v, "x": x}``.
+    progress : callable, optional
+        Called with the fraction written so far (0..1), for a progress line (CSV).
     """
     from hystcomp.io import atomic_path  # imported here: reading a record needs no model
 
@@ -427,15 +602,16 @@ def write_table(path, table: dict) -> None:
         raise DataFileError(
             f"Cannot write {str(path)!r}: the columns have different lengths ({lengths})."
         )
-    with atomic_path(path) as tmp:
+    with atomic_path(path) as tmp, tmp.open("wb") as file:
         if suffix == ".csv":
-            tmp.write_text(format_csv(cols), encoding="utf-8")
-            return
-        buffer = _io.BytesIO()
-        if suffix == ".npz":
-            np.savez(buffer, **cols)
+            try:
+                write_csv(file, cols, progress)
+            finally:
+                if progress is not None:
+                    progress(1.0)
+        elif suffix == ".npz":
+            np.savez(file, **cols)
         else:
             import scipy.io  # imported here: only MAT output needs it
 
-            scipy.io.savemat(buffer, {k: v.reshape(-1, 1) for k, v in cols.items()})
-        tmp.write_bytes(buffer.getvalue())
+            scipy.io.savemat(file, {k: v.reshape(-1, 1) for k, v in cols.items()})

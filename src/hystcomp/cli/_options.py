@@ -10,7 +10,9 @@ import math
 
 import click
 
+from hystcomp._progress import Progress
 from hystcomp._validation import MAX_MAGNITUDE
+from hystcomp.data import X_UNITS  # light: data's readers load compiled code only on use
 from hystcomp.errors import InvalidParameterError
 
 # hystcomp.data, hystcomp.io and the models are imported where they are used: a command that
@@ -100,8 +102,9 @@ columns_option = click.option(
     default=None,
     callback=columns,
     help=(
-        "Which file columns hold t, v, x: 1-based numbers for text tables (v=1,x=5) or "
-        "names (v=volts,x=disp). Default: columns named t, v, x."
+        "Which file columns hold t, v, x: 1-based numbers for text tables or the one matrix "
+        "of a MAT/NPZ file (v=1,x=5), or names in any case (v=volts,x=disp). Default: "
+        "columns named t, v, x."
     ),
 )
 fs_option = click.option(
@@ -126,9 +129,44 @@ def output_option(required: bool = True, what: str = "output"):
     )
 
 
-def read_options(columns: dict | None, sample_rate: float | None) -> dict:
+x_unit_option = click.option(
+    "--x-unit",
+    type=click.Choice(X_UNITS),
+    default=None,
+    help="Unit of the displacement in the file, converted to µm [the file's units row, else um].",
+)
+quiet_option = click.option(
+    "--quiet",
+    "-q",
+    is_flag=True,
+    help="No progress line and no unit-guess warning. Warnings about safety (clamping, "
+    "leaving the model's range) are always shown. Progress is shown only on a terminal, "
+    "for steps over 2 s.",
+)
+
+
+def read_options(
+    columns: dict | None, sample_rate: float | None, x_unit=None, quiet: bool = False, path=""
+) -> dict:
     """Keyword arguments for :func:`hystcomp.data.read_table` from the shared options."""
-    return {"columns": columns, "sample_rate": sample_rate}
+    options = {"columns": columns, "sample_rate": sample_rate, "x_unit": x_unit}
+    if not quiet:
+        options["progress"] = Progress(f"reading {click.format_filename(str(path))}")
+    return options
+
+
+def progress(label: str, quiet: bool):
+    """A progress line for a step (see :mod:`hystcomp._progress`); silent with --quiet."""
+    return Progress(label, enabled=False if quiet else None)
+
+
+def warn_x_unit(x, source, quiet: bool) -> None:
+    """The one-line warning of :func:`hystcomp.data.x_unit_warning`, unless --quiet."""
+    from hystcomp.data import x_unit_warning
+
+    message = x_unit_warning(x, str(source))
+    if message and not quiet:
+        click.echo(f"hystcomp: warning: {message}", err=True)
 
 
 def check_data_output(path, *, inputs=(), what: str = "output"):

@@ -15,8 +15,12 @@ from hystcomp.cli._options import (
     method_options,
     output_option,
     positive,
+    progress,
+    quiet_option,
     read_options,
     voltage_range,
+    warn_x_unit,
+    x_unit_option,
 )
 from hystcomp.data import read_table, write_table
 from hystcomp.errors import InvalidSignalError
@@ -52,6 +56,8 @@ def inverse_options(model, table, *, slew_rate, narrow_range) -> dict:
 @output_option(what="voltage: t, v, x_ref")
 @columns_option
 @fs_option
+@x_unit_option
+@quiet_option
 @click.option(
     "--slew-rate",
     type=float,
@@ -93,6 +99,8 @@ def compensate(
     output,
     columns,
     sample_rate,
+    x_unit,
+    quiet,
     slew_rate,
     narrow_range,
     method,
@@ -112,12 +120,15 @@ def compensate(
     model = load_model(model_file)
     refuse_dynamics_as_model(model, model_file)
     chosen = method_options(model, model_file, method)
-    table = read_table(reference_file, ("x",), **read_options(columns, sample_rate))
+    options = read_options(columns, sample_rate, x_unit, quiet, reference_file)
+    table = read_table(reference_file, ("x",), **options)
+    warn_x_unit(table["x"], reference_file, quiet)
     options = inverse_options(model, table, slew_rate=slew_rate, narrow_range=narrow_range)
     if dynamics_file is not None:
         options["dynamics"] = dynamics_for(load_dynamics(dynamics_file), table)
     compensator = model.inverse(**options, **chosen)
-    result = compensator.run(table["x"])
+    with progress("computing the voltage", quiet).ticking():
+        result = compensator.run(table["x"])
     v = result.v
     lo, hi = compensator.voltage_range
     if result.clamped:
@@ -134,7 +145,8 @@ def compensate(
                 "the reachable range, or drop --strict to accept the clamp."
             )
         click.echo(f"hystcomp: warning: {what}.", err=True)
-    write_table(output, {"t": table["t"], "v": v, "x_ref": table["x"]})
+    written = progress(f"writing {output}", quiet)
+    write_table(output, {"t": table["t"], "v": v, "x_ref": table["x"]}, progress=written)
     click.echo(
         f"wrote {output}: {v.size} samples, v from {v.min():.4g} to {v.max():.4g} V "
         f"(range {lo:.4g} .. {hi:.4g} V, {result.clamped} clamped)"

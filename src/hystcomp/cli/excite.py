@@ -6,7 +6,14 @@ import click
 
 from hystcomp import paper
 from hystcomp.cli import main
-from hystcomp.cli._options import check_data_output, output_option, positive, voltage_range
+from hystcomp.cli._options import (
+    check_data_output,
+    output_option,
+    positive,
+    progress,
+    quiet_option,
+    voltage_range,
+)
 from hystcomp.data import format_csv, write_table
 from hystcomp.identify.excitation import (
     DEFAULT_SAMPLE_RATE,
@@ -58,7 +65,8 @@ SIGNALS = {
     callback=positive("Hz"),
     help="Period rate.",
 )
-def excite(model, output, sample_rate, voltage_range, frequency):
+@quiet_option
+def excite(model, output, sample_rate, voltage_range, frequency, quiet):
     """Write the identification input for MODEL: pi, mpi, preisach, rich or dynamics.
 
     pi, mpi: triangles of 30, 60, 90, 120 V at 1 Hz (Section IV-A); preisach: sinusoids of
@@ -91,5 +99,5 @@ def excite(model, output, sample_rate, voltage_range, frequency):
     if output is None:
         click.echo(format_csv({"t": t, "v": v}), nl=False)
     else:
-        write_table(output, {"t": t, "v": v})
+        write_table(output, {"t": t, "v": v}, progress=progress(f"writing {output}", quiet))
         click.echo(f"wrote {output}: {t.size} samples at {sample_rate:g} Hz ({t[-1]:g} s)")

@@ -15,8 +15,12 @@ from hystcomp.cli._options import (
     fraction,
     fs_option,
     nonnegative,
+    progress,
+    quiet_option,
     read_options,
     voltage_range,
+    warn_x_unit,
+    x_unit_option,
 )
 from hystcomp.data import read_record
 from hystcomp.errors import IdentificationError
@@ -213,6 +217,8 @@ def _sizes(model) -> str:
 )
 @columns_option
 @fs_option
+@x_unit_option
+@quiet_option
 @click.option(
     "--transient",
     type=float,
@@ -264,6 +270,8 @@ def identify(
     constraints,
     columns,
     sample_rate,
+    x_unit,
+    quiet,
     transient,
     voltage_range,
     allow_extrapolation,
@@ -318,7 +326,8 @@ def identify(
         grid=grid,
         constraints=constraints,
     )
-    rec = read_record(data, **read_options(columns, sample_rate))
+    rec = read_record(data, **read_options(columns, sample_rate, x_unit, quiet, data))
+    warn_x_unit(rec.x, data, quiet)
     n = len(rec)
     n_fit = n if holdout is None else n - round(holdout * n)
     if holdout is not None and not 2 <= n_fit < n:
@@ -333,12 +342,13 @@ def identify(
         start = transient_end(v)
     else:
         start = int(np.searchsorted(rec.t - rec.t[0], transient, side="left"))
-    if "transient" in model.get_params():
-        if transient is not None:
-            model.transient = start
-        model.fit(v, x)
-    else:  # a model without its own transient option is fitted on the settled part only
-        model.fit(v[start:], x[start:])
+    with progress(f"identifying the {LABELS[kind]} model", quiet).ticking():
+        if "transient" in model.get_params():
+            if transient is not None:
+                model.transient = start
+            model.fit(v, x)
+        else:  # a model without its own transient option is fitted on the settled part only
+            model.fit(v[start:], x[start:])
     x_model = model.simulate(v)
     report = error_report(x, x_model, start)
 

@@ -10,6 +10,8 @@ from hystcomp.cli._options import (
     columns_option,
     fs_option,
     output_option,
+    progress,
+    quiet_option,
     read_options,
 )
 from hystcomp.data import read_table, write_table
@@ -22,14 +24,17 @@ from hystcomp.io import load_model
 @output_option(what="result: t, v, x")
 @columns_option
 @fs_option
-def simulate(model_file, input_file, output, columns, sample_rate):
+@quiet_option
+def simulate(model_file, input_file, output, columns, sample_rate, quiet):
     """Run the model in MODEL.json on the voltage in INPUT (columns t, v).
 
     Writes t (s), v (V) and the modelled displacement x (µm).
     """
     check_data_output(output, inputs=(model_file, input_file), what="result file")
     model = load_model(model_file)
-    table = read_table(input_file, ("v",), **read_options(columns, sample_rate))
+    table = read_table(
+        input_file, ("v",), **read_options(columns, sample_rate, None, quiet, input_file)
+    )
     v = table["v"]
     lo, hi = getattr(model, "voltage_range_", (-float("inf"), float("inf")))
     if v.min() < lo or v.max() > hi:
@@ -38,6 +43,8 @@ def simulate(model_file, input_file, output, columns, sample_rate):
             f"model's voltage range ({lo:.4g} .. {hi:.4g} V); the model extrapolates there.",
             err=True,
         )
-    x = model.simulate(v)
-    write_table(output, {"t": table["t"], "v": v, "x": x})
+    with progress("simulating", quiet).ticking():
+        x = model.simulate(v)
+    written = progress(f"writing {output}", quiet)
+    write_table(output, {"t": table["t"], "v": v, "x": x}, progress=written)
     click.echo(f"wrote {output}: {x.size} samples, x from {x.min():.4g} to {x.max():.4g} µm")

@@ -1,0 +1,288 @@
+"""Text tables as labs write them: how the layout is recognised, and chunked reading/writing.
+
+The layout is decided from the first data row and the lines above it, by these rules (no
+guessing from statistics, unlike :class:`csv.Sniffer`):
+
+1. The text is UTF-8 (a byte-order mark is dropped). Blank lines are skipped everywhere.
+2. The **first data row** is the first line, not starting with ``#``, whose fields are all
+   numbers. Its **separator** is ``;`` if the line holds one, else a tab if it holds one,
+   else ``,`` if it holds one, else runs of spaces.
+3. With a separator other than ``,``, a ``,`` inside the data rows is a **decimal comma**
+   (``0,5;1,25``): every ``,`` of the data is read as ``.``.
+4. The **header** is the last line above the first data row that is not a comment; if that
+   line is a **units row** (every field a unit such as ``s``, ``V``, ``um``, ``[µm]``,
+   ``(mV)``, or empty), the header is the line above it. Without such a line, the last
+   comment line (``# t,v,x``, as ``numpy.savetxt(..., header=...)`` writes it) directly
+   above the data or the units row is the header. Lines above the header (other comments,
+   a preamble) are ignored. Without any of these the table has no header.
+5. Header names and units lose surrounding quotes (units also brackets); a name such as
+   ``x [um]`` or ``t (s)`` gives the column's name and unit when there is no units row.
+   The header and the units row must have as many fields as the data rows.
+
+The data rows are parsed in chunks of :data:`CHUNK_BYTES` by :func:`numpy.loadtxt` (its C
+parser) into one preallocated array, so a read needs about the memory of the values
+(8 bytes each) and no more; rows are counted first and a file with more than the limit of
+samples (:func:`hystcomp._formats.max_samples`) is refused before any large allocation.
+"""
+
+from __future__ import annotations
+
+import re
+import warnings
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from hystcomp.errors import DataFileError
+
+#: Bytes of data rows parsed at once (and written at once).
+CHUNK_BYTES = 1 << 21
+#: Values up to which CSV is formatted by ``repr`` in the interpreter, in one piece: loading
+#: the compiled formatter costs about as much as formatting this many values so.
+SMALL_TABLE = 200_000
+#: Bytes read to recognise the layout; the header and first data row must lie within them.
+HEAD_BYTES = 1 << 16
+#: Units understood in a units row or ``--x-unit``, per column, as factors to s, V, µm.
+UNITS = {
+    "t": {"s": 1.0, "sec": 1.0, "ms": 1e-3, "us": 1e-6, "µs": 1e-6, "μs": 1e-6},
+    "v": {"v": 1.0, "volt": 1.0, "volts": 1.0, "mv": 1e-3, "kv": 1e3},
+    "x": {"m": 1e6, "mm": 1e3, "um": 1.0, "µm": 1.0, "μm": 1.0, "micron": 1.0, "nm": 1e-3},
+}
+_ALL_UNITS = {u for units in UNITS.values() for u in units} | {"a.u.", "%", "°c", "c", "k", "a"}
+_STRIP = " \t\"'[]()"
+_NAME_UNIT = re.compile(r"\s*(.*?)\s*[\[(]([^\])]*)[\])]\s*")
+
+
+@dataclass(frozen=True)
+class Layout:
+    """How a text table is written: where its data starts and how to split it."""
+
+    names: list[str] | None
+    units: list[str] | None
+    delimiter: str | None  # None: runs of white space
+    decimal_comma: bool
+    n_columns: int
+    data_offset: int  # byte offset of the first data row
+
+
+def _split(line: str, delimiter: str | None) -> list[str]:
+    return [tok.strip() for tok in (line.split(delimiter) if delimiter else line.split())]
+
+
+def _numbers(tokens: list[str], decimal_comma: bool) -> bool:
+    try:
+        for tok in tokens:
+            float(tok.replace(",", ".") if decimal_comma else tok)
+    except ValueError:
+        return False
+    return True
+
+
+def _delimiter(line: str) -> str | None:
+    for sep in (";", "\t", ","):
+        if sep in line:
+            return sep
+    return None
+
+
+def _is_units(tokens: list[str]) -> bool:
+    return all(tok.strip(_STRIP).lower() in _ALL_UNITS or not tok.strip(_STRIP) for tok in tokens)
+
+
+def sniff(path: Path) -> Layout:
+    """The layout of the text table ``path`` by the module's rules.
+
+    Raises
+    ------
+    DataFileError
+        If the file has no data row, or its header or units row does not fit the data.
+    """
+    with path.open("rb") as f:
+        head = f.read(HEAD_BYTES)
+    text = head.decode("utf-8", errors="strict") if len(head) < HEAD_BYTES else None
+    if text is None:  # cut at the last complete line
+        text = head[: head.rfind(b"\n") + 1].decode("utf-8")
+    bom = 3 if head.startswith(b"\xef\xbb\xbf") else 0
+    text = text[1:] if bom else text
+    offset, chars = bom, 0
+    above: list[tuple[bool, str]] = []  # (is a comment, text) of the lines above the data
+    for line in text.splitlines(keepends=True):
+        stripped = line.strip()
+        start, offset = offset, offset + len(line.encode("utf-8"))
+        first, chars = chars, chars + len(line)
+        if not stripped:
+            continue
+        if stripped.startswith("#"):
+            above.append((True, stripped.lstrip("#").strip()))
+            continue
+        delimiter = _delimiter(stripped)
+        decimal_comma = delimiter != "," and "," in text[first:]
+        tokens = _split(stripped, delimiter)
+        if _numbers(tokens, decimal_comma):
+            names, units = _header(path, above, delimiter, len(tokens))
+            return Layout(names, units, delimiter, decimal_comma, len(tokens), start)
+        above.append((False, stripped))
+    if not above and not text.strip():
+        raise DataFileError(f"Data file {str(path)!r} is empty: it has no data rows.")
+    raise DataFileError(
+        f"Data file {str(path)!r} has a header but no data rows"
+        + ("" if len(head) < HEAD_BYTES else f" in its first {HEAD_BYTES} bytes")
+        + ": a data row is a line of numbers only, separated by ',', ';', tabs or spaces."
+    )
+
+
+def _header(path: Path, above, delimiter, n: int):
+    """Names and units from the lines above the first data row (rules 4 and 5)."""
+    plain = [line for comment, line in above if not comment]
+    comments = []
+    for comment, line in reversed(above):  # the comment lines directly above the data
+        if not comment:
+            break
+        comments.insert(0, line)
+    candidates = plain[-2:] if plain else comments[-2:]
+    if not candidates:
+        return None, None
+    rows = [_split(line, delimiter) for line in candidates]
+    units = None
+    if len(rows) == 2 and _is_units(rows[1]) and not _is_units(rows[0]):
+        units = [tok.strip(_STRIP) for tok in rows[1]]
+    names = [tok.strip(" \t\"'") for tok in (rows[0] if units is not None else rows[-1])]
+    split = [_NAME_UNIT.fullmatch(name) for name in names]
+    if any(split):  # "t [s]", "x (um)": the name and its unit
+        names = [m[1] if m else name for m, name in zip(split, names, strict=True)]
+        if units is None:
+            units = [m[2].strip() if m else "" for m in split]
+    if not plain and (len(names) != n or _numbers(names, False)):
+        return None, None  # a comment that is no header
+    where = f"Data file {str(path)!r}"
+    if len(names) != n:
+        raise DataFileError(
+            f"{where} is not a table of numbers as its header says: the header row has "
+            f"{len(names)} names but the first data row {n} columns (separated by "
+            f"{_describe(delimiter)}). Make them agree."
+        )
+    if units is not None and len(units) != n:
+        raise DataFileError(
+            f"{where} has {len(units)} units in its units row but {n} columns of data."
+        )
+    return names, units
+
+
+def _describe(delimiter: str | None) -> str:
+    return {None: "spaces", "\t": "tabs"}.get(delimiter, repr(delimiter))
+
+
+def count_rows(path: Path, offset: int, limit: int) -> int:
+    """Lines from ``offset`` on (an upper bound of the data rows); counting stops past
+    ``limit``."""
+    rows, last = 0, b"\n"
+    with path.open("rb") as f:
+        f.seek(offset)
+        while block := f.read(CHUNK_BYTES):
+            rows += block.count(b"\n")
+            last = block[-1:]
+            if rows > limit:
+                break
+    rows += last != b"\n"
+    return rows
+
+
+def read_rows(path: Path, layout: Layout, limit: int, progress=None) -> np.ndarray:
+    """The data rows of ``path`` as an array of shape (columns, rows), parsed in chunks.
+
+    Raises
+    ------
+    DataFileError
+        If a row does not hold ``layout.n_columns`` numbers, or the file holds more than
+        ``limit`` rows.
+    """
+    where = f"Data file {str(path)!r}"
+    bound = count_rows(path, layout.data_offset, limit)
+    out = np.empty((layout.n_columns, min(bound, limit + 1)))
+    n, done = 0, 0
+    size = max(path.stat().st_size, 1)
+    with path.open("rb") as f:
+        f.seek(layout.data_offset)
+        rest = b""
+        while True:
+            block = f.read(CHUNK_BYTES)
+            chunk = rest + block
+            cut = chunk.rfind(b"\n") + 1 if block else len(chunk)
+            chunk, rest = chunk[:cut], chunk[cut:]
+            if chunk.strip():
+                rows = _parse(chunk.decode("utf-8"), layout, where, n)
+                if n + rows.shape[0] > limit:
+                    raise DataFileError(
+                        f"{where} has more than {limit} rows, the most a record may have "
+                        "(HYSTCOMP_MAX_SAMPLES raises the limit). Split the record or lower "
+                        "its sample rate."
+                    )
+                if n + rows.shape[0] > out.shape[1]:  # lines not ended by "\n" (old Macs)
+                    out = np.concatenate([out[:, :n], rows.T], axis=1)
+                else:
+                    out[:, n : n + rows.shape[0]] = rows.T
+                n += rows.shape[0]
+            done += len(block)
+            if progress is not None:
+                progress(min(1.0, (layout.data_offset + done) / size))
+            if not block:
+                break
+    return out[:, :n]
+
+
+def _parse(text: str, layout: Layout, where: str, before: int) -> np.ndarray:
+    if layout.decimal_comma:
+        text = text.replace(",", ".")
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", UserWarning)  # "input contained no data"
+            rows = np.loadtxt(text.splitlines(), delimiter=layout.delimiter, comments="#", ndmin=2)
+    except (ValueError, IndexError, OverflowError) as exc:
+        raise DataFileError(
+            f"{where} is not a table of numbers ({_reason(exc, before)}). Every row after "
+            f"the header must hold the same number of numeric columns ({layout.n_columns}, "
+            f"separated by {_describe(layout.delimiter)}"
+            + (", with decimal commas" if layout.decimal_comma else "")
+            + ")."
+        ) from None
+    if rows.size and rows.shape[1] != layout.n_columns:
+        raise DataFileError(
+            f"{where} is not a table of numbers: its first data row has {layout.n_columns} "
+            f"columns, a row after data row {before} has {rows.shape[1]}. Every row after "
+            "the header must hold the same number of numeric columns."
+        )
+    return rows
+
+
+def _reason(exc: Exception, before: int) -> str:
+    text = str(exc).strip().splitlines()[0][:160] if str(exc).strip() else type(exc).__name__
+    if before:  # numpy counts the lines of the chunk: say which chunk
+        text = re.sub(
+            r"\b(row|line) (\d+)", lambda m: f"{m[1]} {m[2]} after data row {before}", text
+        )
+    return text
+
+
+def write_csv(file, columns: dict[str, np.ndarray], progress=None) -> None:
+    """Write ``columns`` to the binary ``file`` as CSV with a header row, in chunks.
+
+    Every value is written as Python's ``repr`` writes it (the shortest text that reads
+    back as the same float64), by the compiled formatter of :mod:`hystcomp._floattext`;
+    chunks of rows keep the memory bounded whatever the length.
+    """
+    names = list(columns)
+    file.write((",".join(names) + "\n").encode())
+    arrays = [columns[k] for k in names]
+    n = arrays[0].size if arrays else 0
+    if n * len(arrays) <= SMALL_TABLE:  # not worth loading the compiled formatter
+        rows = zip(*(map(repr, a.tolist()) for a in arrays), strict=True)
+        file.write("".join(",".join(row) + "\n" for row in rows).encode())
+        return
+    from hystcomp._floattext import WIDTH, format_rows  # compiled: loaded when writing
+
+    step = max(1, CHUNK_BYTES // (WIDTH * max(len(arrays), 1)))
+    for start in range(0, n, step):
+        file.write(format_rows(np.column_stack([a[start : start + step] for a in arrays])))
+        if progress is not None:
+            progress(min(1.0, (start + step) / n))

@@ -1,0 +1,255 @@
+"""The files labs have: each layout reads as the canonical t,v,x CSV; limits; units."""
+
+import os
+import subprocess
+import sys
+import zipfile
+
+import numpy as np
+import pytest
+import scipy.io
+from click.testing import CliRunner
+
+from hystcomp._formats import MAX_SAMPLES, max_samples
+from hystcomp.cli import main
+from hystcomp.data import read_record, read_table, write_table, x_unit_warning
+from hystcomp.errors import DataFileError, InvalidParameterError
+
+
+@pytest.fixture
+def record(rng):
+    t = np.arange(300) / 2000.0
+    v = 60.0 + 50.0 * np.sin(2 * np.pi * 5 * t)
+    return {"t": t, "v": v, "x": 0.2 * v - 40.0 + 0.005 * rng.standard_normal(t.size)}
+
+
+def _rows(record, sep=",", decimal="."):
+    return [
+        sep.join(repr(float(record[k][i])).replace(".", decimal) for k in "tvx")
+        for i in range(record["t"].size)
+    ]
+
+
+def _same(path, record, **kwargs):
+    rec = read_record(path, **kwargs)
+    for key in "tvx":
+        np.testing.assert_array_equal(getattr(rec, key), record[key])
+
+
+@pytest.mark.parametrize(
+    ("name", "head", "sep", "decimal"),
+    [
+        ("semicolon.csv", ["t;v;x"], ";", "."),
+        ("comma-decimal.csv", ["t;v;x"], ";", ","),
+        ("comma-decimal-tabs.txt", ["t\tv\tx"], "\t", ","),
+        ("numpy-header.txt", ["# t,v,x"], ",", "."),
+        ("comments.csv", ["# rig 3, 2026-11-02", "# operator: A.B.", "t,v,x"], ",", "."),
+        ("units.csv", ["t,v,x", "s,V,um"], ",", "."),
+        ("units-brackets.csv", ["t;v;x", "[s];[V];[µm]"], ";", ","),
+        ("comment-units.dat", ["# t v x", "# (s) (V) (um)"], " ", "."),
+        ("upper.csv", ["T,V,X"], ",", "."),
+        ("names-units.csv", ["t [s];V (V);x [µm]"], ";", ","),
+        ("mixed.csv", ['"Time","v","X"'], ",", "."),
+        ("crlf.csv", ["t,v,x"], ",", "."),
+        ("cr.csv", ["t,v,x"], ",", "."),
+    ],
+)
+def test_lab_text_layouts_read_as_the_canonical_csv(tmp_path, record, name, head, sep, decimal):
+    path = tmp_path / name
+    newline = {"crlf.csv": "\r\n", "cr.csv": "\r"}.get(name, "\n")
+    path.write_text(newline.join([*head, *_rows(record, sep, decimal)]) + newline, "utf-8")
+    columns = {"t": "time"} if name.startswith("mixed") else None
+    _same(path, record, columns=columns)
+
+
+def test_numpy_savetxt_header_and_semicolon_comma_export(tmp_path, record):
+    table = np.column_stack([record[k] for k in "tvx"])
+    path = tmp_path / "savetxt.txt"
+    np.savetxt(path, table, delimiter=",", header="t,v,x", fmt="%.17g")
+    _same(path, record)
+    canonical = tmp_path / "rec.csv"
+    write_table(canonical, record)
+    german = tmp_path / "export.csv"
+    german.write_text(canonical.read_text().replace(",", ";").replace(".", ","), "utf-8")
+    _same(german, record)
+
+
+def test_units_row_in_mm_is_converted(tmp_path, record):
+    path = tmp_path / "mm.csv"
+    mm = {**record, "x": record["x"] / 1000.0}
+    path.write_text("\n".join(["t,v,x", "s,V,mm", *_rows(mm)]) + "\n")
+    rec = read_record(path)
+    np.testing.assert_allclose(rec.x, record["x"], rtol=1e-15)
+    with pytest.raises(DataFileError, match=r"units row .* says the displacement is in mm"):
+        read_record(path, x_unit="um")
+    path.write_text("\n".join(["Time (s),v [V],x [mm]", *_rows(mm)]) + "\n")
+    np.testing.assert_allclose(read_record(path, columns={"t": "time"}).x, record["x"], rtol=1e-15)
+    path.write_text("\n".join(["t,v,x", "s,V,furlong", *_rows(record)]) + "\n")
+    with pytest.raises(DataFileError, match=r"no column 'x'.*columns are s, V, furlong"):
+        read_record(path)  # not a units row: the header is the last text line
+
+
+def test_mat_and_npz_of_one_matrix_with_numbered_columns(tmp_path, record):
+    matrix = np.column_stack([record["v"], record["t"], np.ones(300), record["x"]])
+    mat, npz = tmp_path / "one.mat", tmp_path / "one.npz"
+    scipy.io.savemat(mat, {"data": matrix})
+    np.savez(npz, data=matrix.T)  # samples along the longer side, whichever it is
+    for path in (mat, npz):
+        _same(path, record, columns={"t": 2, "v": 1, "x": 4})
+    with pytest.raises(DataFileError, match=r"one matrix 'data' \(300 x 4\).*t=1,v=2,x=3"):
+        read_record(npz)
+
+
+def test_duplicate_and_ambiguous_column_names_are_refused(tmp_path, record):
+    path = tmp_path / "dup.csv"
+    path.write_text("\n".join(["t,v,x,x", *(r + ",0" for r in _rows(record))]) + "\n")
+    with pytest.raises(DataFileError, match=r"more than one column x .*own name"):
+        read_record(path)
+    path.write_text("\n".join(["t,v,x,X", *(r + ",0" for r in _rows(record))]) + "\n")
+    with pytest.raises(DataFileError, match=r"more than one column X and x"):
+        read_record(path)
+    for bad in ({"v": 1, "x": 1}, {"v": "x", "x": "X"}):
+        with pytest.raises(InvalidParameterError, match=r"for both 'v' and 'x'"):
+            read_record(path, columns=bad)
+
+
+def test_cli_refuses_duplicates_and_reads_lab_files(tmp_path, record):
+    path = tmp_path / "dup.csv"
+    path.write_text("\n".join(["t;v;x;x", *(r + ";0" for r in _rows(record, ";"))]) + "\n")
+    runner = CliRunner()
+    model = str(tmp_path / "m.json")
+    result = runner.invoke(main, ["identify", str(path), "--model", "pi", "-o", model])
+    assert result.exit_code == 2
+    assert result.output.startswith("hystcomp: error: ")
+    assert "more than one column x" in (result.output)
+    result = runner.invoke(
+        main, ["identify", str(path), "--model", "pi", "--columns", "v=1,x=1", "-o", model]
+    )
+    assert result.exit_code == 2
+    assert "for both 'v' and 'x'" in result.output
+    assert not os.path.exists(model)
+
+
+def test_x_unit_converts_and_the_span_warns(tmp_path, record):
+    metres = {**record, "x": record["x"] * 1e-6}
+    path = tmp_path / "metres.csv"
+    write_table(path, metres)
+    rec = read_record(path, x_unit="m")
+    np.testing.assert_allclose(rec.x, record["x"], rtol=1e-14)
+    assert "looks like metres" in x_unit_warning(read_record(path).x, "metres.csv")
+    assert "--x-unit nm" in x_unit_warning(record["x"] * 1000.0, "f")
+    assert x_unit_warning(record["x"], "f") is None
+    with pytest.raises(InvalidParameterError, match="'x_unit' parameter of read_table"):
+        read_table(path, x_unit="inch")
+
+    runner = CliRunner()
+    model = tmp_path / "m.json"
+    args = ["identify", str(path), "--model", "pi", "--operators", "4", "-o", str(model)]
+    result = runner.invoke(main, args)
+    assert result.exit_code == 0, result.output
+    warnings = [line for line in result.output.splitlines() if "warning" in line]
+    assert len(warnings) == 1
+    assert warnings[0].startswith("hystcomp: warning: the displacement in ")
+    assert "--x-unit m" in warnings[0]
+    result = runner.invoke(main, [*args, "--x-unit", "m"])
+    assert result.exit_code == 0
+    assert "warning" not in result.output
+    assert f"x {record['x'].min():.4g} .. {record['x'].max():.4g} µm" in result.output
+    result = runner.invoke(main, [*args, "--quiet"])
+    assert result.exit_code == 0
+    assert "warning" not in result.output
+    result = runner.invoke(main, [*args, "--x-unit", "yd"])
+    assert result.exit_code == 2
+
+
+def _npz_declaring(path, shape):
+    """An NPZ whose member declares ``shape`` float64 values but holds few bytes."""
+    header = {"descr": "<f8", "fortran_order": False, "shape": shape}
+    with zipfile.ZipFile(path, "w") as archive, archive.open("v.npy", "w") as member:
+        np.lib.format.write_array_header_1_0(member, header)
+        member.write(b"\0" * 64)
+
+
+def test_declared_sizes_are_refused_before_loading(tmp_path, monkeypatch):
+    path = tmp_path / "huge.npz"
+    _npz_declaring(path, (500_000_000,))
+    with pytest.raises(DataFileError, match=r"'v' of shape \(500000000,\), more than 100000000"):
+        read_table(path, ("v",), sample_rate=1.0)
+    assert max_samples() == MAX_SAMPLES
+    monkeypatch.setenv("HYSTCOMP_MAX_SAMPLES", "100")
+    _npz_declaring(path, (101, 1))
+    with pytest.raises(DataFileError, match=r"more than 100 samples.*HYSTCOMP_MAX_SAMPLES"):
+        read_table(path, ("v",), sample_rate=1.0)
+    mat = tmp_path / "big.mat"
+    scipy.io.savemat(mat, {"v": np.zeros(101)})
+    with pytest.raises(DataFileError, match=r"'v' of shape \(1, 101\), more than 100"):
+        read_table(mat, ("v",), sample_rate=1.0)
+    csv = tmp_path / "long.csv"
+    csv.write_text("v\n" + "1\n" * 101)
+    with pytest.raises(DataFileError, match=r"more than 100 rows"):
+        read_table(csv, ("v",), sample_rate=1.0)
+    monkeypatch.setenv("HYSTCOMP_MAX_SAMPLES", "lots")
+    with pytest.raises(DataFileError, match="HYSTCOMP_MAX_SAMPLES must be a whole number"):
+        read_table(csv, ("v",), sample_rate=1.0)
+
+
+def test_chunked_read_and_write_round_trip_across_chunks(tmp_path, rng, monkeypatch):
+    import hystcomp._text as text
+    from hystcomp._formats import read_raw
+
+    monkeypatch.setattr(text, "CHUNK_BYTES", 1000)  # many chunks, rows cut anywhere
+    monkeypatch.setattr(text, "SMALL_TABLE", 0)  # the compiled formatter, even for few rows
+    n = 2000
+    table = {
+        "t": np.arange(n) / 3e3,
+        "v": rng.standard_normal(n),
+        "x": rng.standard_normal(n) * 1e-3,
+        "w": rng.standard_normal(n) * 10.0 ** rng.integers(-300, 300, n),
+    }
+    path = tmp_path / "long.csv"
+    write_table(path, table)
+    lines = path.read_text().splitlines()
+    assert lines[0] == "t,v,x,w"
+    assert lines[1:] == [",".join(repr(float(table[k][i])) for k in "tvxw") for i in range(n)]
+    names, columns, _, _ = read_raw(path)
+    assert names == list("tvxw")
+    for key, column in zip(names, columns, strict=True):
+        np.testing.assert_array_equal(column, table[key])
+    path.write_text(path.read_text().replace("\n", "\n\n# a remark\n", 5))
+    for key in "tvx":
+        np.testing.assert_array_equal(read_table(path)[key], table[key])
+    path.write_text("\n".join([*lines[:1500], "1,2", *lines[1500:]]) + "\n")
+    with pytest.raises(DataFileError, match=r"not a table of numbers.*after data row"):
+        read_table(path)
+
+
+_PEAK = (
+    "import resource, sys\n"
+    "import numpy as np\n"
+    "from hystcomp.data import read_record, write_table\n"
+    "def peak():  # MB; VmHWM, as ru_maxrss keeps the parent's peak across fork and exec\n"
+    "    for line in open('/proc/self/status'):\n"
+    "        if line.startswith('VmHWM:'):\n"
+    "            return int(line.split()[1]) / 1024\n"
+    "    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024\n"
+)
+
+
+def _growth(step: str, path) -> float:
+    """Peak memory growth (MB) of ``step`` in a fresh process, over its imports."""
+    code = _PEAK + "base = peak()\n" + step + "\nprint(peak() - base)\n"
+    out = subprocess.run(
+        [sys.executable, "-c", code, str(path)], capture_output=True, text=True, check=True
+    )
+    return float(out.stdout)
+
+
+def test_writing_and_reading_stay_in_bounded_memory(tmp_path):
+    """Peak memory of writing, then reading, a 5e5-sample CSV (12 MB of values)."""
+    path = tmp_path / "big.csv"
+    make = "t = np.arange(500_000) / 2e4; table = {'t': t, 'v': np.sin(t), 'x': np.cos(t)}\n"
+    # the table (12 MB), chunk buffers and loading the compiled formatter (~40 MB); writing
+    # whole lists of Python floats and strings took about 190 MB
+    assert _growth(make + "write_table(sys.argv[1], table)", path) < 100
+    # the parsed table and the record's own copies (2 x 12 MB), chunk buffers (2 MB of text)
+    assert _growth("rec = read_record(sys.argv[1])", path) < 50
