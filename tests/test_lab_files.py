@@ -227,6 +227,7 @@ _PEAK = (
     "import resource, sys\n"
     "import numpy as np\n"
     "from hystcomp.data import read_record, write_table\n"
+    "import hystcomp._floattext  # numba, which the writer loads on first use\n"
     "def peak():  # MB; VmHWM, as ru_maxrss keeps the parent's peak across fork and exec\n"
     "    for line in open('/proc/self/status'):\n"
     "        if line.startswith('VmHWM:'):\n"

@@ -10,7 +10,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from hystcomp.errors import InvalidParameterError
-from hystcomp.experiment.figures import _thin, fixed_layout
+from hystcomp.experiment._layout import _thin, fixed_layout
 from hystcomp.io import atomic_path
 
 FORMATS = (".png", ".pdf", ".svg")

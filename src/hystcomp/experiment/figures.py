@@ -12,9 +12,9 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
+from hystcomp.experiment._layout import _thin, fixed_layout, new_figure
 from hystcomp.experiment.fig_identification import plot_identification
 from hystcomp.experiment.fig_preisach import plot_preisach_loops
 from hystcomp.experiment.metrics import SATURATION_ZONE
@@ -29,44 +29,13 @@ def _save(fig: Figure, path: Path) -> None:
         fig.savefig(tmp, format="png", dpi=130)
 
 
-def _thin(n: int, points: int = 5000) -> slice:
-    """Every k-th sample, so that a line has about ``points`` points (plots only)."""
-    return slice(None, None, max(1, n // points))
-
-
-def _new_figure(size) -> Figure:
-    fig = Figure(figsize=size)
-    FigureCanvasAgg(fig)
-    return fig
-
-
-def fixed_layout(fig: Figure, *, left, right, top, bottom, hgap=0.0, wgap=0.0, rows=1, cols=1):
-    """Place a grid of ``rows`` x ``cols`` axes with margins and gaps given in inches.
-
-    The space for tick labels, axis labels and titles is known in advance for these
-    figures, so it is set once instead of measured (a constrained layout draws every text
-    twice more).
-    """
-    width, height = fig.get_size_inches()
-    axes_w = (width - left - right - (cols - 1) * wgap) / cols
-    axes_h = (height - top - bottom - (rows - 1) * hgap) / rows
-    fig.subplots_adjust(
-        left=left / width,
-        right=1.0 - right / width,
-        top=1.0 - top / height,
-        bottom=bottom / height,
-        wspace=wgap / axes_w,
-        hspace=hgap / axes_h,
-    )
-
-
 def figure_9(results: dict, path: Path) -> None:
     """Fig. 9: measured displacement against the reference at one frequency, four methods.
 
     ``results`` maps each method to its :class:`~hystcomp.experiment.tracking.TrackingResult`;
     the inset zooms on the saturation zone (top quarter of the reference range).
     """
-    fig = _new_figure((7.5, 6.0))
+    fig = new_figure((7.5, 6.0))
     fixed_layout(fig, left=0.75, right=0.15, top=0.4, bottom=0.6)
     ax = fig.add_subplot()
     top = max(float(r.x_ref.max()) for r in results.values())
@@ -107,7 +76,7 @@ def figure_10(results: dict, path: Path) -> None:
     ``results[frequency][method]`` are tracking results; the measured window is shown.
     """
     frequencies = sorted(results)
-    fig = _new_figure((11.0, 3.0 * len(frequencies) + 0.3))
+    fig = new_figure((11.0, 3.0 * len(frequencies) + 0.3))
     fixed_layout(
         fig, left=0.75, right=0.15, top=0.75, bottom=0.55, hgap=0.85, wgap=0.9,
         rows=len(frequencies), cols=2,
