@@ -41,7 +41,7 @@ COMMANDS = {
     ),
     "excite": (
         "hystcomp.cli.excite",
-        "Write the identification input for MODEL (pi, mpi or preisach).",
+        "Write the identification input for MODEL (pi, mpi, preisach or rich).",
     ),
     "export-c": (
         "hystcomp.cli.export_c",
