@@ -178,6 +178,7 @@ def test_preisach_through_every_command(tmp_path):
     t, v = (read_table(tmp_path / "v.csv", ("v",))[k] for k in "tv")
     write_table(tmp_path / "rec.csv", {"t": t, "v": v, "x": true.simulate(v) - 120.0})
     args = ["identify", tmp_path / "rec.csv", "--model", "preisach", "--degree", "3"]
+    args += ["--fit", "reversal-curves"]  # the paper's fit: eq. 5 to the reversal curves
     result = run(*args, "-o", tmp_path / "m.json")
     assert result.exit_code == 0, result.output
     assert result.output.startswith("Preisach model from")

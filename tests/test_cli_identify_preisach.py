@@ -18,18 +18,19 @@ def test_the_real_record_predicts_its_second_half_far_better_than_a_line(tmp_pat
     args = ["identify", REAL_RECORD, "--model", "preisach", "--columns", "v=1,x=5"]
     result = run(*args, "--fs", "200", "--holdout", "0.5", "-o", out)
     assert result.exit_code == 0, result.output
-    assert "least squares over the record" in result.output
-    assert "(auto: the record has too few first-order descending curves)" in result.output
+    assert "25 x 25 table, least squares over the record" in result.output
+    assert "compensation (estimated)" in result.output
     model = hystcomp.load_model(out)
     assert model.fit_report_["fit"] == "least-squares"
     assert model.fit_report_["first_used_sample"] == 0  # the CLI cut the transient (44 samples)
+    assert model.fit_report_["tracking_rms_um"] < model.fit_report_["baseline_tracking_rms_um"]
     better = float(result.output.split("µm: ")[1].split("x better")[0])
     assert better > 1 / 0.3  # the model's hold-out error is < 0.3x the straight line's
-    table = tmp_path / "t.json"
-    result = run(*args, "--fs", "200", "--holdout", "0.5", "--everett", "table", "-o", table)
+    cubic = tmp_path / "c.json"
+    result = run(*args, "--fs", "200", "--holdout", "0.5", "--degree", "3", "-o", cubic)
     assert result.exit_code == 0, result.output
-    assert "25 x 25 table" in result.output
-    assert float(result.output.split("µm: ")[1].split("x better")[0]) > better
+    assert "degree-3 polynomial, least squares" in result.output  # --degree: the polynomial
+    assert float(result.output.split("µm: ")[1].split("x better")[0]) < better
 
 
 def test_fit_choices_and_the_table_go_into_the_model_file(tmp_path):
@@ -37,14 +38,18 @@ def test_fit_choices_and_the_table_go_into_the_model_file(tmp_path):
     x = presets.paper_preisach(zero_diagonal=True).simulate(v) - 20.0
     write_table(tmp_path / "rec.csv", {"t": np.arange(v.size) / 500.0, "v": v, "x": x})
     base = ["identify", tmp_path / "rec.csv", "--model", "preisach"]
-    result = run(*base, "--fit", "reversal-curves", "-o", tmp_path / "paper.json")
+    paper = ["--fit", "reversal-curves", "--everett", "polynomial"]
+    result = run(*base, *paper, "-o", tmp_path / "paper.json")
     assert result.exit_code == 0, result.output
-    assert "reversal curves from 4 maxima (paper, Section III-A)" in result.output
+    assert "polynomial, reversal curves from 4 maxima (paper, Section III-A)" in result.output
+    result = run(*base, "--fit", "reversal-curves", "-o", tmp_path / "rc.json")
+    assert result.exit_code == 0, result.output
+    assert "25 x 25 table, reversal curves from 4 maxima\n" in result.output
     result = run(*base, "--everett", "table", "--grid", "13", "-o", tmp_path / "t.json")
     assert result.exit_code == 0, result.output
     assert "13 x 13 table, least squares" in result.output
     doc = json.loads((tmp_path / "t.json").read_text())
-    assert doc["hyperparameters"]["fit_method"] == "auto"
+    assert doc["hyperparameters"]["fit_method"] == "least-squares"
     assert np.array(doc["parameters"]["table"]).shape == (13, 13)
     model = hystcomp.load_model(tmp_path / "t.json")
     assert model.fit_report_["density_min"] >= -1e-9
@@ -62,7 +67,7 @@ def test_fit_choices_and_the_table_go_into_the_model_file(tmp_path):
 @pytest.mark.parametrize(
     ("extra", "message"),
     [
-        (["--grid", "9"], r"--grid applies to --everett table"),
+        (["--everett", "polynomial", "--grid", "9"], r"--grid applies to --everett table"),
         (["--everett", "table", "--degree", "4"], r"--degree applies to --everett polynomial"),
         (["--fit", "paper"], r"'paper' is not one of 'auto', 'reversal-curves', 'least-squares'"),
         (["--everett", "table", "--grid", "1"], r"--grid.*1 is not in the range 2<=x<=41"),

@@ -228,8 +228,10 @@ def identified_preisach():
     table = 0.2 * (a - b) + 9.0 * np.tanh((a - b) / 60.0) ** 2 * (1 + a / 120.0)
     x = hystcomp.Preisach.from_parameters(table=np.tril(table)).simulate(v)
     return {
-        "quartic_bipolar": hystcomp.Preisach(degree=4).fit(2.5 * v - 150.0, x - 120.0),
-        "table": hystcomp.Preisach(everett="table").fit(v, x),
+        "quartic_bipolar": hystcomp.Preisach(degree=4, everett="polynomial", fit_method="auto").fit(
+            2.5 * v - 150.0, x - 120.0
+        ),
+        "table": hystcomp.Preisach(everett="table", fit_method="auto").fit(v, x),
     }
 
 

@@ -60,7 +60,7 @@ def test_estimate_is_zero_for_an_exact_model_and_the_line_residual_for_a_line():
 def test_estimate_works_for_a_preisach_model_and_predicts_its_tracking(twin_record):
     bench = Bench("twin", sample_rate=5000.0)
     v, x = bench.record("preisach")
-    model = hystcomp.Preisach().fit(v, x)
+    model = hystcomp.Preisach(fit_method="reversal-curves", everett="polynomial").fit(v, x)
     est = compensation_error(model, v, x)
     measured = bench.ratio(model) * bench.baseline_rms
     assert est["ratio"] < 0.5
@@ -101,6 +101,34 @@ def test_panel_subset_tracks_within_targets_from_the_paper_triangles(name, pi_ta
     mpi = bench.ratio(hystcomp.ModifiedPrandtlIshlinskii().fit(v, x))
     assert pi < pi_target
     assert mpi < mpi_target
+
+
+@pytest.mark.parametrize(("name", "excitation"), [("kp", "pi"), ("preisach", "rich")])
+def test_panel_subset_preisach_default_tracks_within_target(name, excitation):
+    """The default Preisach fit (least squares, 25 x 25 table) from records that are not the
+    paper's sinusoids, below 0.25x the uncompensated error (measured at 5 kHz: kp 0.02x,
+    preisach 0.14x); its fit report predicts the compensator beats the straight line."""
+    bench = Bench(name, sample_rate=5000.0)
+    v, x = bench.record(excitation)
+    model = hystcomp.Preisach().fit(v, x)
+    assert bench.ratio(model) < 0.25
+    report = model.fit_report_
+    # the estimate is pessimistic on the saturated Preisach stage (0.66x for 0.14x measured)
+    assert report["tracking_rms_um"] < report["baseline_tracking_rms_um"]
+
+
+@pytest.mark.slow
+def test_whole_panel_within_targets():
+    """Every cell of benchmarks/bench_accuracy.py (about 3 minutes). Preisach meets its
+    target (< 0.25x, worst 0.16x); PI and MPI are held where they are, so that none
+    regresses: they miss their targets (0.5x, 0.2x) on the Bouc-Wen stages and PI from the
+    sinusoids on the Krasnosel'skii-Pokrovskii stage (worst 0.62x and 0.49x)."""
+    from benchmarks.bench_accuracy import ratio_table
+
+    for (name, exc), cells in ratio_table().items():
+        assert cells["Preisach"] < 0.25, (name, exc, cells)
+        assert cells["PI"] < 0.65, (name, exc, cells)
+        assert cells["MPI"] < 0.55, (name, exc, cells)
 
 
 def test_real_record_holdout_stays_well_below_the_straight_line():

@@ -145,7 +145,7 @@ def compensator(request):
         from hystcomp.identify.excitation import PI_AMPLITUDES, sinusoid_sequence
 
         _, v = sinusoid_sequence(PI_AMPLITUDES, sample_rate=FS)
-        model = hystcomp.Preisach(degree=3).fit(v, twin.run(v))
+        model = hystcomp.Preisach(everett="polynomial").fit(v, twin.run(v))
     return model.inverse(dynamics=_stage(), slew_rate=2e5)
 
 
@@ -233,7 +233,7 @@ def test_targets_on_a_creep_stage():
     _, v = dynamics_excitation()
     dyn = LinearDynamics().fit(v, twin.run(v), FS)
     _, v = sinusoid_sequence(PI_AMPLITUDES, sample_rate=FS)
-    model = hystcomp.Preisach(degree=3).fit(v, twin.run(v))
+    model = hystcomp.Preisach(everett="polynomial").fit(v, twin.run(v))
     comp = model.inverse(dynamics=dyn)
     rms = {}
     for f in (1.0, 100.0, 200.0):

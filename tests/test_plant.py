@@ -143,7 +143,7 @@ def test_bad_arguments_are_refused():
     [
         (hystcomp.ModifiedPrandtlIshlinskii(n_operators=16, n_deadzones=16), triangle_sequence),
         (hystcomp.PrandtlIshlinskii(n_operators=16), triangle_sequence),
-        (hystcomp.Preisach(degree=3), sinusoid_sequence),
+        (hystcomp.Preisach(everett="polynomial", fit_method="reversal-curves"), sinusoid_sequence),
     ],
     ids=["mpi", "pi", "preisach"],
 )

@@ -242,6 +242,19 @@ def test_model_file_round_trip(make, tmp_path, rng):
     assert np.array_equal(loaded.inverse().simulate(x), model.inverse().simulate(x))
 
 
+def test_model_file_written_before_the_table_default_loads_as_a_polynomial(tmp_path):
+    # a file of the earlier default (cubic of eq. 5) names no Everett representation
+    path = tmp_path / "old.json"
+    doc = {"format": "hystcomp-model", "version": 1, "kind": "preisach"}
+    params = {"theta": list(presets.PAPER_PREISACH_THETA), "voltage_range": [0.0, 120.0]}
+    hyper = {"degree": 3, "voltage_range": None, "zero_diagonal": False, "max_extrema": 1024}
+    path.write_text(json.dumps({**doc, "hyperparameters": hyper, "parameters": params}))
+    loaded = hystcomp.load_model(path)
+    assert (loaded.everett, loaded.degree) == ("polynomial", 3)
+    v = np.linspace(0.0, 120.0, 50)
+    assert np.array_equal(loaded.simulate(v), presets.paper_preisach().simulate(v))
+
+
 def test_model_file_with_bad_theta_is_refused(tmp_path):
     path = tmp_path / "m.json"
     doc = {"format": "hystcomp-model", "version": 1, "kind": "preisach"}

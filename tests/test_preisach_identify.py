@@ -15,6 +15,9 @@ from hystcomp.identify.preisach import find_reversal_curves, identify_preisach
 from hystcomp.models.preisach import Preisach
 from tests.conftest import monotone_theta
 
+#: The paper's fit: eq. (5) by least squares on the reversal curves (Section III-A).
+PAPER = {"fit_method": "reversal-curves", "everett": "polynomial"}
+
 
 @pytest.fixture(scope="module")
 def excitation():
@@ -33,7 +36,7 @@ def test_recovers_eq_6_from_its_own_response(excitation):
     truth = presets.paper_preisach()
     x = truth.simulate(excitation)
     # eq. (6) has X(v, v) != 0: the paper's unconstrained least squares recovers it
-    model = Preisach(zero_diagonal=False).fit(excitation, x)
+    model = Preisach(**PAPER, zero_diagonal=False).fit(excitation, x)
     np.testing.assert_allclose(model.theta_, presets.PAPER_PREISACH_THETA, rtol=1e-4)
     assert _surface_error(model, truth) < 1e-4
     assert model.fit_report_["n_curves"] == 24
@@ -44,7 +47,7 @@ def test_recovers_eq_6_from_its_own_response(excitation):
 def test_recovers_eq_6_with_5_nm_noise_and_an_offset(excitation, rng):
     truth = presets.paper_preisach()
     x = truth.simulate(excitation) - 120.0 + 0.005 * rng.standard_normal(excitation.size)
-    model = Preisach(zero_diagonal=False).fit(excitation, x)
+    model = Preisach(**PAPER, zero_diagonal=False).fit(excitation, x)
     np.testing.assert_allclose(model.theta_, presets.PAPER_PREISACH_THETA, rtol=0.01)
     # each coefficient's contribution at full scale (120 V) within 30 nm
     powers = np.array([1, 1, 2, 2, 2, 3, 3, 3, 3])
@@ -57,7 +60,7 @@ def test_recovers_eq_6_with_5_nm_noise_and_an_offset(excitation, rng):
 
 def test_zero_diagonal_fit_of_a_continuous_model_is_exact(excitation, rng):
     truth = Preisach.from_parameters(theta=monotone_theta(rng, 3, 120.0, 36.0))
-    model = Preisach().fit(excitation, truth.simulate(excitation))
+    model = Preisach(**PAPER).fit(excitation, truth.simulate(excitation))
     assert _surface_error(model, truth) < 1e-4
     g = np.linspace(0, 120, 25)
     np.testing.assert_allclose(model.everett_function(g, g), 0.0, atol=1e-12)
@@ -75,12 +78,12 @@ def test_other_ranges_rates_offsets_and_noise(voltage_range, sample_rate, offset
     amplitudes = scaled_amplitudes(PREISACH_AMPLITUDES, voltage_range=voltage_range)
     _, v = sinusoid_sequence(amplitudes, sample_rate=sample_rate, v_min=lo)
     x = truth.simulate(v) + offset + 0.005 * rng.standard_normal(v.size)
-    model = Preisach().fit(v, x)
+    model = Preisach(**PAPER).fit(v, x)
     assert model.voltage_range_ == pytest.approx(voltage_range, abs=1e-3 * (hi - lo))
     assert model.output_offset_ == pytest.approx(offset, abs=0.01)
     assert _surface_error(model, truth) < 0.03  # of a 40 µm stroke
     assert model.fit_report_["n_curves"] == 24
-    table = Preisach(everett="table").fit(v, x)
+    table = Preisach(fit_method="reversal-curves", everett="table").fit(v, x)
     assert _surface_error(table, truth) < 0.1
 
 
@@ -114,9 +117,9 @@ def test_fitted_model_reproduces_a_continuous_non_polynomial_preisach_system(exc
     truth_table = 0.2 * (a - b) + 9.0 * np.tanh((a - b) / 60.0) ** 2 * (1 + a / 120.0)
     truth = Preisach.from_parameters(table=np.tril(truth_table))
     x = truth.simulate(excitation)
-    cubic = Preisach().fit(excitation, x)
-    quartic = Preisach(degree=4).fit(excitation, x)
-    table = Preisach(everett="table").fit(excitation, x)
+    cubic = Preisach(**PAPER).fit(excitation, x)
+    quartic = Preisach(**PAPER, degree=4).fit(excitation, x)
+    table = Preisach(fit_method="reversal-curves", everett="table").fit(excitation, x)
     # a higher degree or the table follow the non-polynomial X better
     assert cubic.fit_report_["record_rms_um"] < 0.4  # of a 40 µm stroke
     assert quartic.fit_report_["record_rms_um"] < 0.05
@@ -130,8 +133,8 @@ def test_reversal_curve_fit_of_a_record_without_them_names_the_fix():
     ramp = np.linspace(0.0, 120.0, 1000)
     with pytest.raises(IdentificationError, match=r"no first-order descending.*excite preisach"):
         Preisach(fit_method="reversal-curves").fit(ramp, 0.3 * ramp)
-    # the default falls back to least squares, which a ramp determines along X(v, 0)
-    model = Preisach().fit(ramp, 0.3 * ramp)
+    # least squares (the default, and auto's choice here) is determined along X(v, 0)
+    model = Preisach(fit_method="auto").fit(ramp, 0.3 * ramp)
     assert model.fit_report_["fit"] == "least-squares"
     np.testing.assert_allclose(model.simulate(ramp), 0.3 * ramp, atol=1e-6)
 
@@ -143,12 +146,12 @@ def test_reversal_curve_fit_of_one_amplitude_names_what_is_missing(rng):
     with pytest.raises(
         IdentificationError, match=r"1 distinct maximum \(3\.6 V\).*excite preisach"
     ):
-        Preisach(fit_method="reversal-curves").fit(v, x)
+        Preisach(**PAPER).fit(v, x)
     with pytest.raises(IdentificationError, match=r"1 distinct maximum"):
         Preisach(everett="table", fit_method="reversal-curves").fit(v, x)
     with pytest.raises(IdentificationError, match=r"constant"):
         Preisach().fit(np.full(10, 2.0), np.zeros(10))
-    assert Preisach().fit(v, x).fit_report_["fit"] == "least-squares"
+    assert Preisach(fit_method="auto").fit(v, x).fit_report_["fit"] == "least-squares"
 
 
 @pytest.mark.parametrize(

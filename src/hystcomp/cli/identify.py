@@ -97,8 +97,10 @@ def _everett_params(fit, everett, degree, grid) -> dict:
     """The Preisach estimator's ``fit_method``, ``everett`` and ``grid_size`` from the options."""
     if everett == "table" and degree is not None:
         raise click.UsageError("--degree applies to --everett polynomial; a table has --grid.")
-    if grid is not None and everett != "table":
+    if grid is not None and everett == "polynomial":
         raise click.UsageError("--grid applies to --everett table.")
+    if degree is not None and everett is None:
+        everett = "polynomial"  # a degree names the polynomial of eq. 5, not the default table
     params = {}
     if fit is not None:
         params["fit_method"] = fit
@@ -173,24 +175,26 @@ def _sizes(model) -> str:
     "--degree",
     type=click.IntRange(1, MAX_DEGREE),
     default=None,
-    help="Degree of the Everett polynomial, preisach [3, eq. 5].",
+    help="Degree of the Everett polynomial of a preisach model; implies --everett polynomial "
+    "[3, eq. 5].",
 )
 @click.option(
     "--fit",
     type=click.Choice(FIT_METHODS),
     default=None,
-    help="How the preisach model is fitted [auto]: reversal-curves is the paper's fit of eq. 5 "
-    "to first-order descending curves (the record of `hystcomp excite preisach`); "
-    "least-squares fits the model's output over any record that sweeps the range, with a "
-    "non-negative Preisach density; auto takes the reversal curves when the record has them "
-    "from 8 or more maxima, else least squares.",
+    help="How the preisach model is fitted [least-squares]: least-squares fits the model's "
+    "output over any record that sweeps the range, with a non-negative Preisach density; "
+    "reversal-curves fits X to first-order descending curves (the record of `hystcomp excite "
+    "preisach`), with --everett polynomial the paper's fit of eq. 5 (Section III-A); auto takes "
+    "the reversal curves when the record has them from 8 or more maxima, else least squares.",
 )
 @click.option(
     "--everett",
     type=click.Choice(EVERETT_KINDS),
     default=None,
-    help="Everett function of the preisach model: the polynomial of eq. 5 (--degree) or a "
-    "table interpolated bilinearly (--grid) [polynomial].",
+    help="Everett function of the preisach model: a table interpolated bilinearly (--grid) "
+    "[table: it tracks better than the cubic on every actuator of benchmarks/bench_accuracy.py] "
+    "or the polynomial of eq. 5 (--degree).",
 )
 @click.option(
     "--grid",
@@ -283,8 +287,8 @@ def identify(
 
     PI and MPI: constrained least squares (eqs. 16-19) with invertible weights; the
     start-up transient, the input range (bipolar too) and a displacement offset are handled.
-    Preisach: the paper's fit to reversal curves (Section III-A) or least squares over any
-    record (--fit). dynamics (beyond the paper): creep and first resonance from the answer to
+    Preisach: least squares over any record with a tabulated Everett function by default;
+    --fit reversal-curves --everett polynomial is the paper's fit (Section III-A, eq. 5). dynamics (beyond the paper): creep and first resonance from the answer to
     'hystcomp excite dynamics', for compensate/export-c --dynamics; --plot draws its Bode plot.
     By default the play weights beyond the first are non-negative (--constraints physical);
     --constraints paper --regularization 0 is eq. 19 as printed.
@@ -425,7 +429,9 @@ def _preisach_fit_line(model) -> str:
         else f"degree-{model.degree} polynomial"
     )
     if report["fit"] == "reversal-curves":
-        how = f"reversal curves from {report['n_curves']} maxima (paper, Section III-A)"
+        how = f"reversal curves from {report['n_curves']} maxima"
+        if model.everett == "polynomial":
+            how += " (paper, Section III-A)"
     else:
         how = "least squares over the record, non-negative density"
     why = ""

@@ -171,7 +171,9 @@ def identify_models(
     config = CompareConfig() if config is None else config
     pi = PrandtlIshlinskii(n_operators=config.n_operators)
     mpi = ModifiedPrandtlIshlinskii(n_operators=config.n_operators, n_deadzones=config.n_deadzones)
-    preisach = Preisach(degree=config.preisach_degree, fit_method="reversal-curves")
+    preisach = Preisach(
+        degree=config.preisach_degree, everett="polynomial", fit_method="reversal-curves"
+    )  # the paper's fit (Section III-A), not the library's default
     return {
         "preisach": preisach.fit(record_preisach.v, record_preisach.x),
         "pi": pi.fit(record_pi.v, record_pi.x),

@@ -13,7 +13,9 @@ from hystcomp import paper
 from hystcomp import preisach_kernels as pk
 from hystcomp._validation import as_signal, as_vector, check_int, check_range, check_real
 from hystcomp.errors import InvalidParameterError, InvalidTypeError
+from hystcomp.identify.compensation import compensation_error
 from hystcomp.identify.preisach import MAX_DEGREE, check_options, identify_preisach
+from hystcomp.identify.scoring import transient_end
 from hystcomp.models.base import DEFAULT_VOLTAGE_RANGE, HysteresisModel, slew_to_step
 from hystcomp.models.compensator import Compensator, Stepper
 from hystcomp.models.dynamic_compensator import with_dynamics
@@ -59,14 +61,44 @@ class Preisach(HysteresisModel):
     by eq. 2, but a least-squares polynomial only approximately) the output steps by
     ``X(v, v)`` at each reversal; ``fit_report_["diagonal_max_um"]`` says how much.
 
+    Defaults (a deviation from the paper): ``fit`` fits X by least squares over the whole
+    record with a non-negative density, as a 25 x 25 table. The paper's fit, eq. (5) fitted
+    to the first-order descending curves of its sinusoids (Section III-A), is
+    ``Preisach(fit_method="reversal-curves", everett="polynomial")``; ``hystcomp compare``
+    runs it for Table I. The defaults were chosen by the measured tracking of a 1 Hz
+    triangle on the panel of ``benchmarks/bench_accuracy.py`` (5 actuators of none of the
+    model families x 4 excitations; rms error over the uncompensated one, worst / median
+    cell; ``python benchmarks/bench_accuracy.py --preisach``):
+
+    ==========================================  ============  ============
+    fit                                         worst         median
+    ==========================================  ============  ============
+    paper: reversal curves, cubic (sinusoids)   0.51          0.16
+    reversal curves, 25 x 25 table (sinusoids)  0.48          0.11
+    least squares, cubic                        0.31          0.16
+    least squares, 13 x 13 table                0.14          0.081
+    least squares, 17 x 17 table                0.14          0.080
+    least squares, 25 x 25 table (default)      0.16          0.074
+    least squares, 33 x 33 table                0.27          0.069
+    ==========================================  ============  ============
+
+    The reversal-curve fits have the sinusoids' 5 cells only, the others all 20. Least
+    squares with a table tracks at least as well as the cubic in every cell (better in 19 of
+    20: a cubic cannot follow a density that is not polynomial) and better than the paper's
+    fit on the paper's own record on every actuator (0.01 to 0.16x against 0.13 to 0.51x).
+    Of the grids, 25 nodes per axis has the best median; 13 and 17 have a slightly lower
+    worst cell (the Duhem stage from the sinusoids, 0.14x against 0.16x), and 33 over-fits
+    there (0.27x).
+
     Parameters
     ----------
     degree : int, default 3
-        Degree of the Everett polynomial (3 is eq. 5).
-    everett : {"polynomial", "table"}, default "polynomial"
-        Representation of X that ``fit`` identifies.
+        Degree of the Everett polynomial (3 is eq. 5), for ``everett="polynomial"``.
+    everett : {"table", "polynomial"}, default "table"
+        Representation of X that ``fit`` identifies: a table interpolated bilinearly, or
+        the polynomial of eq. (5) (``degree``).
     grid_size : int, default 25
-        Nodes per axis of a table.
+        Nodes per axis of a table (25: one every 5 V on 0..120 V).
     voltage_range : (float, float) or None, default None
         The Preisach plane and the compensators' output range, in V; None takes the
         identification record's range (``v_min`` is its minimum).
@@ -74,13 +106,15 @@ class Preisach(HysteresisModel):
         Bound of the memory (stored extrema, ``beta_0`` included). When a reversal would
         exceed it the innermost stored minor loop is wiped out first; the default is far
         beyond what measured signals reach.
-    fit_method : {"auto", "reversal-curves", "least-squares"}, default "auto"
-        How ``fit`` identifies X: ``"reversal-curves"`` is the paper's fit to the
-        first-order descending curves of the record (Section III-A, the response to
-        ``hystcomp excite preisach``); ``"least-squares"`` fits the model's output over the
-        whole record, any record that sweeps the range, with a non-negative Preisach
-        density (so every branch rises and the exact inverse exists); ``"auto"`` takes the
-        reversal curves when the record has them from 8 or more maxima, else least squares.
+    fit_method : {"least-squares", "reversal-curves", "auto"}, default "least-squares"
+        How ``fit`` identifies X: ``"least-squares"`` fits the model's output over the
+        whole record, any record that sweeps the range (``hystcomp excite rich``, the
+        paper's triangles or sinusoids, a measured record), with a non-negative Preisach
+        density (so every branch rises and the exact inverse exists);
+        ``"reversal-curves"`` fits X to the first-order descending curves of the record
+        (Section III-A, the response to ``hystcomp excite preisach``), with
+        ``everett="polynomial"`` the paper's fit; ``"auto"`` takes the reversal curves when
+        the record has them from 8 or more maxima, else least squares.
         See :func:`~hystcomp.identify.preisach.identify_preisach`.
 
     Attributes
@@ -112,12 +146,12 @@ class Preisach(HysteresisModel):
         self,
         *,
         degree=3,
-        everett="polynomial",
+        everett="table",
         grid_size=25,
         voltage_range=None,
         zero_diagonal=True,
         max_extrema=pk.DEFAULT_DEPTH,
-        fit_method="auto",
+        fit_method="least-squares",
     ):
         self.degree = degree
         self.everett = everett
@@ -164,6 +198,7 @@ class Preisach(HysteresisModel):
                     f"Got {theta.size} instead."
                 )
             model.degree = sizes[theta.size]
+            model.everett = "polynomial"
             model.theta_, model.table_ = theta, None
         else:
             model.everett = "table"
@@ -186,7 +221,11 @@ class Preisach(HysteresisModel):
         Returns
         -------
         Preisach
-            ``self``, fitted; ``fit_report_`` holds the fit's figures.
+            ``self``, fitted; ``fit_report_`` holds the fit's figures, among them
+            ``tracking_rms_um`` (the estimated tracking error of ``inverse()``, µm rms,
+            :func:`hystcomp.identify.compensation.compensation_error`, from the first sample
+            at an end of the range on) and ``baseline_tracking_rms_um`` (the same for a
+            straight line ``v = x / k_lin``), as for PI and MPI.
         """
         self._check_hyperparameters()
         result = identify_preisach(
@@ -203,7 +242,11 @@ class Preisach(HysteresisModel):
         self.table_ = None if result.table is None else _frozen(result.table)
         self.voltage_range_ = result.voltage_range
         self.output_offset_ = result.output_offset
-        self.fit_report_ = result.report
+        report = dict(result.report)
+        est = compensation_error(self, v, x, start=transient_end(v))
+        report["tracking_rms_um"] = est["tracking_rms_um"]
+        report["baseline_tracking_rms_um"] = est["baseline_rms_um"]
+        self.fit_report_ = report
         return self
 
     def _derived_hyperparameters(self) -> dict:
