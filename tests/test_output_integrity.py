@@ -240,7 +240,7 @@ STALLED = textwrap.dedent(
     from hystcomp.io import atomic_path
     from hystcomp.cli import main, compensate
 
-    def stalled_write(path, table):
+    def stalled_write(path, table, **options):
         with atomic_path(path) as tmp:
             tmp.write_text("half")
             print("writing", flush=True)
@@ -257,7 +257,7 @@ def test_a_signal_in_a_write_exits_128_plus_its_number_and_cleans_up(files, sig,
     out = files / "v.csv"
     out.write_text("old\n")
 
-    def signalled_write(path, table):
+    def signalled_write(path, table, **options):  # options: write_table's progress
         with hystcomp.io.atomic_path(path) as tmp:
             tmp.write_text("half")
             assert len(_hidden(files)) == 1
