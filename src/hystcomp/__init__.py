@@ -30,7 +30,7 @@ _LAZY = {
     "PrandtlIshlinskii": ("hystcomp.models.pi", "PrandtlIshlinskii"),
     "Preisach": ("hystcomp.models.preisach", "Preisach"),
     "Record": ("hystcomp.data", "Record"),
-    "Stepper": ("hystcomp.models.compensator", "Stepper"),
+    "Stepper": ("hystcomp.models.system", "Stepper"),
     "errors": ("hystcomp.errors", None),
     "load_model": ("hystcomp.io", "load_model"),
     "presets": ("hystcomp.presets", None),
@@ -61,11 +61,12 @@ if TYPE_CHECKING:  # what static tools see; at run time __getattr__ imports on f
     from hystcomp.control import to_control
     from hystcomp.data import Record, read_record
     from hystcomp.io import load_model, save_model
-    from hystcomp.models.compensator import Compensator, Stepper
+    from hystcomp.models.compensator import Compensator
     from hystcomp.models.dynamics import LinearDynamics
     from hystcomp.models.mpi import ModifiedPrandtlIshlinskii
     from hystcomp.models.pi import PrandtlIshlinskii
     from hystcomp.models.preisach import Preisach
+    from hystcomp.models.system import Stepper
 
 
 def __getattr__(name: str):

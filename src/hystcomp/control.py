@@ -82,7 +82,7 @@ def register(cls: type):
 
 
 def _stepped(stepper, inputs: tuple[str, ...], outputs: tuple[str, ...]) -> DiscreteSystem:
-    """A packed system (any :class:`~hystcomp.models.compensator.Stepper`) as a DiscreteSystem.
+    """A packed system (any :class:`~hystcomp.models.system.Stepper`) as a DiscreteSystem.
 
     The state is the packed array's state part, from ``kernels.state_start`` to its end; one
     step of the stepper's own kernel gives both the output and the next state.

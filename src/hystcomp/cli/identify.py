@@ -8,6 +8,7 @@ import click
 import numpy as np
 
 from hystcomp import paper
+from hystcomp._hyperparameters import EVERETT_KINDS, MAX_DEGREE
 from hystcomp.cli import main
 from hystcomp.cli._options import (
     columns_option,
@@ -25,7 +26,7 @@ from hystcomp.cli._options import (
 from hystcomp.data import read_record
 from hystcomp.errors import IdentificationError
 from hystcomp.identify.compensation import compensation_error
-from hystcomp.identify.preisach import EVERETT_KINDS, FIT_METHODS, MAX_DEGREE
+from hystcomp.identify.preisach import FIT_METHODS
 from hystcomp.identify.preisach_lsq import MAX_LSQ_GRID
 from hystcomp.identify.scoring import error_report, holdout_report, straight_line, transient_end
 from hystcomp.io import MODEL_KINDS, atomic_paths, check_output_path, model_text

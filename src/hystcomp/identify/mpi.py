@@ -66,13 +66,16 @@ from dataclasses import dataclass
 import numpy as np
 
 from hystcomp import paper
+from hystcomp._hyperparameters import (
+    DEFAULT_MARGIN,
+    check_constraints,
+    check_margin,
+    check_regularization,
+)
 from hystcomp._validation import as_vector, check_int, check_real
 from hystcomp.errors import InvalidParameterError
 from hystcomp.identify.lsq import RIDGE, constrained_lsq, normal_equations
 from hystcomp.identify.pi import (
-    DEFAULT_MARGIN,
-    check_constraints,
-    check_margin,
     paper_thresholds,
     play_thresholds,
     prepare_record,
@@ -114,17 +117,6 @@ class MPIFit:
     output_offset: float
     first_sample: int
     samples: np.ndarray | None = None
-
-
-def check_regularization(regularization, owner: str) -> float:
-    """The MPI regularisation weight, a number >= 0."""
-    regularization = check_real(regularization, "regularization", owner)
-    if regularization < 0:
-        raise InvalidParameterError(
-            f"The 'regularization' parameter of {owner} must be >= 0 (0: eq. 19 as printed; "
-            f"try 1e-3 to 1e-1). Got {regularization!r} instead."
-        )
-    return regularization
 
 
 def absorb_bias(weights, initial_state, input_offset: float, bias: float):

@@ -38,13 +38,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from hystcomp import paper
+from hystcomp._hyperparameters import DEFAULT_MARGIN, check_constraints, check_margin
 from hystcomp._validation import as_signal, check_int, check_real
-from hystcomp.errors import IdentificationError, InvalidParameterError, InvalidSignalError
+from hystcomp.errors import IdentificationError, InvalidSignalError
 from hystcomp.identify import scoring
 from hystcomp.identify.lsq import constrained_lsq, normal_equations
 from hystcomp.identify.scoring import check_response, check_transient, thin
-
-DEFAULT_MARGIN = 1e-3
 
 
 def paper_thresholds(n_operators: int, span: float) -> np.ndarray:
@@ -142,32 +141,6 @@ def thinned(rec: PreparedRecord) -> tuple[np.ndarray, int]:
     """
     keep = thin(rec.u, rec.start, scoring.MAX_SAMPLES)
     return keep, int(np.searchsorted(keep, rec.start))
-
-
-def check_margin(margin, owner: str) -> float:
-    """The relative invertibility margin, a number in (0, 1)."""
-    margin = check_real(margin, "margin", owner, positive=True)
-    if margin >= 1.0:
-        raise InvalidParameterError(
-            f"The 'margin' parameter of {owner} must be below 1 (a small fraction such as "
-            f"{DEFAULT_MARGIN}). Got {margin!r} instead."
-        )
-    return margin
-
-
-#: The constraint sets of the PI/MPI fits: the default, and eq. (12)/(19) as printed.
-CONSTRAINTS = ("physical", "paper")
-
-
-def check_constraints(constraints, owner: str) -> str:
-    """The ``constraints`` option: ``"physical"`` or ``"paper"``."""
-    if constraints not in CONSTRAINTS:
-        raise InvalidParameterError(
-            f"The 'constraints' parameter of {owner} must be one of {CONSTRAINTS} "
-            f"('physical': non-negative play weights, the default; 'paper': the partial-sum "
-            f"constraints of eqs. 12/19 only). Got {constraints!r} instead."
-        )
-    return constraints
 
 
 @dataclass(frozen=True)

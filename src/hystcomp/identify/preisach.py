@@ -25,18 +25,16 @@ import scipy.sparse
 import scipy.sparse.linalg
 
 from hystcomp import preisach_kernels as pk
-from hystcomp._validation import as_signal, check_int, check_range, check_real
+from hystcomp._hyperparameters import check_options
+from hystcomp._validation import as_signal, check_range, check_real
 from hystcomp.errors import (
     IdentificationError,
     InvalidParameterError,
     InvalidSignalError,
-    InvalidTypeError,
 )
 from hystcomp.identify.preisach_lsq import MAX_LSQ_GRID, fit_preisach_lsq
 from hystcomp.identify.scoring import check_response
 
-MAX_DEGREE = 8
-EVERETT_KINDS = ("polynomial", "table")
 N_BINS = 200  # X samples per full-range curve: each curve is averaged in bins of span / N_BINS
 FIT_METHODS = ("auto", "reversal-curves", "least-squares")
 #: ``fit="auto"`` uses the reversal curves when they descend from this many distinct maxima.
@@ -310,33 +308,6 @@ def fit_everett_table(alpha, beta, value, *, grid_size: int, voltage_range) -> n
     p, q = np.tril_indices(n, -1)
     lower[p, q] = solution[p * (p - 1) // 2 + q]
     return pk.antisymmetric_table(lower)
-
-
-def check_options(degree, everett, grid_size, zero_diagonal, owner):
-    """Validate the fit options of a Preisach identification; returns ``(degree, grid_size)``."""
-    degree = check_int(degree, "degree", owner)
-    if not isinstance(zero_diagonal, bool | np.bool_):
-        raise InvalidTypeError(
-            f"The 'zero_diagonal' parameter of {owner} must be True or False. "
-            f"Got {zero_diagonal!r} of type {type(zero_diagonal).__name__} instead."
-        )
-    if degree > MAX_DEGREE:
-        raise InvalidParameterError(
-            f"The 'degree' parameter of {owner} must be an int in 1..{MAX_DEGREE}. "
-            f"Got {degree} instead; eq. (5) is degree 3."
-        )
-    if everett not in EVERETT_KINDS:
-        raise InvalidParameterError(
-            f"The 'everett' parameter of {owner} must be 'polynomial' (eq. 5) or 'table'. "
-            f"Got {everett!r} instead."
-        )
-    grid_size = check_int(grid_size, "grid_size", owner, minimum=2)
-    if grid_size > 400:
-        raise InvalidParameterError(
-            f"The 'grid_size' parameter of {owner} must be an int in 2..400. "
-            f"Got {grid_size} instead."
-        )
-    return degree, grid_size
 
 
 def identify_preisach(

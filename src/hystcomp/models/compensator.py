@@ -1,196 +1,21 @@
-"""Batch ``simulate`` of packed operator chains, and the ``Stepper`` of every packed system.
+"""The compensators of the play-chain models, and what a compensator run reports.
 
-The :class:`Stepper` serves every packed system of the package (play chains here, Preisach
-systems in :mod:`hystcomp.models.preisach`) through the kernels its class names.
-
-A :class:`ChainSystem` is immutable: it holds a packed chain (see :mod:`hystcomp.operators`)
-whose state part is the initial state. ``simulate`` runs a copy, so calling it twice gives
-the same answer; a :class:`Stepper` owns its own copy and can be reset or copied.
+A :class:`Compensator` is a :class:`~hystcomp.models.system.PackedSystem`: reference (µm)
+in, voltage (V) out, through the chain kernel, clamped to its voltage range. ``Stepper`` is
+importable from here too (it lives in :mod:`hystcomp.models.system`).
 """
 
 from __future__ import annotations
 
-import numbers
-from abc import ABC, abstractmethod
 from typing import NamedTuple
 
 import numpy as np
 
 from hystcomp import operators
 from hystcomp._validation import as_signal
-from hystcomp.errors import InvalidSignalError, InvalidTypeError
+from hystcomp.models.system import PackedSystem, Stepper
 
-
-def _sample(u) -> float:
-    """One input sample as a float: a real number (not a bool, text or array), else raise."""
-    if isinstance(u, numbers.Real | np.floating | np.integer) and not isinstance(
-        u, bool | np.bool_
-    ):
-        return float(u)
-    raise InvalidTypeError(
-        f"Stepper.step takes one sample, a real number. Got {u!r:.40} of type "
-        f"{type(u).__name__}; convert it with float(...), or pass a block of samples to "
-        "step_block."
-    )
-
-
-def _checked_step(kernel, p):
-    """``step(u) = kernel(p, u)`` for a float ``u`` (the fast path: one type test), and
-    for any other real number after conversion; text, bools and arrays are refused (the
-    compiled kernel alone would parse a string)."""
-
-    def step(u):
-        if u.__class__ is float:
-            return kernel(p, u)
-        return kernel(p, _sample(u))
-
-    step.func = kernel  # as functools.partial names them: what it calls, and on what
-    step.state = p
-    return step
-
-
-class Stepper:
-    """Streaming evaluation, one sample per call, bit for bit equal to the batch run.
-
-    A non-finite input sample holds the last output (the amplifier keeps its voltage) and
-    is counted in :attr:`nonfinite_count`; nothing is raised inside a real-time loop.
-
-    For speed, each stepper binds :meth:`step` to the compiled step kernel and its own state
-    when it is made (no method lookup, no dispatch on argument types): a call from Python
-    costs about a quarter of a microsecond, 0.5 % of a 20 kHz period, for the play chains
-    and for the Preisach model and its multiplicative inverse; the exact Preisach inverse
-    adds its root search per sample (``python benchmarks/run.py realtime`` and ``...
-    preisach``). One test that the sample is a float guards it (the compiled kernel alone
-    would parse the text ``"1.0"``); that small Python frame is the only cost above the
-    bare kernel (the ``realtime`` benchmark gives the ratio). A loop that has its samples
-    in blocks can use :meth:`step_block`, faster per sample.
-
-    The same class serves every kind of packed system: the class attribute ``kernels``
-    (:class:`~hystcomp.operators.StepKernels`) names its step and batch kernels and where
-    its state lies; it is the play chain's here and the Preisach system's in
-    :class:`~hystcomp.models.preisach.PreisachStepper`.
-    """
-
-    kernels = operators.CHAIN_KERNELS
-
-    def __init__(self, packed: np.ndarray):
-        self._initial = packed
-        self._p = packed.copy()
-        self._start = int(self.kernels.state_start(packed))
-        self._run = self.kernels.run  # looked up once: a block call is short too
-        # an instance attribute hides the method below, which documents it
-        self.step = _checked_step(operators.step_function(self.kernels.step), self._p)
-
-    def step(self, u: float) -> float:
-        """Advance one sample and return the output.
-
-        Parameters
-        ----------
-        u : float
-            The input sample (a reference in µm for a compensator, a voltage in V for a
-            model). A non-finite value holds the last output.
-
-        Returns
-        -------
-        float
-            The output (V for a compensator, µm for a model).
-        """
-        return self.kernels.step(self._p, u)
-
-    def step_block(self, u) -> np.ndarray:
-        """Advance over a block of samples and return the outputs (non-finite samples held).
-
-        Parameters
-        ----------
-        u : array_like
-            A 1-D block of real samples (a single number is a block of one).
-
-        Raises
-        ------
-        InvalidSignalError
-            If ``u`` has more than one dimension (one channel at a time).
-        InvalidTypeError
-            If ``u`` holds text, booleans or objects.
-        """
-        arr = np.asarray(u)
-        if arr.dtype.kind not in "fiu":
-            raise InvalidTypeError(
-                f"Stepper.step_block takes real numbers. Got an array of {arr.dtype} "
-                f"({type(u).__name__}); convert it with np.asarray(u, dtype=float)."
-            )
-        if arr.ndim > 1:
-            raise InvalidSignalError(
-                f"Stepper.step_block takes a 1-D block of samples. Got shape {arr.shape}; "
-                "pass one channel at a time (for example u[:, 0])."
-            )
-        u = np.ascontiguousarray(arr, dtype=np.float64).reshape(-1)
-        out = np.empty_like(u)
-        self._run(self._p, u, out)
-        return out
-
-    def reset(self) -> None:
-        """Return to the initial state."""
-        self._p[:] = self._initial
-
-    def copy(self) -> Stepper:
-        """An independent stepper in the same state."""
-        twin = type(self)(self._initial)
-        twin._p[:] = self._p
-        return twin
-
-    @property
-    def nonfinite_count(self) -> int:
-        """How many non-finite input samples were held since the last reset."""
-        return int(self._p[self._start + self.kernels.nonfinite])
-
-    @property
-    def clamped_count(self) -> int:
-        """How many outputs the voltage range clamped since the last reset.
-
-        An output counts when the compensator asked for a voltage beyond the range by more
-        than :data:`~hystcomp.operators.CLAMP_TOLERANCE` of it (or, for the exact Preisach
-        inverse, stopped at a range end short of the reference): the reference was out of
-        the actuator's reach there. Always 0 for a forward model.
-        """
-        return int(self._p[self._start + self.kernels.clamped])
-
-    @property
-    def last_output(self) -> float:
-        """The last output (before the first sample: the rest value of the system)."""
-        return float(self._p[self._start + self.kernels.last])
-
-
-class ChainSystem(ABC):
-    """A static hysteretic map evaluated by the chain kernel (a model or a compensator)."""
-
-    _input_name = "v"
-
-    @abstractmethod
-    def _packed(self) -> np.ndarray:
-        """The packed chain: parameters and initial state."""
-
-    def simulate(self, signal) -> np.ndarray:
-        """Run a whole signal from the initial state; the system is not changed.
-
-        Parameters
-        ----------
-        signal : array_like
-            1-D finite samples.
-
-        Returns
-        -------
-        ndarray
-            The output, one sample per input sample.
-        """
-        u = as_signal(signal, self._input_name)
-        p = self._packed().copy()
-        out = np.empty_like(u)
-        operators.chain_run(p, u, out)
-        return out
-
-    def stepper(self) -> Stepper:
-        """A :class:`Stepper` starting from the initial state."""
-        return Stepper(self._packed())
+__all__ = ["Compensator", "CompensatorRun", "Stepper"]
 
 
 class CompensatorRun(NamedTuple):
@@ -216,7 +41,7 @@ class CompensatorRun(NamedTuple):
         return self.clamped / self.v.size if self.v.size else 0.0
 
 
-class Compensator(ChainSystem):
+class Compensator(PackedSystem):
     """Inverse-based feedforward: reference displacement (µm) in, voltage (V) out.
 
     Built by ``model.inverse()``; the output is always inside ``voltage_range``.

@@ -35,7 +35,7 @@ def inverse_fir(resonance, bandwidth_hz: float, sample_rate: float):
     sample of preview beyond the output's own delay and the reflected zero one more, so
     ``preview = m + 2``.
     """
-    from scipy.signal import firwin
+    from scipy.signal import firwin  # type: ignore[import-untyped]  # no stubs
 
     b, a = resonance
     # z A(z) (b1 z^-1 + b2) ... in powers of z^-1 from z^+2: relative degree 1 plus the zero
@@ -123,7 +123,9 @@ class DynamicsInverseStepper:
     def __init__(self, packed: np.ndarray):
         self._initial = packed
         self._p = packed.copy()
-        self.step = functools.partial(operators.step_function(dk.inverse_step), self._p)
+        self.step = functools.partial(  # type: ignore[method-assign]  # bound fast path
+            operators.step_function(dk.inverse_step), self._p
+        )
 
     def step(self, x_ref: float) -> float:
         """One reference sample (µm, ``preview`` samples ahead) -> filter output; NaN held out."""

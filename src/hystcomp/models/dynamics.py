@@ -108,6 +108,11 @@ class LinearDynamics:
         "creep_time_constants",
         "creep_weights",
     )
+    sample_rate_: float
+    resonance_hz_: float
+    damping_ratio_: float
+    creep_time_constants_: np.ndarray
+    creep_weights_: np.ndarray
 
     @classmethod
     def from_parameters(

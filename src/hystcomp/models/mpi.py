@@ -1,38 +1,34 @@
-"""The Modified Prandtl-Ishlinskii model (paper eq. 15) and its analytic inverse (eq. 23)."""
+"""The Modified Prandtl-Ishlinskii model (paper eq. 15) and its analytic inverse (eq. 23).
+
+The MPI model is the PI model of :mod:`hystcomp.models.pi` with a saturation stage ``S``
+after the plays; only that stage and the fit of eq. (19) are written here.
+"""
 
 from __future__ import annotations
 
+from typing import Any, Self
+
 import numpy as np
 
-from hystcomp import operators, paper
+from hystcomp import paper
+from hystcomp._hyperparameters import check_regularization_option
 from hystcomp._validation import as_vector, check_int, check_thresholds
-from hystcomp.errors import InvalidParameterError
 from hystcomp.identify.compensation import tracking_scorer
-from hystcomp.identify.mpi import REGULARIZATION_GRID, check_regularization, fit_mpi_path
-from hystcomp.identify.scoring import error_report
-from hystcomp.models.base import (
-    DEFAULT_VOLTAGE_RANGE,
-    HysteresisModel,
-    check_play_hyperparameters,
-    fit_voltage_range,
-    inverse_play_compensator,
-    set_common_parameters,
-    set_plays,
-    thinned_record,
-)
+from hystcomp.identify.mpi import REGULARIZATION_GRID, fit_mpi_path
+from hystcomp.models.base import DEFAULT_VOLTAGE_RANGE, fit_voltage_range
 from hystcomp.models.compensator import Compensator
-from hystcomp.models.dynamic_compensator import with_dynamics
-from hystcomp.models.inversion import (
-    check_invertible,
-    invert_superposition,
-)
+from hystcomp.models.dynamic_compensator import DynamicCompensator
+from hystcomp.models.inversion import check_invertible, invert_superposition
+from hystcomp.models.pi import PrandtlIshlinskii, thinned_record
 
 
-class ModifiedPrandtlIshlinskii(HysteresisModel):
+class ModifiedPrandtlIshlinskii(PrandtlIshlinskii):
     """Modified Prandtl-Ishlinskii model, eq. (15): ``x = x_0 + S[H[v - v_0]]``.
 
     ``H`` is a PI model (eq. 12) of plays, ``S`` a superposition of one-sided dead-zones
-    (eqs. 13-14), which makes the loops asymmetric and lets them saturate.
+    (eqs. 13-14), which makes the loops asymmetric and lets them saturate. It is a
+    :class:`~hystcomp.models.pi.PrandtlIshlinskii` with the stage ``S`` added (its plays,
+    offsets, inverse and play hyperparameters are the PI model's) and its own fit, eq. (19).
 
     Parameters
     ----------
@@ -103,6 +99,8 @@ class ModifiedPrandtlIshlinskii(HysteresisModel):
         "input_offset",
         "output_offset",
     )
+    deadzone_thresholds_: np.ndarray
+    deadzone_weights_: np.ndarray
 
     def __init__(
         self,
@@ -123,7 +121,7 @@ class ModifiedPrandtlIshlinskii(HysteresisModel):
         self.regularization = regularization
         self.constraints = constraints
 
-    def fit(self, v, x) -> ModifiedPrandtlIshlinskii:
+    def fit(self, v, x) -> Self:
         """Identify the model from a measured record by eq. (19) (Section IV-A).
 
         Delegates to :func:`hystcomp.identify.mpi.fit_mpi`, which finds the plays of ``H``
@@ -159,7 +157,7 @@ class ModifiedPrandtlIshlinskii(HysteresisModel):
         # scored on the samples the fit used (a long record is thinned, see fit_mpi_path)
         v_k, x_k, first = thinned_record(v, x, fits[0])
         score = tracking_scorer(v_k, x_k, start=first)
-        best = None
+        candidates = []
         for penalty, fit in zip(penalties, fits, strict=True):
             rs, ws = self.forward_deadzones(
                 fit.inverse_deadzone_thresholds, fit.inverse_deadzone_weights
@@ -174,30 +172,19 @@ class ModifiedPrandtlIshlinskii(HysteresisModel):
                 input_offset=fit.input_offset,
                 output_offset=fit.output_offset,
             )
-            est = score(candidate)
-            if best is None or est["tracking_rms_um"] < best[2]["tracking_rms_um"]:
-                best = (candidate, penalty, est)
-        model, penalty, est = best
-        report = error_report(x_k, model.simulate(v_k), first)
-        report["regularization"] = penalty
-        report["tracking_rms_um"] = est["tracking_rms_um"]
-        report["baseline_tracking_rms_um"] = est["baseline_rms_um"]
-        self._adopt(model, report)
+            candidates.append((candidate, penalty, score(candidate)))
+        # the smallest estimated tracking error (the first of equals)
+        model, penalty, est = min(candidates, key=lambda c: c[2]["tracking_rms_um"])
+        self._adopt_fit(model, v_k, x_k, first, est, regularization=penalty)
         return self
 
     def _penalties(self, owner: str) -> tuple[float, ...]:
         """The regularisation values to fit: the grid for ``"auto"``, else the one given."""
-        if isinstance(self.regularization, str):
-            if self.regularization != "auto":
-                raise InvalidParameterError(
-                    f"The 'regularization' parameter of {owner} must be 'auto' or a number "
-                    f">= 0 (0: eq. 19 as printed). Got {self.regularization!r} instead."
-                )
-            return REGULARIZATION_GRID
-        return (check_regularization(self.regularization, owner),)
+        value = check_regularization_option(self.regularization, owner)
+        return REGULARIZATION_GRID if isinstance(value, str) else (value,)
 
     @classmethod
-    def from_parameters(
+    def from_parameters(  # type: ignore[override]  # S's dead-zones are required
         cls,
         *,
         thresholds,
@@ -208,50 +195,42 @@ class ModifiedPrandtlIshlinskii(HysteresisModel):
         voltage_range=DEFAULT_VOLTAGE_RANGE,
         input_offset=0.0,
         output_offset=0.0,
-    ) -> ModifiedPrandtlIshlinskii:
+    ) -> Self:
         """A model with the given parameters (V, µm/V, µm, unitless); all validated."""
         owner = cls.__name__
         rs = check_thresholds(deadzone_thresholds, "deadzone_thresholds", owner)
         model = cls(n_operators=np.size(thresholds), n_deadzones=rs.size, voltage_range=None)
-        set_plays(model, owner, thresholds=thresholds, weights=weights, initial_state=initial_state)
+        model._set_plays(owner, thresholds, weights, initial_state)
         model.deadzone_thresholds_ = rs
         model.deadzone_weights_ = as_vector(
             deadzone_weights, "deadzone_weights", owner, length=rs.size
         )
-        set_common_parameters(
-            model,
-            owner,
-            voltage_range=voltage_range,
-            input_offset=input_offset,
-            output_offset=output_offset,
-        )
+        model._set_offsets(owner, voltage_range, input_offset, output_offset)
         return model
 
-    def _derived_hyperparameters(self) -> dict:
+    def _derived_hyperparameters(self) -> dict[str, Any]:
         return {
-            "n_operators": int(self.thresholds_.size),
+            **super()._derived_hyperparameters(),
             "n_deadzones": int(self.deadzone_thresholds_.size),
         }
 
     def _check_hyperparameters(self) -> None:
         super()._check_hyperparameters()
-        check_play_hyperparameters(self)
         owner = type(self).__name__
         check_int(self.n_deadzones, "n_deadzones", owner)
-        self._penalties(owner)
+        check_regularization_option(self.regularization, owner)
 
-    def _packed(self) -> np.ndarray:
-        self._check_fitted()
-        return operators.pack_chain(
-            plays=(self.thresholds_, self.weights_, self.initial_state_),
-            post=(self.deadzone_thresholds_, self.deadzone_weights_),
-            in_offset=self.input_offset_,
-            out_offset=self.output_offset_,
-        )
+    def _saturation(self) -> tuple[np.ndarray, np.ndarray]:
+        return self.deadzone_thresholds_, self.deadzone_weights_
+
+    def _check_invertible(self) -> None:
+        owner = type(self).__name__
+        check_invertible(self.weights_, f"The hysteresis operator H of this {owner} model")
+        check_invertible(self.deadzone_weights_, f"The saturation operator S of this {owner} model")
 
     def inverse(
         self, *, slew_rate=None, sample_rate=paper.SAMPLE_RATE, voltage_range=None, dynamics=None
-    ) -> Compensator:
+    ) -> Compensator | DynamicCompensator:
         """The analytic inverse MPI, eq. (23): ``v = v_0 + H^-1[S^-1[x - x_0]]``, clamped.
 
         ``S^-1`` is a dead-zone superposition and ``H^-1`` a PI model, both from eqs. 24-25
@@ -264,18 +243,12 @@ class ModifiedPrandtlIshlinskii(HysteresisModel):
         NotInvertibleError
             If a partial sum of the play weights or of the dead-zone weights is not positive.
         """
-        self._check_fitted()
-        owner = type(self).__name__
-        check_invertible(self.weights_, f"The hysteresis operator H of this {owner} model")
-        check_invertible(self.deadzone_weights_, f"The saturation operator S of this {owner} model")
-        compensator = inverse_play_compensator(
-            self,
+        return super().inverse(
             slew_rate=slew_rate,
             sample_rate=sample_rate,
             voltage_range=voltage_range,
-            pre=invert_superposition(self.deadzone_thresholds_, self.deadzone_weights_),
+            dynamics=dynamics,
         )
-        return compensator if dynamics is None else with_dynamics(self, compensator, dynamics)
 
     @staticmethod
     def forward_deadzones(inverse_thresholds, inverse_weights) -> tuple[np.ndarray, np.ndarray]:

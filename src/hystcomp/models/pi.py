@@ -1,28 +1,35 @@
-"""The classical Prandtl-Ishlinskii model (paper eq. 12) and its analytic inverse (eqs. 24-26)."""
+"""The classical Prandtl-Ishlinskii model (paper eq. 12) and its analytic inverse (eqs. 24-26).
+
+:class:`PrandtlIshlinskii` is also the base of the Modified PI model
+(:class:`~hystcomp.models.mpi.ModifiedPrandtlIshlinskii`, eq. 15): the plays, the offsets, the
+packed chain, the inverse and the play hyperparameters live here once, and the saturation
+stage ``S`` enters through :meth:`PrandtlIshlinskii._saturation` (none for PI).
+"""
 
 from __future__ import annotations
+
+from typing import Any, ClassVar, Self
 
 import numpy as np
 
 from hystcomp import operators, paper
-from hystcomp._validation import check_int
+from hystcomp._hyperparameters import check_constraints, check_margin
+from hystcomp._validation import as_vector, check_int, check_range, check_real, check_thresholds
 from hystcomp.identify.compensation import compensation_error
 from hystcomp.identify.pi import fit_pi, paper_thresholds
 from hystcomp.identify.scoring import error_report
 from hystcomp.models.base import (
     DEFAULT_VOLTAGE_RANGE,
     HysteresisModel,
-    check_play_hyperparameters,
     fit_voltage_range,
-    inverse_play_compensator,
-    set_common_parameters,
-    set_plays,
-    thinned_record,
+    slew_to_step,
 )
 from hystcomp.models.compensator import Compensator
-from hystcomp.models.dynamic_compensator import with_dynamics
+from hystcomp.models.dynamic_compensator import DynamicCompensator, with_dynamics
 from hystcomp.models.inversion import (
     check_invertible,
+    inverse_initial_state,
+    invert_superposition,
 )
 
 __all__ = ["PrandtlIshlinskii", "paper_thresholds"]
@@ -85,7 +92,7 @@ class PrandtlIshlinskii(HysteresisModel):
     """
 
     kind = "pi"
-    _learned = (
+    _learned: ClassVar[tuple[str, ...]] = (
         "thresholds",
         "weights",
         "initial_state",
@@ -93,6 +100,11 @@ class PrandtlIshlinskii(HysteresisModel):
         "input_offset",
         "output_offset",
     )
+    thresholds_: np.ndarray
+    weights_: np.ndarray
+    initial_state_: np.ndarray
+    input_offset_: float
+    output_offset_: float
 
     def __init__(
         self,
@@ -109,7 +121,7 @@ class PrandtlIshlinskii(HysteresisModel):
         self.margin = margin
         self.constraints = constraints
 
-    def fit(self, v, x) -> PrandtlIshlinskii:
+    def fit(self, v, x) -> Self:
         """Identify the model from a measured record (Section IV-A, eqs. 12, 16, 18).
 
         Delegates to :func:`hystcomp.identify.pi.fit_pi` (constrained least squares, with
@@ -146,12 +158,18 @@ class PrandtlIshlinskii(HysteresisModel):
             output_offset=fit.output_offset,
         )
         v_k, x_k, first = thinned_record(v, x, fit)
+        self._adopt_fit(fitted, v_k, x_k, first, compensation_error(fitted, v_k, x_k, start=first))
+        return self
+
+    def _adopt_fit(self, fitted: Self, v_k, x_k, first: int, est: dict, **extra) -> None:
+        """Take ``fitted``'s parameters, with its fit report on the thinned record: the
+        errors of :func:`~hystcomp.identify.scoring.error_report`, then ``extra``, then the
+        estimated tracking errors ``est`` of its compensator and of a straight line."""
         report = error_report(x_k, fitted.simulate(v_k), first)
-        est = compensation_error(fitted, v_k, x_k, start=first)
+        report.update(extra)
         report["tracking_rms_um"] = est["tracking_rms_um"]
         report["baseline_tracking_rms_um"] = est["baseline_rms_um"]
         self._adopt(fitted, report)
-        return self
 
     @classmethod
     def from_parameters(
@@ -163,38 +181,68 @@ class PrandtlIshlinskii(HysteresisModel):
         voltage_range=DEFAULT_VOLTAGE_RANGE,
         input_offset=0.0,
         output_offset=0.0,
-    ) -> PrandtlIshlinskii:
+    ) -> Self:
         """A model with the given parameters (V, µm/V, µm); every value is validated."""
         owner = cls.__name__
         model = cls(n_operators=np.size(thresholds), voltage_range=None)
-        set_plays(model, owner, thresholds=thresholds, weights=weights, initial_state=initial_state)
-        set_common_parameters(
-            model,
-            owner,
-            voltage_range=voltage_range,
-            input_offset=input_offset,
-            output_offset=output_offset,
-        )
+        model._set_plays(owner, thresholds, weights, initial_state)
+        model._set_offsets(owner, voltage_range, input_offset, output_offset)
         return model
 
-    def _derived_hyperparameters(self) -> dict:
+    def _set_plays(self, owner: str, thresholds, weights, initial_state) -> None:
+        """Validate and set ``thresholds_``, ``weights_`` and ``initial_state_`` (eq. 18:
+        zero unless given)."""
+        r = check_thresholds(thresholds, "thresholds", owner)
+        self.thresholds_ = r
+        self.weights_ = as_vector(weights, "weights", owner, length=r.size)
+        if initial_state is None:
+            zeros = np.zeros(r.size)
+            zeros.setflags(write=False)
+            self.initial_state_ = zeros
+        else:
+            self.initial_state_ = as_vector(initial_state, "initial_state", owner, length=r.size)
+
+    def _set_offsets(self, owner: str, voltage_range, input_offset, output_offset) -> None:
+        """Validate and set ``voltage_range_``, ``input_offset_`` and ``output_offset_``."""
+        self.voltage_range_ = check_range(voltage_range, "voltage_range", owner)
+        self.input_offset_ = check_real(input_offset, "input_offset", owner)
+        self.output_offset_ = check_real(output_offset, "output_offset", owner)
+
+    def _derived_hyperparameters(self) -> dict[str, Any]:
         return {"n_operators": int(self.thresholds_.size)}
 
     def _check_hyperparameters(self) -> None:
+        """The range, then the play hyperparameters: operator count, transient, margin,
+        constraints."""
         super()._check_hyperparameters()
-        check_play_hyperparameters(self)
+        owner = type(self).__name__
+        check_int(self.n_operators, "n_operators", owner)
+        if self.transient is not None:
+            check_int(self.transient, "transient", owner, minimum=0)
+        check_margin(self.margin, owner)
+        check_constraints(self.constraints, owner)
+
+    def _saturation(self) -> tuple[np.ndarray, np.ndarray] | None:
+        """The dead-zones ``(thresholds, weights)`` of the saturation stage ``S`` after the
+        plays (eq. 15), or None: a PI model has none."""
+        return None
+
+    def _check_invertible(self) -> None:
+        """Raise :class:`~hystcomp.errors.NotInvertibleError` unless eqs. (24)-(25) apply."""
+        check_invertible(self.weights_, f"This {type(self).__name__} model")
 
     def _packed(self) -> np.ndarray:
         self._check_fitted()
         return operators.pack_chain(
             plays=(self.thresholds_, self.weights_, self.initial_state_),
+            post=self._saturation(),
             in_offset=self.input_offset_,
             out_offset=self.output_offset_,
         )
 
     def inverse(
         self, *, slew_rate=None, sample_rate=paper.SAMPLE_RATE, voltage_range=None, dynamics=None
-    ) -> Compensator:
+    ) -> Compensator | DynamicCompensator:
         """The analytic inverse PI (eqs. 24-26) as a compensator clamped to the voltage range.
 
         Parameters
@@ -217,9 +265,38 @@ class PrandtlIshlinskii(HysteresisModel):
             If a partial sum of the weights is not positive; its ``index`` names it.
         """
         self._check_fitted()
+        self._check_invertible()
+        # the chain x -> (x - x_0) -> [S^-1 dead-zones] -> inverse plays (eqs. 24-26) -> + v_0
         owner = type(self).__name__
-        check_invertible(self.weights_, f"This {owner} model")
-        compensator = inverse_play_compensator(
-            self, slew_rate=slew_rate, sample_rate=sample_rate, voltage_range=voltage_range
+        max_step = slew_to_step(slew_rate, sample_rate, owner)
+        lo, hi = self._clamp_range(voltage_range, f"{owner}.inverse")
+        saturation = self._saturation()
+        packed = operators.pack_chain(
+            pre=None if saturation is None else invert_superposition(*saturation),
+            plays=(
+                *invert_superposition(self.thresholds_, self.weights_),
+                inverse_initial_state(self.weights_, self.initial_state_),
+            ),
+            in_offset=self.output_offset_,
+            out_offset=self.input_offset_,
+            low=lo,
+            high=hi,
+            max_step=max_step,
         )
+        compensator = Compensator(packed, kind=self.kind, voltage_range=(lo, hi))
         return compensator if dynamics is None else with_dynamics(self, compensator, dynamics)
+
+
+def thinned_record(v, x, fit) -> tuple[np.ndarray, np.ndarray, int]:
+    """The samples a PI/MPI fit ran over (``fit.samples``), and the first one in its cost.
+
+    For a record longer than :data:`hystcomp.identify.scoring.MAX_SAMPLES` these are its
+    turning points and a regular subset: the fit report and the tracking estimate are
+    computed there, which gives the same figures as the whole record at a fraction of the
+    cost (rate independence).
+    """
+    keep = fit.samples
+    v, x = np.asarray(v, dtype=np.float64), np.asarray(x, dtype=np.float64)
+    if keep is None or keep.size == v.size:
+        return v, x, fit.first_sample
+    return v[keep], x[keep], int(np.searchsorted(keep, fit.first_sample))

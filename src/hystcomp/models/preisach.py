@@ -11,14 +11,16 @@ import numpy as np
 
 from hystcomp import paper
 from hystcomp import preisach_kernels as pk
-from hystcomp._validation import as_signal, as_vector, check_int, check_range, check_real
+from hystcomp._hyperparameters import MAX_DEGREE, check_options
+from hystcomp._validation import as_vector, check_int, check_range, check_real
 from hystcomp.errors import InvalidParameterError, InvalidTypeError
 from hystcomp.identify.compensation import compensation_error
-from hystcomp.identify.preisach import MAX_DEGREE, check_options, identify_preisach
+from hystcomp.identify.preisach import identify_preisach
 from hystcomp.identify.scoring import transient_end
 from hystcomp.models.base import DEFAULT_VOLTAGE_RANGE, HysteresisModel, slew_to_step
-from hystcomp.models.compensator import Compensator, Stepper
-from hystcomp.models.dynamic_compensator import with_dynamics
+from hystcomp.models.compensator import Compensator
+from hystcomp.models.dynamic_compensator import DynamicCompensator, with_dynamics
+from hystcomp.models.system import Stepper
 
 INVERSE_METHODS = ("multiplicative", "exact")
 
@@ -26,7 +28,7 @@ INVERSE_METHODS = ("multiplicative", "exact")
 class PreisachStepper(Stepper):
     """Streaming evaluation of a Preisach system, bit for bit equal to its batch run.
 
-    A :class:`~hystcomp.models.compensator.Stepper` on the Preisach kernels: the same fast
+    A :class:`~hystcomp.models.system.Stepper` on the Preisach kernels: the same fast
     bound :meth:`step`, :meth:`step_block`, :meth:`reset` and :meth:`copy`. A non-finite
     input sample holds the last output (before the first sample: ``x_0`` for a model,
     ``v_min`` for a compensator) and is counted in :attr:`nonfinite_count`.
@@ -38,13 +40,6 @@ class PreisachStepper(Stepper):
     def memory_depth(self) -> int:
         """How many extrema the memory holds now (``beta_0`` included)."""
         return int(self._p[self._start + pk.ST_TOP]) + 1
-
-
-def _run(packed: np.ndarray, u: np.ndarray) -> np.ndarray:
-    p = packed.copy()
-    out = np.empty_like(u)
-    pk.preisach_run(p, u, out)
-    return out
 
 
 class Preisach(HysteresisModel):
@@ -141,6 +136,10 @@ class Preisach(HysteresisModel):
 
     kind = "preisach"
     _learned = ("voltage_range", "output_offset", "theta", "table")
+    stepper_class = PreisachStepper
+    theta_: np.ndarray | None
+    table_: np.ndarray | None
+    output_offset_: float
 
     def __init__(
         self,
@@ -250,7 +249,7 @@ class Preisach(HysteresisModel):
         return self
 
     def _derived_hyperparameters(self) -> dict:
-        if self.theta_ is not None:
+        if self.table_ is None:  # X is the polynomial theta_
             return {"everett": "polynomial", "degree": self.degree}
         return {"everett": "table", "grid_size": int(self.table_.shape[0])}
 
@@ -272,7 +271,7 @@ class Preisach(HysteresisModel):
         lo, hi = self.voltage_range_
         if self.theta_ is not None:
             kind, coef = pk.POLYNOMIAL, pk.coefficient_matrix(self.theta_, self.degree)
-        else:
+        elif self.table_ is not None:  # one of the two is set (from_parameters, fit)
             kind, coef = pk.TABLE, self.table_
         return pk.pack_preisach(
             kind=kind,
@@ -286,14 +285,6 @@ class Preisach(HysteresisModel):
             max_step=max_step,
             clamp=clamp,
         )
-
-    def simulate(self, v) -> np.ndarray:
-        """Output ``x`` (µm) for input ``v`` (V) from the initial state; the model is unchanged."""
-        return _run(self._packed(), as_signal(v, "v"))
-
-    def stepper(self) -> PreisachStepper:
-        """A :class:`PreisachStepper` (voltage in, displacement out) from the initial state."""
-        return PreisachStepper(self._packed())
 
     def everett_function(self, alpha, beta) -> np.ndarray:
         """``X(alpha, beta)`` in µm (eq. 2) at voltages clamped to the plane (broadcast)."""
@@ -329,7 +320,7 @@ class Preisach(HysteresisModel):
         sample_rate=paper.SAMPLE_RATE,
         voltage_range=None,
         dynamics=None,
-    ) -> PreisachCompensator:
+    ) -> PreisachCompensator | DynamicCompensator:
         """A compensator (reference µm -> voltage V) clamped to ``voltage_range_``.
 
         Parameters
@@ -420,6 +411,8 @@ class PreisachCompensator(Compensator):
         Largest output change per sample, in V (``inf`` without a slew-rate limit).
     """
 
+    stepper_class = PreisachStepper
+
     def __init__(self, model: Preisach, *, method: str, rho: float | None, max_step: float, clamp):
         mode = pk.EXACT if method == "exact" else pk.MULTIPLICATIVE
         rho_value = 1.0 if rho is None else rho
@@ -432,14 +425,6 @@ class PreisachCompensator(Compensator):
         self.rho = rho
         self.voltage_range = clamp
         self.max_step = float(max_step)
-
-    def simulate(self, x_ref) -> np.ndarray:
-        """Voltage (V) for a whole reference (µm) from the initial state; nothing is changed."""
-        return _run(self._chain, as_signal(x_ref, "x_ref"))
-
-    def stepper(self) -> PreisachStepper:
-        """A :class:`PreisachStepper` (reference in, voltage out) from the initial state."""
-        return PreisachStepper(self._chain)
 
     def __repr__(self) -> str:
         lo, hi = self.voltage_range

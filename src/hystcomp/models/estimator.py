@@ -1,0 +1,262 @@
+"""The estimator base: scikit-learn's contract for the models, without importing it.
+
+:class:`Estimator` holds what every fitted model shares as an *estimator*: hyperparameters
+read from the ``__init__`` signature (``get_params``, ``set_params``, ``repr``), the fitted
+check, ``score``, the hyperparameter checks that ``fit`` and model files share, and the
+model-file dictionary (``to_dict``, ``from_dict``). How a model computes its output lives
+elsewhere (:class:`~hystcomp.models.system.PackedSystem`).
+"""
+
+from __future__ import annotations
+
+import inspect
+from typing import Any, ClassVar, Self
+
+import numpy as np
+
+from hystcomp._validation import as_signal_pair
+from hystcomp.errors import InvalidParameterError, NotFittedError
+
+
+class Estimator:
+    """Base of the fitted models: voltage (V) in, displacement (µm) out, learned from data.
+
+    Subclasses list their learned parameters in ``_learned`` (names without the trailing
+    underscore); the learned attributes end in ``_`` as in scikit-learn. The hyperparameters
+    are the keyword parameters of the subclass's ``__init__``, which stores each unchanged
+    under its own name (validation waits for ``fit``): :meth:`get_params`, :meth:`set_params`,
+    the model file and ``repr`` read them from the signature, so a new hyperparameter is
+    written once. That is scikit-learn's estimator contract, without importing it:
+    ``sklearn.base.clone``, grid searches and pipelines work on these models, and
+    :meth:`score` is the coefficient of determination of the predicted displacement.
+    A model without learned parameters can only be fitted.
+
+    A subclass gives ``simulate(v)`` (the prediction :meth:`score` rates) and the
+    classmethod ``from_parameters(**parameters)`` (which :meth:`from_dict` calls).
+    """
+
+    kind: ClassVar[str]
+    _learned: ClassVar[tuple[str, ...]]
+    fit_report_: dict[str, Any]
+
+    def simulate(self, v) -> np.ndarray:  # given by the subclass (its system's run)
+        raise NotImplementedError
+
+    @classmethod
+    def from_parameters(cls, *args: Any, **parameters: Any) -> Self:  # given by the subclass
+        raise NotImplementedError
+
+    @classmethod
+    def _get_param_names(cls) -> tuple[str, ...]:
+        """The hyperparameter names: the parameters of ``__init__``, in their order."""
+        names = []
+        for param in inspect.signature(cls.__init__).parameters.values():
+            if param.name == "self":
+                continue
+            if param.kind in (param.VAR_POSITIONAL, param.VAR_KEYWORD):
+                raise TypeError(  # a programming error in a subclass, not a user's
+                    f"{cls.__name__}.__init__ must name its hyperparameters explicitly "
+                    f"(no *args or **kwargs); found {param}."
+                )
+            names.append(param.name)
+        return tuple(names)
+
+    @classmethod
+    def _param_defaults(cls) -> dict[str, Any]:
+        return {
+            name: param.default
+            for name, param in inspect.signature(cls.__init__).parameters.items()
+            if name != "self"
+        }
+
+    def _check_fitted(self) -> None:
+        if not hasattr(self, self._learned[0] + "_"):
+            name = type(self).__name__
+            raise NotFittedError(
+                f"This {name} has no parameters yet. Call fit(v, x) on measured data, "
+                f"build it with {name}.from_parameters(...), or load one with "
+                "hystcomp.load_model(path)."
+            )
+
+    def _derived_hyperparameters(self) -> dict[str, Any]:
+        """Hyperparameters that the learned parameters determine (e.g. the operator count
+        from the thresholds), with their values; a model file must agree with them."""
+        return {}
+
+    def _check_hyperparameters(self) -> None:
+        """Validate every hyperparameter's type and value, as ``fit`` does (and raise).
+
+        Subclasses extend it for their own; ``fit`` and ``from_dict`` both call it, so a
+        new hyperparameter is checked on both paths once it is checked here.
+        """
+
+    def get_params(self, deep: bool = True) -> dict[str, Any]:
+        """The hyperparameters, as given to ``__init__`` (scikit-learn's contract).
+
+        Parameters
+        ----------
+        deep : bool, default True
+            Accepted for scikit-learn; these models hold no nested estimators.
+
+        Returns
+        -------
+        dict
+            Name to value, in the order of ``__init__``'s signature.
+        """
+        return {name: getattr(self, name) for name in self._get_param_names()}
+
+    def set_params(self, **params) -> Self:
+        """Set hyperparameters by name (checked in :meth:`fit`, as in scikit-learn).
+
+        Learned attributes stay as they are until the next :meth:`fit`.
+
+        Returns
+        -------
+        estimator
+            ``self``.
+
+        Raises
+        ------
+        InvalidParameterError
+            If a name is not a hyperparameter of this model.
+
+        Examples
+        --------
+        >>> from hystcomp import PrandtlIshlinskii
+        >>> PrandtlIshlinskii().set_params(n_operators=8)
+        PrandtlIshlinskii(n_operators=8, unfitted)
+        """
+        valid = self._get_param_names()
+        for name, value in params.items():
+            if name not in valid:
+                raise InvalidParameterError(
+                    f"{name!r} is not a hyperparameter of {type(self).__name__}. Valid "
+                    f"hyperparameters are: {', '.join(valid)}. Check the spelling."
+                )
+            setattr(self, name, value)
+        return self
+
+    def score(self, v, x) -> float:
+        """Coefficient of determination R² of the displacement predicted for ``v``.
+
+        ``1 - sum((x - x_hat)^2) / sum((x - mean(x))^2)`` with ``x_hat = simulate(v)``, as
+        scikit-learn's regressors score; 1 is a perfect prediction. Like
+        ``sklearn.metrics.r2_score``, a constant ``x`` scores 1.0 if predicted exactly,
+        else 0.0.
+
+        Parameters
+        ----------
+        v, x : array_like
+            Input voltage (V) and measured displacement (µm), one sample each per instant.
+
+        Returns
+        -------
+        float
+        """
+        v, x = as_signal_pair(v, x, ("v", "x"), f"{type(self).__name__}.score")
+        residual = float(np.sum((x - self.simulate(v)) ** 2))
+        total = float(np.sum((x - x.mean()) ** 2))
+        if total == 0.0:
+            return 1.0 if residual == 0.0 else 0.0
+        return 1.0 - residual / total
+
+    def parameters(self) -> dict[str, Any]:
+        """The learned parameters as plain Python values (lists and floats)."""
+        self._check_fitted()
+        out = {}
+        for name in self._learned:
+            value = getattr(self, name + "_")
+            out[name] = value.tolist() if isinstance(value, np.ndarray) else value
+        return out
+
+    def to_dict(self) -> dict[str, Any]:
+        """Kind, hyperparameters, parameters and fit report, ready for JSON."""
+        out = {
+            "kind": self.kind,
+            "hyperparameters": self.get_params(),
+            "parameters": self.parameters(),
+        }
+        report = getattr(self, "fit_report_", None)
+        if report is not None:
+            out["fit_report"] = dict(report)
+        return out
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> Self:
+        """Inverse of :meth:`to_dict` (validates everything through ``from_parameters``).
+
+        :func:`hystcomp.io.model_from_dict` checks a whole document (keys, JSON types) first.
+        """
+        if not (isinstance(data, dict) and isinstance(data.get("parameters"), dict)):
+            raise InvalidParameterError(
+                f"{cls.__name__}.from_dict needs a dict with a 'parameters' dict (as written "
+                f"by to_dict). Got {type(data).__name__}."
+            )
+        model = cls.from_parameters(**data["parameters"])
+        derived = model._derived_hyperparameters()
+        for name, value in data.get("hyperparameters", {}).items():
+            if name not in cls._get_param_names():
+                continue
+            if name in derived and not _same_value(value, derived[name]):
+                raise InvalidParameterError(
+                    f"The hyperparameter {name!r} of this {cls.__name__} is {value!r}, but its "
+                    f"parameters give {derived[name]!r}: the two disagree. The file was "
+                    f"edited by hand; set {name!r} to {derived[name]!r} or identify again."
+                )
+            setattr(model, name, value)
+        model._check_hyperparameters()  # every value, as fit() would check it
+        if "fit_report" in data:
+            model.fit_report_ = dict(data["fit_report"])
+        return model
+
+    _estimator_type = "regressor"  # what scikit-learn < 1.6 reads
+
+    def __sklearn_tags__(self):
+        """scikit-learn's description (>= 1.6): a regressor of 1-D signals.
+
+        Called only by scikit-learn, so importing it here adds no dependency.
+        """
+        from sklearn.utils import (  # type: ignore[import-untyped]  # no stubs
+            InputTags,
+            RegressorTags,
+            Tags,
+            TargetTags,
+        )
+
+        return Tags(
+            estimator_type="regressor",
+            target_tags=TargetTags(required=True, one_d_labels=True),
+            input_tags=InputTags(one_d_array=True, two_d_array=False),
+            regressor_tags=RegressorTags(),
+        )
+
+    def _adopt(self, fitted: Self, fit_report: dict[str, Any]) -> None:
+        """Take the learned parameters of ``fitted`` (built by ``from_parameters``, so validated)."""
+        for name in self._learned:
+            setattr(self, name + "_", getattr(fitted, name + "_"))
+        self.fit_report_ = fit_report
+
+    def __repr__(self) -> str:
+        """Only the hyperparameters that differ from their defaults, as scikit-learn shows."""
+        defaults = self._param_defaults()
+        args = [f"{k}={v!r}" for k, v in self.get_params().items() if _differs(v, defaults[k])]
+        if not hasattr(self, self._learned[0] + "_"):
+            args.append("unfitted")
+        return f"{type(self).__name__}({', '.join(args)})"
+
+
+def _differs(value, default) -> bool:
+    """Whether a hyperparameter differs from its default (for ``repr``)."""
+    if value is default:
+        return False
+    if type(value) is not type(default):
+        return True
+    try:
+        return not bool(value == default)
+    except (TypeError, ValueError):  # e.g. an array's ambiguous truth value
+        return True
+
+
+def _same_value(value, expected) -> bool:
+    """Equal and of the same JSON type (3 is not 3.0, "3" or True)."""
+    return type(value) is type(expected) and value == expected
