@@ -138,7 +138,8 @@ def pack_preisach(
         [mode, kind, v_min, v_max, offset, step, n, depth, rho, max_step, low, high],
         dtype=np.float64,
     )
-    last = offset if mode == FORWARD else v_min
+    # a compensator at rest holds v_min clamped to its output range (a narrower clamp)
+    last = offset if mode == FORWARD else min(max(v_min, low), high)
     state = np.array([0.0, v_min, 0.0, last, 0.0])
     stack = np.zeros(depth)
     stack[0] = v_min

@@ -41,7 +41,7 @@ def preisach_template(compensator) -> CTemplate:
         low=lo,
         high=hi,
         max_step=float(p[pk.MAX_STEP]),
-        initial_output=v_min,
+        initial_output=float(p[pk.state_start(p) + pk.ST_LAST]),  # v_min in the clamp
         hold_on_overflow=False,  # the kernel takes v = +-inf to the range ends (min/max)
         state_fields=[
             "long top; /* index of the innermost stored extremum (e[0] = beta_0) */",
