@@ -29,6 +29,7 @@ from hystcomp.data import read_record, read_table
 from hystcomp.errors import (
     HystcompError,
     InvalidParameterError,
+    InvalidSignalError,
     InvalidTypeError,
     NotInvertibleError,
 )
@@ -120,7 +121,7 @@ def _check_record(rec) -> None:
 def valid_files(draw):
     """A valid record as the bytes of a ``.csv``, ``.txt``, ``.dat`` or ``.npz`` file."""
     table = draw(tables(min_size=2, special=False))
-    table["v"][0] += 1.0  # an input that varies (read_record refuses a constant one)
+    table["v"][0] = table["v"].max() + 1.0  # an input that varies (not refused as constant)
     suffix = draw(st.sampled_from([".csv", ".txt", ".dat", ".npz"]))
     if suffix == ".npz":
         buffer = io.BytesIO()
@@ -134,9 +135,9 @@ def valid_files(draw):
     return (end.join(lines) + end * draw(st.integers(0, 2))).encode("ascii"), suffix
 
 
-MUTATIONS = st.lists(  # overwrite, insert or delete a few bytes, or cut the file short
+MUTATIONS = st.lists(  # change a digit, overwrite, insert or delete bytes, or cut the file
     st.tuples(
-        st.sampled_from(["flip", "insert", "delete", "truncate"]),
+        st.sampled_from(["digit", "digit", "flip", "insert", "delete", "truncate"]),
         st.integers(0, 10**6),
         st.one_of(  # mostly digits: a corrupted value that may still parse
             st.text("0123456789", min_size=1, max_size=3),
@@ -154,13 +155,16 @@ def _mutate(data: bytes, mutations) -> bytes:
     for op, where, chunk in mutations:
         chunk = chunk.encode("utf-8") if isinstance(chunk, str) else chunk
         k = where % (len(out) + 1)
-        if op == "flip":
+        digits = [i for i, byte in enumerate(out) if 48 <= byte <= 57]
+        if op == "digit" and digits:  # another value, often still a valid file
+            out[digits[where % len(digits)]] = 48 + chunk[0] % 10
+        elif op == "flip":
             out[k : k + len(chunk)] = chunk
         elif op == "insert":
             out[k:k] = chunk
         elif op == "delete":
             del out[k : k + len(chunk)]
-        else:
+        elif op == "truncate":
             del out[k:]
     return bytes(out)
 
@@ -191,9 +195,10 @@ def test_valid_then_mutated_data_files():
     assert {suffix for suffix, _, _ in seen} == {".csv", ".txt", ".dat", ".npz"}
     assert np.mean([ok for _, _, ok in seen]) > 0.4, seen
     assert len(mutated) > 0.3 * len(seen)
-    assert np.mean(mutated) > 0.15, seen  # corrupted files that are still read, and checked
+    assert np.mean(mutated) > 0.1, seen  # corrupted files that are still read, and checked
 
 
+@FUZZ
 @given(data=st.binary(max_size=400), suffix=st.sampled_from([".csv", ".dat", ".npz"]))
 def test_random_bytes(data, suffix):
     """Random bytes, also behind the magic numbers of a zip and an npy file: never a crash."""
@@ -442,6 +447,9 @@ def _check_stream(system, signal, expected, holes, rest) -> None:
     held = np.concatenate([[rest], out[:-1]])
     np.testing.assert_array_equal(out[hole], held[hole])
     assert stepper.nonfinite_count == hole.sum()
+    if hole.any():  # a batch run refuses them instead (documented on simulate)
+        with pytest.raises(InvalidSignalError, match="must be finite"):
+            system.simulate(u)
 
 
 def _exercise_preisach(model, signal, reference, holes=(), options=None) -> None:
@@ -456,7 +464,8 @@ def _exercise_preisach(model, signal, reference, holes=(), options=None) -> None
     x = model.simulate(signal)
     assert np.all(np.isfinite(x))
     # eqs. (3)-(4): x - x_0 sums at most one X per stored extremum, and one more
-    assert np.all(np.abs(x - x0) <= (len(signal) + 2) * bound * (1 + 1e-9)), (x, bound)
+    limit = (len(signal) + 2) * bound * (1 + 1e-9) + 2 * np.spacing(abs(x0))  # x0 + H rounds
+    assert np.all(np.abs(x - x0) <= limit), (x, bound)
     _check_stream(model, signal, x, holes, rest=x0)
     ref = np.clip(x0 + bound * np.asarray(reference), -MAX_MAGNITUDE, MAX_MAGNITUDE)
     compensators = []
