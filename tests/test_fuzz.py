@@ -560,6 +560,15 @@ def test_preisach_table_beyond_the_magnitude_bound_is_refused():
         Preisach.from_parameters(table=[["0", "0"], ["1", "0"]])
 
 
+def test_preisach_file_whose_degree_does_not_match_theta_is_refused():
+    # was loaded, then simulate raised a bare ValueError from the coefficient matrix
+    doc = model_io.model_to_dict(presets.paper_preisach())
+    doc["parameters"]["theta"] = [0.0, 0.3]  # degree 1, but "degree": 3 stays
+    assert _load_text(json.dumps(doc)) is None
+    doc["hyperparameters"]["degree"] = 1
+    assert _load_text(json.dumps(doc)).simulate([0.0, 10.0]).tolist() == [0.0, 3.0]
+
+
 @pytest.mark.parametrize("method", ["multiplicative", "exact"])
 def test_preisach_compensator_rests_inside_a_narrower_range(method):
     # before the first finite sample it held v_min, outside voltage_range=(10, 100)

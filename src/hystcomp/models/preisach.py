@@ -189,6 +189,25 @@ class Preisach(HysteresisModel):
         model.voltage_range = None
         return model
 
+    @classmethod
+    def from_dict(cls, data) -> Preisach:
+        """Inverse of :meth:`to_dict`; a ``degree`` hyperparameter must match ``theta``.
+
+        Evaluation takes the degree of X from the hyperparameter, so a document whose
+        ``theta`` has the size of another degree is refused here rather than failing later.
+        """
+        model = super().from_dict(data)
+        if model.theta_ is not None:
+            sizes = {pk.n_monomials(d): d for d in range(1, MAX_DEGREE + 1)}
+            degree = sizes[model.theta_.size]
+            if type(model.degree) is not int or model.degree != degree:  # not 3.0 nor True
+                raise InvalidParameterError(
+                    f"The 'degree' hyperparameter of {cls.__name__} must match 'theta', whose "
+                    f"{model.theta_.size} entries are those of degree {degree}. Got "
+                    f"{model.degree!r} instead; correct or drop it."
+                )
+        return model
+
     def fit(self, v, x) -> Preisach:
         """Identify the model from a record (Section III-A); see
         :func:`~hystcomp.identify.preisach.identify_preisach`.
