@@ -567,6 +567,8 @@ def test_preisach_file_whose_degree_does_not_match_theta_is_refused():
     assert _load_text(json.dumps(doc)) is None
     doc["hyperparameters"]["degree"] = 1
     assert _load_text(json.dumps(doc)).simulate([0.0, 10.0]).tolist() == [0.0, 3.0]
+    doc["hyperparameters"]["max_extrema"] = 0  # was loaded, then refused by simulate
+    assert _load_text(json.dumps(doc)) is None
 
 
 @pytest.mark.parametrize("method", ["multiplicative", "exact"])

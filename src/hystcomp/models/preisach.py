@@ -193,10 +193,12 @@ class Preisach(HysteresisModel):
     def from_dict(cls, data) -> Preisach:
         """Inverse of :meth:`to_dict`; a ``degree`` hyperparameter must match ``theta``.
 
-        Evaluation takes the degree of X from the hyperparameter, so a document whose
-        ``theta`` has the size of another degree is refused here rather than failing later.
+        Evaluation takes the degree of X and the memory bound from the hyperparameters, so
+        a document whose ``theta`` has the size of another degree, or whose ``max_extrema``
+        is not an int >= 3, is refused here rather than failing later.
         """
         model = super().from_dict(data)
+        check_int(model.max_extrema, "max_extrema", cls.__name__, minimum=3)
         if model.theta_ is not None:
             sizes = {pk.n_monomials(d): d for d in range(1, MAX_DEGREE + 1)}
             degree = sizes[model.theta_.size]
