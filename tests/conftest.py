@@ -1,13 +1,42 @@
-"""Shared fixtures and strategies: seeded data and random invertible models."""
+"""Shared fixtures and strategies: seeded data and random invertible models.
+
+Also the suite's one Hypothesis profile, loaded here for every test file: ``ci`` by default
+(the same examples on every run and machine, so a failure in CI reproduces locally), or
+``thorough`` (random examples, many more of them) with ``HYPOTHESIS_PROFILE=thorough``.
+"""
 
 from __future__ import annotations
 
+import os
+
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, settings
 from hypothesis import strategies as st
 
 import hystcomp
 from hystcomp import operators
+
+settings.register_profile(
+    "ci",
+    max_examples=40,
+    derandomize=True,  # examples seeded from each test's name: every run tests the same ones
+    deadline=None,  # a first call compiles numba kernels, and the machines are shared
+    suppress_health_check=[HealthCheck.too_slow],  # some strategies build and run models
+    print_blob=True,  # a failure prints the @reproduce_failure line
+)
+settings.register_profile(
+    "thorough", settings.get_profile("ci"), max_examples=1000, derandomize=False
+)
+settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "ci"))
+
+
+def examples(factor: float) -> int:
+    """``max_examples`` for a test that needs ``factor`` times the profile's count (>= 1).
+
+    Scales with the profile, so ``HYPOTHESIS_PROFILE=thorough`` runs these tests longer too.
+    """
+    return max(1, round(factor * settings.default.max_examples))
 
 
 @pytest.fixture

@@ -4,7 +4,7 @@ import functools
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import given
 from hypothesis import strategies as st
 
 import hystcomp
@@ -133,7 +133,6 @@ def test_bipolar_record_with_offset_gives_the_true_offset(rng):
     np.testing.assert_allclose(model.thresholds_, true.thresholds_, atol=1e-9)  # eq. (16)
 
 
-@settings(max_examples=40, deadline=None)
 @given(mpi_models(), st.floats(-50.0, 50.0))
 def test_a_bias_on_h_is_absorbed_into_offset_and_states(case, bias):
     # b + H[v - v0; y0] = H[v - v0'; y0'] (shift equivariance of the play, eq. 11)

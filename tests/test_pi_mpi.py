@@ -4,7 +4,7 @@ import itertools
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import given
 from hypothesis import strategies as st
 
 import hystcomp
@@ -13,15 +13,12 @@ from hystcomp.models.inversion import invert_superposition
 from tests import naive
 from tests.conftest import mpi_models, pi_models, random_walk
 
-PROPERTY = settings(max_examples=60, deadline=None)
-
 
 def _inputs(model, rng, n=400):
     lo, hi = model.voltage_range_
     return random_walk(rng, n, lo, hi, (hi - lo) / 8)
 
 
-@PROPERTY
 @given(pi_models())
 def test_pi_matches_naive_sum_of_plays(case):
     model, rng = case
@@ -37,7 +34,6 @@ def test_pi_matches_naive_sum_of_plays(case):
     np.testing.assert_allclose(model.simulate(v), expected, rtol=1e-12, atol=1e-9)
 
 
-@PROPERTY
 @given(mpi_models())
 def test_mpi_matches_naive_cascade(case):
     model, rng = case
@@ -55,7 +51,6 @@ def test_mpi_matches_naive_cascade(case):
     np.testing.assert_allclose(model.simulate(v), expected, rtol=1e-12, atol=1e-9)
 
 
-@PROPERTY
 @given(st.one_of(pi_models(), mpi_models()))
 def test_inverse_after_model_returns_the_voltage(case):
     model, rng = case
@@ -64,7 +59,6 @@ def test_inverse_after_model_returns_the_voltage(case):
     np.testing.assert_allclose(v_back, v, rtol=0, atol=1e-9 * max(1.0, np.abs(v).max()))
 
 
-@PROPERTY
 @given(st.one_of(pi_models(), mpi_models()))
 def test_model_after_inverse_returns_the_reference(case):
     model, rng = case
@@ -74,7 +68,6 @@ def test_model_after_inverse_returns_the_reference(case):
     np.testing.assert_allclose(x_back, x, rtol=0, atol=1e-9 * max(1.0, np.abs(x).max()))
 
 
-@PROPERTY
 @given(st.one_of(pi_models(), mpi_models()), st.floats(-1e4, 1e4), st.floats(0.0, 1e4))
 def test_compensator_output_never_leaves_the_voltage_range(case, center, scale):
     model, rng = case

@@ -5,7 +5,7 @@ import json
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import given
 from hypothesis import strategies as st
 
 import hystcomp
@@ -15,8 +15,6 @@ from hystcomp.errors import InvalidParameterError, ModelFileError, NotFittedErro
 from hystcomp.models.preisach import Preisach
 from tests import naive
 from tests.conftest import preisach_models, random_walk
-
-PROPERTY = settings(max_examples=40, deadline=None)
 
 
 def _walk(model, rng, n=250, overshoot=0.1):
@@ -32,7 +30,6 @@ def _reference_everett(model):
     return naive.everett_table(model.table_, lo, hi)
 
 
-@PROPERTY
 @given(preisach_models(monotone=False))
 def test_kernel_matches_extrema_recomputed_from_scratch(case):
     # any X, even one with X(v, v) != 0 as eq. (6): eqs. (3)-(4) as written
@@ -45,7 +42,6 @@ def test_kernel_matches_extrema_recomputed_from_scratch(case):
     np.testing.assert_allclose(model.simulate(v), expected, rtol=0, atol=1e-11 * scale)
 
 
-@PROPERTY
 @given(preisach_models(monotone=True), st.integers(3, 25))
 def test_kernel_matches_relay_grid_of_eq_1(case, n_nodes):
     # eq. (1) literally: relays weighted by the density integrated over their cells
@@ -103,7 +99,6 @@ def _ramp(a, b, n=7):
     return np.linspace(a, b, n)[1:]
 
 
-@PROPERTY
 @given(preisach_models(monotone=False), st.data())
 def test_wipe_out_erases_a_minor_loop_once_its_maximum_is_passed(case, data):
     model, rng = case
@@ -127,7 +122,6 @@ def test_wipe_out_erases_a_minor_loop_once_its_maximum_is_passed(case, data):
     np.testing.assert_allclose(x_with[-n_after:], x_without[-n_after:], atol=1e-12 * scale)
 
 
-@PROPERTY
 @given(preisach_models(monotone=False), st.data())
 def test_minor_loops_between_the_same_extrema_are_congruent(case, data):
     model, rng = case

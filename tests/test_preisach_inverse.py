@@ -2,7 +2,7 @@
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import given
 from hypothesis import strategies as st
 
 import hystcomp
@@ -12,8 +12,6 @@ from hystcomp.identify.excitation import triangle_sequence
 from hystcomp.models.preisach import Preisach, PreisachCompensator
 from tests.conftest import monotone_theta, preisach_models, random_walk
 
-PROPERTY = settings(max_examples=40, deadline=None)
-
 
 def _reachable(model, rng, n=400):
     lo, hi = model.voltage_range_
@@ -21,7 +19,6 @@ def _reachable(model, rng, n=400):
     return v, model.simulate(v)
 
 
-@PROPERTY
 @given(preisach_models(monotone=True))
 def test_model_after_exact_inverse_is_the_identity(case):
     model, rng = case
@@ -30,7 +27,6 @@ def test_model_after_exact_inverse_is_the_identity(case):
     np.testing.assert_allclose(x_back, x, rtol=0, atol=1e-9 * max(1.0, np.abs(x).max()))
 
 
-@PROPERTY
 @given(preisach_models(monotone=True, representation=("polynomial",)))
 def test_exact_inverse_after_model_returns_the_voltage(case):
     # strictly monotone branches: the voltage is unique
@@ -41,7 +37,6 @@ def test_exact_inverse_after_model_returns_the_voltage(case):
     np.testing.assert_allclose(v_back, v, rtol=0, atol=1e-7 * (hi - lo))
 
 
-@PROPERTY
 @given(
     preisach_models(monotone=False),
     st.sampled_from(["multiplicative", "exact"]),

@@ -12,7 +12,15 @@ import numpy as np
 from hystcomp import paper
 from hystcomp import preisach_kernels as pk
 from hystcomp._hyperparameters import MAX_DEGREE, check_options
-from hystcomp._validation import as_vector, check_int, check_range, check_real
+from hystcomp._validation import (
+    MAX_MAGNITUDE,
+    _first_out_of_bounds,
+    _real_array,
+    as_vector,
+    check_int,
+    check_range,
+    check_real,
+)
 from hystcomp.errors import InvalidParameterError, InvalidTypeError
 from hystcomp.identify.compensation import compensation_error
 from hystcomp.identify.preisach import identify_preisach
@@ -31,7 +39,8 @@ class PreisachStepper(Stepper):
     A :class:`~hystcomp.models.system.Stepper` on the Preisach kernels: the same fast
     bound :meth:`step`, :meth:`step_block`, :meth:`reset` and :meth:`copy`. A non-finite
     input sample holds the last output (before the first sample: ``x_0`` for a model,
-    ``v_min`` for a compensator) and is counted in :attr:`nonfinite_count`.
+    ``v_min`` clamped to the output range for a compensator) and is counted in
+    :attr:`nonfinite_count`.
     """
 
     kernels = pk.PREISACH_KERNELS
@@ -204,6 +213,27 @@ class Preisach(HysteresisModel):
             model.theta_, model.table_ = None, _check_table(table, owner)
             model.grid_size = model.table_.shape[0]
         model.voltage_range = None
+        return model
+
+    @classmethod
+    def from_dict(cls, data) -> Preisach:
+        """Inverse of :meth:`to_dict`; a ``degree`` hyperparameter must match ``theta``.
+
+        Evaluation takes the degree of X and the memory bound from the hyperparameters, so
+        a document whose ``theta`` has the size of another degree, or whose ``max_extrema``
+        is not an int >= 3, is refused here rather than failing later.
+        """
+        model = super().from_dict(data)
+        check_int(model.max_extrema, "max_extrema", cls.__name__, minimum=3)
+        if model.theta_ is not None:
+            sizes = {pk.n_monomials(d): d for d in range(1, MAX_DEGREE + 1)}
+            degree = sizes[model.theta_.size]
+            if type(model.degree) is not int or model.degree != degree:  # not 3.0 nor True
+                raise InvalidParameterError(
+                    f"The 'degree' hyperparameter of {cls.__name__} must match 'theta', whose "
+                    f"{model.theta_.size} entries are those of degree {degree}. Got "
+                    f"{model.degree!r} instead; correct or drop it."
+                )
         return model
 
     def fit(self, v, x) -> Preisach:
@@ -392,8 +422,8 @@ class PreisachCompensator(Compensator):
     """Preisach-based feedforward: reference displacement (µm) in, voltage (V) out.
 
     Built by :meth:`Preisach.inverse`; the output is always inside ``voltage_range``, and
-    before the first sample it is ``v_min`` (the model's start state). Batch ``simulate``
-    and the stepper run the same kernel, bit for bit.
+    before the first sample it is ``v_min`` (the model's start state) clamped to it. Batch
+    ``simulate`` and the stepper run the same kernel, bit for bit.
 
     Attributes
     ----------
@@ -439,8 +469,8 @@ def _frozen(arr: np.ndarray) -> np.ndarray:
 
 def _check_table(table, owner) -> np.ndarray:
     try:
-        arr = np.array(table, dtype=np.float64)
-    except (TypeError, ValueError):
+        arr = _real_array(table, copy=True)
+    except (TypeError, ValueError, OverflowError):
         raise InvalidTypeError(
             f"The 'table' parameter of {owner} must be a square 2-D array of numbers. "
             f"Got a {type(table).__name__} that does not convert to one."
@@ -451,10 +481,12 @@ def _check_table(table, owner) -> np.ndarray:
             f"values X(alpha_i, beta_j). Got shape {arr.shape} instead."
         )
     lower = np.tril(arr)
-    if not np.all(np.isfinite(lower)):
-        i, j = np.argwhere(~np.isfinite(lower))[0]
+    bad = _first_out_of_bounds(lower)  # beyond MAX_MAGNITUDE, sums of X overflow to inf/NaN
+    if bad is not None:
+        i, j = np.unravel_index(bad, arr.shape)
         raise InvalidParameterError(
-            f"The 'table' parameter of {owner} must be finite on and below the diagonal. "
-            f"Entry [{i}, {j}] is {float(arr[i, j])!r}."
+            f"The 'table' parameter of {owner} must be finite and at most {MAX_MAGNITUDE:g} "
+            f"in size on and below the diagonal. Entry [{i}, {j}] is {float(arr[i, j])!r}; "
+            "check the units."
         )
     return _frozen(pk.antisymmetric_table(lower))
