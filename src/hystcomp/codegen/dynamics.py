@@ -34,7 +34,7 @@ def add_dynamics(template: CTemplate, inverse) -> CTemplate:
         "  sample its voltage is for (fed the reference of now, the stage lags it by that).",
     ]
     template.state_fields += [f"double dyn_line[{n_fir}]; /* reference delay line, um */"]
-    template.tables.append(c_table("{p}_dyn_h", taps, "FIR taps: resonance inverse (ZPETC)"))
+    template.tables.append(c_table("{p}_dyn_h", taps, "FIR taps: resonance inverse, non-negative"))
     rest = c_double(inverse.rest)
     template.reset_body += [
         "{",
