@@ -83,8 +83,9 @@ class DynamicsInverse:
     Attributes
     ----------
     preview : int
-        Samples of look-ahead of the FIR part (``D[inverse[x]]`` equals ``x`` low-passed,
-        with no delay, once the stepper is given the reference this many samples ahead).
+        Samples of look-ahead of the FIR part (``D[inverse[x]]`` equals ``x`` filtered by
+        ``R G``, close to 1 in the band, with no delay, once the stepper is given the
+        reference this many samples ahead).
     rest : float
         The reference at which the filter starts at rest, µm.
     """
