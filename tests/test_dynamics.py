@@ -14,6 +14,7 @@ from hystcomp.cli import main
 from hystcomp.data import read_table, write_table
 from hystcomp.errors import IdentificationError, InvalidParameterError, InvalidTypeError
 from hystcomp.identify.dynamics import dynamics_excitation
+from hystcomp.models.dynamic_compensator import MAX_PREVIEW
 from hystcomp.models.dynamics import DynamicCompensator, LinearDynamics
 from hystcomp.plant import Twin, creep_twin
 from tests.conftest import random_walk
@@ -81,8 +82,10 @@ def test_resonance_zoh_is_the_exact_discretisation():
         np.testing.assert_allclose(b.sum() / a.sum(), 1.0, rtol=1e-12)
 
 
-@pytest.mark.parametrize("f", [1.0, 10.0, 100.0, 200.0])
-def test_inverse_then_forward_is_the_identity_in_band(f):
+@pytest.mark.parametrize(
+    ("f", "limit"), [(1.0, 0.005), (10.0, 0.005), (100.0, 0.005), (200.0, 0.015)]
+)
+def test_inverse_then_forward_is_the_identity_in_band(f, limit):
     dyn = _stage()
     inverse = dyn.inverse(rest=3.0)
     t = np.arange(round(2.0 * FS)) / FS
@@ -90,7 +93,8 @@ def test_inverse_then_forward_is_the_identity_in_band(f):
     y = inverse.simulate(x)
     back = dyn.simulate(y, initial=3.0)
     inner = slice(round(0.1 * FS), -2 * inverse.preview)
-    assert np.abs(back - x)[inner].max() < 0.005 * 5.0  # 0.5 % of the amplitude
+    # of the amplitude: non-negative taps leave an error growing as f^4 (1.2 % at 200 Hz)
+    assert np.abs(back - x)[inner].max() < limit * 5.0
 
 
 def test_inverse_is_stable_for_any_resonance_and_creep():
@@ -106,6 +110,39 @@ def test_inverse_is_stable_for_any_resonance_and_creep():
         assert np.all(np.isfinite(y))
         assert abs(y[-1] - 1.0) < 0.05  # it settles: no growing mode
         assert np.abs(y).max() < 1e3
+
+
+def test_inverse_of_a_step_rises_monotonically_and_never_amplifies():
+    rng = np.random.default_rng(5)
+    for _ in range(20):
+        dyn = _stage(
+            resonance_hz=rng.uniform(50.0, 9000.0),
+            damping_ratio=rng.uniform(0.005, 3.0),
+            creep_time_constants=(),
+            creep_weights=(),
+        )
+        inverse = dyn.inverse()
+        assert inverse.taps.min() >= 0.0
+        assert inverse.taps.sum() == pytest.approx(1.0, abs=1e-12)
+        assert 0 <= inverse.preview <= MAX_PREVIEW
+        y = inverse.simulate(np.r_[np.zeros(100), np.ones(2000)])
+        assert np.diff(y).min() >= -1e-12  # no overshoot, no dip: no minor loop downstream
+        f = np.linspace(0.0, 0.5 * FS, 501)
+        gain = np.abs(
+            np.exp(-2j * np.pi * np.outer(f / FS, np.arange(inverse.taps.size))) @ inverse.taps
+        )
+        assert gain.max() <= 1.0 + 1e-12
+
+
+def test_matching_leaves_its_centre_in_place_and_scales_about_it():
+    dyn = _stage(creep_time_constants=[0.004, 0.4], creep_weights=[0.015, 0.015])
+    gain = abs(dyn.frequency_response([1.0])[0])
+    inverse = dyn.inverse(rest=0.0, match_hz=1.0, match_centre=10.0)
+    held = inverse.simulate(np.r_[np.zeros(100), np.full(400_000, 10.0)])
+    assert held[-1] == pytest.approx(10.0, abs=1e-9)
+    top = inverse.simulate(np.r_[np.zeros(100), np.full(400_000, 20.0)])
+    assert top[-1] == pytest.approx(10.0 + 10.0 * gain, abs=1e-9)
+    assert gain < 0.995  # so that the two cases differ
 
 
 def test_model_file_round_trip(identified, tmp_path):
@@ -220,7 +257,7 @@ def test_c_without_creep_matches_the_stepper(tmp_path):
     v_c, _ = _run_c(drive, x)
     s = comp.stepper()
     np.testing.assert_allclose(v_c, [s.step(u) for u in x], rtol=0, atol=1e-9)
-    assert comp.preview == 26  # ceil(1.5 fs / (2 f_n)) + 2: documented in docs/dynamics.md
+    assert comp.preview == 8  # half the taps' span, documented in docs/dynamics.md
 
 
 def test_targets_on_a_creep_stage():

@@ -1,8 +1,8 @@
 """Compiled kernel of the inverse of the linear dynamics: one step, and a batch loop over it.
 
-The inverse filter (see :mod:`hystcomp.models.dynamics`) is a FIR stage (the inverse of
-the resonance with its sampling zero reflected, ZPETC, times a linear-phase low-pass) in
-series with the exact inverse of the creep bank. Its parameters and state are one packed
+The inverse filter (see :mod:`hystcomp.models.dynamics`) is a FIR stage (non-negative taps
+fitted so that the resonance times them is close to 1 in the band) in series with the
+exact inverse of the creep bank. Its parameters and state are one packed
 float64 array, as the chain's (:mod:`hystcomp.operators`)::
 
     [N_FIR, N_CREEP, SCALE, DIRECT, LOW, HIGH, BIAS, h_0 .. h_{N_FIR-1}, a_1 .. a_n, c_1 .. c_n,

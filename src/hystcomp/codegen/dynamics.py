@@ -1,7 +1,7 @@
 """C99 of the inverse of the linear dynamics, put in front of any compensator template.
 
 The generated ``NAME_step`` first runs the reference through the inverse filter of
-:mod:`hystcomp.models.dynamics` (the FIR of the resonance inverse and low-pass, then the
+:mod:`hystcomp.models.dynamics` (the non-negative FIR of the resonance inverse, then the
 exact inverse of the creep bank, clamped to the model's displacement range), then the
 hysteresis compensator's own code on the filtered reference, exactly as
 :class:`~hystcomp.models.dynamic_compensator.DynamicStepper` does. The FIR looks ahead: the caller
@@ -34,7 +34,7 @@ def add_dynamics(template: CTemplate, inverse) -> CTemplate:
         "  sample its voltage is for (fed the reference of now, the stage lags it by that).",
     ]
     template.state_fields += [f"double dyn_line[{n_fir}]; /* reference delay line, um */"]
-    template.tables.append(c_table("{p}_dyn_h", taps, "FIR taps: resonance inverse (ZPETC)"))
+    template.tables.append(c_table("{p}_dyn_h", taps, "FIR taps: resonance inverse, non-negative"))
     rest = c_double(inverse.rest)
     template.reset_body += [
         "{",

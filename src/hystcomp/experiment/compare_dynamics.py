@@ -140,8 +140,8 @@ def dynamics_markdown(dc: DynamicsComparison, table1: dict) -> list[str]:
             f"Step to half the peak, held {STEP_HOLD:g} s: mean |error| from "
             f"{1000 * STEP_FROM:g} ms to the end, and how far the error drifts over that time "
             "(the creep left), in µm. With the dynamics the drift is gone; what is left is the "
-            "hysteresis model's static error at that point, and for MPI the minor loop that the "
-            "inverse's overshoot at the step opens (see docs/dynamics.md):"
+            "hysteresis model's static error at that point, and the minor loops that the "
+            "compensator's own path opens (see docs/dynamics.md):"
         ),
         "",
         "| method | mean abs error | drift |",
