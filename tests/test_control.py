@@ -122,3 +122,37 @@ def test_the_twin_as_a_system_equals_twin_run_noise_included():
     np.testing.assert_allclose(_response(sys, v), Twin(seed=5).run(v), rtol=0, atol=1e-12)
     with pytest.raises(InvalidParameterError, match="twin's sample time"):
         hystcomp.to_control(Twin(), 1e-3)
+
+
+def _dynamics():
+    from hystcomp.models.dynamics import LinearDynamics
+
+    return LinearDynamics.from_parameters(
+        sample_rate=20_000.0,
+        resonance_hz=780.0,
+        damping_ratio=0.05,
+        creep_time_constants=[0.01, 0.3],
+        creep_weights=[0.02, 0.01],
+    )
+
+
+def test_linear_dynamics_as_a_system_equals_its_simulate():
+    dyn = _dynamics()
+    rng = np.random.default_rng(3)
+    v = np.cumsum(rng.normal(0.0, 0.5, 3000))
+    response = _response(hystcomp.to_control(dyn, DT), v)
+    expected = dyn.simulate(v, initial=0.0)
+    np.testing.assert_allclose(response, expected, rtol=0, atol=1e-9 * np.ptp(v))
+    with pytest.raises(InvalidParameterError, match="dynamics model's sample time"):
+        hystcomp.to_control(dyn, 1e-3)
+
+
+def test_compensator_with_dynamics_as_a_system_equals_its_stepper():
+    model = presets.paper_mpi()
+    comp = model.inverse(dynamics=_dynamics())
+    x_ref = 10.0 + 8.0 * np.sin(np.linspace(0.0, 12.0, 2000))
+    response = _response(hystcomp.to_control(comp, DT), x_ref)
+    np.testing.assert_array_equal(response, comp.stepper().step_block(x_ref))
+    lo, hi = comp.voltage_range
+    assert lo <= response.min()
+    assert response.max() <= hi

@@ -33,7 +33,7 @@ from hystcomp.errors import (
     InvalidTypeError,
     NotInvertibleError,
 )
-from hystcomp.identify.preisach import MAX_DEGREE
+from hystcomp._hyperparameters import MAX_DEGREE
 from hystcomp.models.preisach import Preisach
 from hystcomp.preisach_kernels import monomial_exponents, n_monomials
 from tests.conftest import examples

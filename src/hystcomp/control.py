@@ -13,7 +13,9 @@ python-control is an optional dependency (``pip install "hystcomp[control]"``), 
 only when :func:`to_control` is called.
 
 The simulated axis (:class:`hystcomp.plant.Twin`) converts too (input ``v``, output ``x``,
-the noisy sensor reading), so a whole loop can be simulated with python-control.
+the noisy sensor reading), so a whole loop can be simulated with python-control; so do a
+:class:`~hystcomp.models.dynamics.LinearDynamics` model (a linear state-space system) and a
+compensator with the inverse of the dynamics (``model.inverse(dynamics=dyn)``).
 
 Another kind of object plugs in with one function that describes it, at sample time ``dt``,
 as a :class:`DiscreteSystem`, registered for its class with :func:`register`::
@@ -120,12 +122,7 @@ def _twin(twin, dt: float) -> DiscreteSystem:
     """
     from hystcomp.plant import _kernels as kernels
 
-    rate = twin.sample_rate
-    if abs(dt * rate - 1.0) > 1e-9:
-        raise InvalidParameterError(
-            f"The 'dt' parameter of to_control must be the twin's sample time 1/{rate:g} s "
-            f"= {1.0 / rate:g} s. Got {dt:g} s; build a Twin with another sample_rate instead."
-        )
+    _check_rate(dt, twin.sample_rate, "the twin's", "build a Twin with another sample_rate instead")
     params = twin.params
     sigma = params.sensor_noise / params.sensor_gain
     rng = np.random.default_rng(twin.seed)
@@ -157,10 +154,86 @@ def _twin(twin, dt: float) -> DiscreteSystem:
     )
 
 
+def _linear_dynamics(dyn, dt: float) -> DiscreteSystem:
+    """The linear dynamics ``D(z)`` (creep bank, then the resonance) as a state-space system.
+
+    The same transfer function as :meth:`LinearDynamics.simulate
+    <hystcomp.models.dynamics.LinearDynamics.simulate>`, from rest at 0 (input ``v``, the
+    output ``x`` of the hysteresis in µm, to the displacement ``x_d`` in µm).
+    """
+    from scipy.signal import tf2ss
+
+    from hystcomp import _lti
+
+    _check_rate(dt, dyn.sample_rate_, "the dynamics model's", "identify it at that rate")
+    lags, weights = dyn.creep_lags, dyn.creep_weights_
+    scale = 1.0 + float(np.sum(weights))
+    # the creep bank, state s_i = w_i[k-1] of w_i = lfilter([1 - a_i], [1, -a_i], u):
+    # y_c = (u + sum_i c_i w_i) / (1 + sum c),  s_i' = a_i s_i + (1 - a_i) u
+    c_creep = weights * lags / scale
+    d_creep = (1.0 + float(np.sum(weights * (1.0 - lags)))) / scale
+    # then the resonance (b0 z + b1) / (z^2 + a1 z + a2), strictly proper, fed y_c
+    b, a = _lti.resonance_zoh(dyn.resonance_hz_, dyn.damping_ratio_, dyn.sample_rate_)
+    a_res, b_res, c_res, _ = tf2ss(b, a)
+    n = lags.size
+    A = np.zeros((n + 2, n + 2))
+    A[:n, :n] = np.diag(lags)
+    A[n:, :n] = np.outer(b_res[:, 0], c_creep)
+    A[n:, n:] = a_res
+    b_col = np.r_[1.0 - lags, b_res[:, 0] * d_creep]
+    c_row = np.r_[np.zeros(n), c_res[0]]
+    d = 0.0
+    return DiscreteSystem(
+        state=np.zeros(n + 2),
+        update=lambda s, u: A @ s + b_col * float(np.ravel(u)[0]),
+        output=lambda s, u: float(c_row @ s) + d * float(np.ravel(u)[0]),
+        inputs=("v",),
+        outputs=("x",),
+    )
+
+
+def _dynamic_compensator(obj, dt: float) -> DiscreteSystem:
+    """The inverse of the dynamics, then the hysteresis compensator: the state of both.
+
+    As the compensator's stepper, its input is the reference ``preview`` samples ahead
+    (:attr:`~hystcomp.models.dynamic_compensator.DynamicCompensator.preview`).
+    """
+    stepper = obj.stepper()
+    dyn, hyst = stepper._dyn, stepper._hyst
+    n_dyn, start = dyn._p.size, hyst._start
+
+    def step(s: np.ndarray, u: np.ndarray) -> float:
+        dyn._p[:] = s[:n_dyn]
+        hyst._p[start:] = s[n_dyn:]
+        return stepper.step(float(np.ravel(u)[0]))
+
+    def update(s, u):
+        step(s, u)
+        return np.concatenate([dyn._p, hyst._p[start:]])
+
+    return DiscreteSystem(
+        state=np.concatenate([dyn._initial, hyst._initial[start:]]),
+        update=update,
+        output=step,
+        inputs=("x_ref",),
+        outputs=("v",),
+    )
+
+
+def _check_rate(dt: float, rate: float, whose: str, fix: str) -> None:
+    if abs(dt * rate - 1.0) > 1e-9:
+        raise InvalidParameterError(
+            f"The 'dt' parameter of to_control must be {whose} sample time 1/{rate:g} s "
+            f"= {1.0 / rate:g} s. Got {dt:g} s; {fix}."
+        )
+
+
 def _builtin_adapters() -> list[tuple[type, Adapter]]:
     # Imported here so that importing this module loads no kernel.
     from hystcomp.models.base import HysteresisModel
     from hystcomp.models.compensator import Compensator
+    from hystcomp.models.dynamic_compensator import DynamicCompensator
+    from hystcomp.models.dynamics import LinearDynamics
     from hystcomp.plant import Twin
 
     def _model(obj, dt) -> DiscreteSystem:
@@ -169,7 +242,13 @@ def _builtin_adapters() -> list[tuple[type, Adapter]]:
     def _compensator(obj, dt) -> DiscreteSystem:
         return _stepped(obj.stepper(), ("x_ref",), ("v",))
 
-    return [(HysteresisModel, _model), (Compensator, _compensator), (Twin, _twin)]
+    return [
+        (HysteresisModel, _model),
+        (Compensator, _compensator),
+        (Twin, _twin),
+        (LinearDynamics, _linear_dynamics),
+        (DynamicCompensator, _dynamic_compensator),
+    ]
 
 
 def _import_control():
