@@ -23,6 +23,7 @@ from hypothesis.extra import numpy as hnp
 import hystcomp
 from hystcomp import io as model_io
 from hystcomp import presets
+from hystcomp._hyperparameters import MAX_DEGREE
 from hystcomp._kernels.preisach import monomial_exponents, n_monomials
 from hystcomp._validation import MAX_MAGNITUDE
 from hystcomp.codegen import generate_c
@@ -34,7 +35,6 @@ from hystcomp.errors import (
     InvalidTypeError,
     NotInvertibleError,
 )
-from hystcomp.identify.preisach import MAX_DEGREE
 from hystcomp.models.preisach import Preisach
 from tests.conftest import examples
 
