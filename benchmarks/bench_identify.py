@@ -40,7 +40,8 @@ ONE_THREAD = {
 
 import numpy as np
 
-from hystcomp import ModifiedPrandtlIshlinskii, PrandtlIshlinskii, operators, presets
+from hystcomp import ModifiedPrandtlIshlinskii, PrandtlIshlinskii, presets
+from hystcomp._kernels import chain
 from hystcomp.identify.excitation import triangle_sequence
 from hystcomp.identify.pi import paper_thresholds
 
@@ -65,7 +66,7 @@ def _design(v, x, n_operators, n_deadzones):
     """The MPI regressors of eq. (19) as a dense matrix, for the reference solver."""
     plays = np.empty((v.size, n_operators))
     r = paper_thresholds(n_operators, np.ptp(v))
-    operators.play_outputs(v - v.min(), r, np.zeros(n_operators), plays)
+    chain.play_outputs(v - v.min(), r, np.zeros(n_operators), plays)
     z = x - x.min()
     rs = paper_thresholds(n_deadzones, z.max())[1:]
     deadzones = np.maximum(z[:, None] - rs[None, :], 0.0)

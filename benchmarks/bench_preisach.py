@@ -33,8 +33,8 @@ from pathlib import Path
 import numba
 import numpy as np
 
-from hystcomp import preisach_kernels as pk
 from hystcomp import presets
+from hystcomp._kernels import preisach as pk
 from hystcomp.codegen import export_c
 
 N_SAMPLES = 1_000_000

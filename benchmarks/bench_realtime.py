@@ -4,7 +4,7 @@
   over a million samples, against a C99 version with the same loop structure as the kernel
   (``benchmarks/c/inverse_mpi_blocks.c``: blocks, dead-zones vectorised over samples, plays
   over operators) compiled here with the compiler licences that numba has: the fast-math subset of the package's
-  kernels (:data:`hystcomp.operators.FASTMATH`: reassociation, contraction, no signed zeros,
+  kernels (:data:`hystcomp._kernels._jit.FASTMATH`: reassociation, contraction, no signed zeros,
   reciprocals; :data:`C_FASTMATH` here) and the host's instruction set (numba compiles for
   the host CPU, so ``-march=native``). That ratio says how far the kernels are from what the
   same loop can do (target: at most 1.5x its time). The same C with plain ``cc -O3`` (no
@@ -35,14 +35,14 @@ from pathlib import Path
 import numpy as np
 
 import hystcomp
-from hystcomp import operators
+from hystcomp._kernels import _jit, chain
 from hystcomp.codegen import export_c
 
 HERE = Path(__file__).resolve().parent
 N_SAMPLES = 1_000_000
 REPEAT = 11
 CC = shutil.which("cc")
-# gcc/clang flags for the fast-math flags of the package's kernels (operators.FASTMATH:
+# gcc/clang flags for the fast-math flags of the package's kernels (_jit.FASTMATH:
 # reassoc, contract, nsz, arcp; not nnan/ninf, which would drop the finiteness tests).
 # -fassociative-math needs -fno-signed-zeros and -fno-trapping-math to take effect.
 C_FASTMATH = [
@@ -105,7 +105,7 @@ def batch_rows(comp, x: np.ndarray, tmp: Path) -> list[dict]:
         return lambda: run(x, out)
 
     funcs = {
-        "numba": timed("numba", lambda u, out: operators.chain_run(comp.packed.copy(), u, out)),
+        "numba": timed("numba", lambda u, out: chain.chain_run(comp.packed.copy(), u, out)),
         "simulate": lambda: comp.simulate(x),
     }
     funcs["numba"]()  # compile, or load from the cache
@@ -169,7 +169,7 @@ class PlainC:
     N_DEADZONES = N_PLAYS = 16
 
     def __init__(self, comp, tmp: Path, flags: list[str], variant: str = ""):
-        c = operators.unpack_chain(comp.packed)
+        c = chain.unpack_chain(comp.packed)
         if (c.pre_r.size, c.play_r.size, c.post_r.size) != (self.N_DEADZONES, self.N_PLAYS, 0):
             raise ValueError("the C reference is written for 16 dead-zones then 16 plays")
         name = "inverse_mpi" + (f"_{variant}" if variant else "")
@@ -189,7 +189,7 @@ class PlainC:
             doubles(*c.play_w),
             *(getattr(c, name) for name in scalars),
             doubles(*c.plays),
-            c.state[operators.STATE_LAST],
+            c.state[chain.STATE_LAST],
         )
         self._state = state_type()
 
@@ -243,7 +243,7 @@ def stepper_rows(comp, x: np.ndarray) -> list[dict]:
             stepper.step_block(block)
 
     # the reference: the compiled step bound to the state, without the sample's type check
-    raw = functools.partial(operators.step_function(stepper.kernels.step), stepper._p)
+    raw = functools.partial(_jit.step_function(stepper.kernels.step), stepper._p)
 
     def raw_loop():
         for xk in samples:

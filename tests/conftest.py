@@ -15,7 +15,7 @@ from hypothesis import HealthCheck, settings
 from hypothesis import strategies as st
 
 import hystcomp
-from hystcomp import operators
+from hystcomp._kernels import chain
 
 settings.register_profile(
     "ci",
@@ -71,7 +71,7 @@ def pi_models(draw, max_ops=8):
     if draw(st.booleans()):
         history = random_walk(rng, 50, 0.0, span, span / 4)
         out = np.empty((history.size, n))
-        operators.play_outputs(history, r, initial_state, out)
+        chain.play_outputs(history, r, initial_state, out)
         initial_state = out[-1]
     model = hystcomp.PrandtlIshlinskii.from_parameters(
         thresholds=r,
@@ -112,7 +112,7 @@ def everett_from_density(nu, mu, degree):
     ``mu(a, b) = sum mu[(p, q)] b^p a^q``; non-negative coefficients make every branch
     monotone (and strictly so when ``nu[0] > 0``).
     """
-    from hystcomp.preisach_kernels import monomial_exponents
+    from hystcomp._kernels.preisach import monomial_exponents
 
     coef = {}
 
@@ -148,7 +148,7 @@ def monotone_theta(rng, degree, span, stroke):
 
 
 def _exps(degree):
-    from hystcomp.preisach_kernels import monomial_exponents
+    from hystcomp._kernels.preisach import monomial_exponents
 
     return monomial_exponents(degree)
 
@@ -160,8 +160,8 @@ def preisach_models(draw, monotone=True, representation=("polynomial", "table"))
     ``monotone``: X(v, v) = 0 and strictly monotone branches (built from a density);
     otherwise an arbitrary polynomial or table. The table samples such a polynomial on a grid.
     """
+    from hystcomp._kernels.preisach import n_monomials
     from hystcomp.models.preisach import Preisach
-    from hystcomp.preisach_kernels import n_monomials
 
     seed = draw(st.integers(0, 2**32 - 1))
     rng = np.random.default_rng(seed)

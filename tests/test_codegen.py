@@ -12,7 +12,8 @@ import numpy as np
 import pytest
 
 import hystcomp
-from hystcomp import preisach_kernels as pk
+from hystcomp._kernels import chain
+from hystcomp._kernels import preisach as pk
 from hystcomp.codegen import export_c, generate_c
 from hystcomp.errors import InvalidParameterError
 from hystcomp.identify.excitation import sinusoid_sequence
@@ -165,7 +166,7 @@ def test_parameters_are_written_with_full_precision():
     _, source = generate_c(comp)
     table = re.search(r"play_w\[16\] = \{([^}]*)\}", source).group(1)
     values = np.array([float(t) for t in table.replace("\n", " ").split(",")])
-    play_w = hystcomp.operators.unpack_chain(comp.packed).play_w
+    play_w = chain.unpack_chain(comp.packed).play_w
     assert np.array_equal(values, play_w)  # 17 significant digits read back exactly
 
 

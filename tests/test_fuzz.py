@@ -24,6 +24,7 @@ import hystcomp
 from hystcomp import io as model_io
 from hystcomp import presets
 from hystcomp._hyperparameters import MAX_DEGREE
+from hystcomp._kernels.preisach import monomial_exponents, n_monomials
 from hystcomp._validation import MAX_MAGNITUDE
 from hystcomp.codegen import generate_c
 from hystcomp.data import read_record, read_table
@@ -35,7 +36,6 @@ from hystcomp.errors import (
     NotInvertibleError,
 )
 from hystcomp.models.preisach import Preisach
-from hystcomp.preisach_kernels import monomial_exponents, n_monomials
 from tests.conftest import examples
 
 # Boundary fuzzing needs many examples to reach the odd corners, and each one is cheap.

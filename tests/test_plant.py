@@ -88,6 +88,42 @@ def test_stepper_equals_batch_bit_for_bit(rng):
     np.testing.assert_array_equal(stepper.step_block(v), streamed)
 
 
+def test_stepper_is_the_package_stepper_over_the_twin_kernel(rng):
+    from hystcomp._kernels import twin as kernels
+    from hystcomp.models.system import Stepper
+
+    twin = Twin(QUIET)
+    v = random_walk(rng, 300, 0.0, 120.0, 5.0)
+    stepper = twin.stepper()
+    assert isinstance(stepper, Stepper)
+    assert stepper.kernels is kernels.TWIN_KERNELS
+    stepper.step_block(v[:100])
+    other = stepper.copy()  # same state, its own noise generator
+    np.testing.assert_array_equal(other.step_block(v[100:]), stepper.step_block(v[100:]))
+    assert stepper.last_output == twin.run_noiseless(v)[-1] - QUIET.sensor_offset
+    assert stepper.nonfinite_count == 0
+    assert stepper.clamped_count == 0
+    with pytest.raises(InvalidParameterError, match="finite"):
+        stepper.step(np.nan)
+
+
+def test_twin_kernel_holds_a_non_finite_command_and_counts_it(rng):
+    from hystcomp._kernels import twin as kernels
+
+    twin = Twin(QUIET)
+    v = random_walk(rng, 200, 0.0, 120.0, 5.0)
+    held = v.copy()
+    held[50] = np.nan
+    held[120] = -np.inf
+    p = twin._packed.copy()
+    out = np.empty_like(v)
+    kernels.twin_run(p, held, out)
+    v[50] = v[49]  # the amplifier keeps its voltage
+    v[120] = v[119]
+    np.testing.assert_array_equal(out, twin.run_noiseless(v) - QUIET.sensor_offset)
+    assert p[kernels.state_start.py_func(p) + kernels.S_NONFINITE] == 2.0
+
+
 def test_amplifier_rails_clamp_the_command():
     twin = Twin(QUIET)
     ramp = np.linspace(0.0, 150.0, 301)

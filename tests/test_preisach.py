@@ -9,8 +9,8 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 import hystcomp
-from hystcomp import preisach_kernels as pk
 from hystcomp import presets
+from hystcomp._kernels import preisach as pk
 from hystcomp.errors import InvalidParameterError, ModelFileError, NotFittedError
 from hystcomp.models.preisach import Preisach
 from tests import naive

@@ -9,8 +9,10 @@ import numpy as np
 import pytest
 
 import hystcomp
-from hystcomp import operators, presets
-from hystcomp import preisach_kernels as pk
+from hystcomp import presets
+from hystcomp._kernels import chain
+from hystcomp._kernels import preisach as pk
+from hystcomp._kernels._jit import step_function
 from hystcomp.models.preisach import Preisach, PreisachStepper
 from tests.conftest import random_walk
 
@@ -74,7 +76,7 @@ def test_bound_step_equals_the_batch_run_bit_for_bit(case):
     stepper = system.stepper()
     # the fast path: the compiled entry point of the kind's step kernel, bound to the state
     # behind one type test of the sample
-    assert stepper.step.func is operators.step_function(stepper.kernels.step)
+    assert stepper.step.func is step_function(stepper.kernels.step)
     assert stepper.step.state is stepper._p
     assert np.array_equal([stepper.step(uk) for uk in u], expected)
     assert stepper.nonfinite_count == len(NON_FINITE)
@@ -110,7 +112,7 @@ def test_copies_and_resets_are_independent(case):
 
 
 @pytest.mark.parametrize(
-    "kernels", [operators.CHAIN_KERNELS, pk.PREISACH_KERNELS], ids=["chain", "preisach"]
+    "kernels", [chain.CHAIN_KERNELS, pk.PREISACH_KERNELS], ids=["chain", "preisach"]
 )
 def test_step_kernel_is_compiled_with_the_flags_of_its_batch_kernel(kernels):
     step, run = kernels.step.targetoptions, kernels.run.targetoptions
@@ -130,4 +132,4 @@ def test_every_system_has_the_one_stepper_class():
     assert all(isinstance(s, hystcomp.Stepper) for s in steppers)
     assert [type(s).kernels for s in steppers[2:]] == [pk.PREISACH_KERNELS] * 3
     assert all(isinstance(s, PreisachStepper) for s in steppers[2:])
-    assert all(type(s).kernels is operators.CHAIN_KERNELS for s in steppers[:2])
+    assert all(type(s).kernels is chain.CHAIN_KERNELS for s in steppers[:2])

@@ -1,6 +1,6 @@
 /*
  * The inverse MPI compensator (paper eq. 23) in C99 with the loop structure of hystcomp's
- * compiled chain (hystcomp/operators.py, chain_blocks): samples in blocks of 256, the
+ * compiled chain (hystcomp/_kernels/chain.py, chain_blocks): samples in blocks of 256, the
  * stateless dead-zones as passes over a block (operators outer, samples inner, so that the
  * inner loop vectorises over samples), the plays sample by sample with one fused loop over
  * the operators (their count a multiple of 8), then the hold / slew-limit / clamp. The same

@@ -120,7 +120,7 @@ def _twin(twin, dt: float) -> DiscreteSystem:
     control evaluates. The sensor reads the axis before the sample's voltage acts, so the
     output does not depend on the input (no algebraic loop in feedback).
     """
-    from hystcomp.plant import _kernels as kernels
+    from hystcomp._kernels import twin as kernels
 
     _check_rate(dt, twin.sample_rate, "the twin's", "build a Twin with another sample_rate instead")
     params = twin.params
@@ -136,13 +136,13 @@ def _twin(twin, dt: float) -> DiscreteSystem:
 
     def update(s, u):
         nxt = s.copy()
-        kernels.twin_step(twin._p, nxt[:-1], float(np.ravel(u)[0]))
+        kernels.axis_step(twin._p, nxt[:-1], float(np.ravel(u)[0]))
         nxt[-1] += 1.0
         return nxt
 
     def output(s, u):
         # the reading before u acts: the input does not matter
-        x = kernels.twin_step(twin._p, s[:-1].copy(), float(np.ravel(u)[0]))
+        x = kernels.axis_step(twin._p, s[:-1].copy(), float(np.ravel(u)[0]))
         return x + params.sensor_offset + sigma * noise_at(int(s[-1]))
 
     return DiscreteSystem(

@@ -1,6 +1,6 @@
 """The C template of the PI and MPI compensators, read from their packed operator chain.
 
-The code follows the stages of :mod:`hystcomp.operators` (offset, dead-zones, plays,
+The code follows the stages of :mod:`hystcomp._kernels.chain` (offset, dead-zones, plays,
 dead-zones, offset), each emitted only if the chain has it, so that it exports whatever
 the chain can express: the inverse PI (eqs. 24-26) is plays alone, the inverse MPI (eq. 23)
 dead-zones then plays.
@@ -8,13 +8,13 @@ dead-zones then plays.
 
 from __future__ import annotations
 
-from hystcomp import operators
+from hystcomp._kernels import chain as ck
 from hystcomp.codegen.c99 import CTemplate, c_double, c_table
 
 
 def chain_template(compensator) -> CTemplate:
     """The :class:`~hystcomp.codegen.c99.CTemplate` of a PI or MPI :class:`Compensator`."""
-    c = operators.unpack_chain(compensator.packed)
+    c = ck.unpack_chain(compensator.packed)
     lo, hi = compensator.voltage_range
     n_pre, n_play, n_post = c.pre_r.size, c.play_r.size, c.post_r.size
     template = CTemplate(
@@ -23,7 +23,7 @@ def chain_template(compensator) -> CTemplate:
         low=lo,
         high=hi,
         max_step=c.max_step,
-        initial_output=c.state[operators.STATE_LAST],
+        initial_output=c.state[ck.STATE_LAST],
         locals=["double z;"] + (["int i;"] if n_pre > 1 or n_play or n_post > 1 else []),
     )
     if n_play:

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from hystcomp import dynamics_kernels as dk
+from hystcomp._kernels import dynamics as dk
 from hystcomp.codegen.c99 import CTemplate, c_double, c_table
 
 

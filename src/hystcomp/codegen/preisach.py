@@ -1,6 +1,6 @@
 """The C template of the Preisach compensators, read from their packed system.
 
-The generated code is a line-by-line C version of :mod:`hystcomp.preisach_kernels`, with the
+The generated code is a line-by-line C version of :mod:`hystcomp._kernels.preisach`, with the
 packed numbers baked in: the Everett-type function X of eq. (2) (the polynomial of eq. 5 of
 any degree, or a table interpolated bilinearly), the memory of alternating dominant extrema
 of eqs. (3)-(4) with the wipe-out property and its prefix sums (one evaluation of X per
@@ -19,7 +19,7 @@ root finder agrees within its tolerance (about 1e-13 V).
 
 from __future__ import annotations
 
-from hystcomp import preisach_kernels as pk
+from hystcomp._kernels import preisach as pk
 from hystcomp.codegen.c99 import CTemplate, c_double, c_table
 from hystcomp.codegen.preisach_exact import exact_functions
 

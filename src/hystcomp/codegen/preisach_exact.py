@@ -1,4 +1,4 @@
-"""The C functions of the exact Preisach inverse, as in :mod:`hystcomp.preisach_kernels`.
+"""The C functions of the exact Preisach inverse, as in :mod:`hystcomp._kernels.preisach`.
 
 ``{p}_exact_input(s, target)`` returns the input that makes ``H`` reach ``target`` (um, no
 offset) from the current memory without changing it: the monotone branch from the last

@@ -27,7 +27,7 @@ import numba
 import numpy as np
 import quadprog
 
-from hystcomp import operators
+from hystcomp._kernels import chain
 from hystcomp.errors import IdentificationError
 
 _BLOCK = 256  # rows per BLAS update of the Gram matrix (larger blocks gain nothing)
@@ -46,10 +46,10 @@ def _regressor_rows(u, r, y, z, rs, begin, rows):
     m = rs.size
     for i in range(rows.shape[0]):
         k = begin + i
-        operators.play_update(u[k], r, y)
+        chain.play_update(u[k], r, y)
         for j in range(n):  # a loop, not row[:n] = y: slice assignment compiles slowly
             rows[i, j] = y[j]
-        operators.deadzone_values(z[k], rs, rows[i, n : n + m])  # negated after the sums
+        chain.deadzone_values(z[k], rs, rows[i, n : n + m])  # negated after the sums
         rows[i, n + m] = 1.0
         rows[i, n + m + 1] = z[k]
 

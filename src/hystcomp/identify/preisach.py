@@ -24,8 +24,9 @@ import numpy as np
 import scipy.sparse
 import scipy.sparse.linalg
 
-from hystcomp import preisach_kernels as pk
 from hystcomp._hyperparameters import check_options
+from hystcomp._kernels import preisach as pk
+from hystcomp._kernels.reversals import turning_points
 from hystcomp._validation import as_signal, check_range, check_real
 from hystcomp.errors import (
     IdentificationError,
@@ -147,7 +148,7 @@ def find_reversal_curves(v, x, *, tolerance=None) -> list[ReversalCurve]:
         else check_real(tolerance, "tolerance", "find_reversal_curves", positive=True)
     )
     idx = np.empty(v.size, dtype=np.int64)
-    count, first_is_max = pk.turning_points(v, tol, idx)
+    count, first_is_max = turning_points(v, tol, idx)
     idx = idx[:count]
     v_min = float(v.min())
     curves = []
@@ -206,7 +207,7 @@ def fit_everett_polynomial(
     """Least-squares fit of eq. (5) (or its degree-``degree`` version) to samples of X.
 
     ``theta`` multiplies the monomials of ``b = beta - v_min`` and ``a = alpha - v_min`` in the
-    order of :func:`~hystcomp.preisach_kernels.monomial_exponents` (eq. 5 for degree 3, where
+    order of :func:`~hystcomp._kernels.preisach.monomial_exponents` (eq. 5 for degree 3, where
     ``v_min = 0`` makes ``a, b`` the paper's ``alpha, beta``). The columns are scaled to the
     unit square for conditioning and the result scaled back exactly.
 

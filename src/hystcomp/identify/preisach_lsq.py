@@ -6,11 +6,11 @@ input's memory of alternating dominant extrema with the wipe-out property (eqs. 
 output of a Preisach model at each sample is a sum of Everett differences over the memory
 staircase, so for an Everett function that is linear in its parameters,
 ``X = sum_m c_m X_m``, the output ``x[k] = x_0 + sum_m c_m R_m[k]`` is linear in ``c`` and
-``x_0``. :func:`~hystcomp.preisach_kernels.preisach_rows` computes the regressors
+``x_0``. :func:`~hystcomp._kernels.preisach.preisach_rows` computes the regressors
 ``R_m[k]`` (eqs. 3-4 with ``X_m`` alone) in one pass over the record, and the normal
 equations are accumulated block by block, as :mod:`hystcomp.identify.lsq` does for PI.
 
-Two bases (see :func:`~hystcomp.preisach_kernels.everett_basis`):
+Two bases (see :func:`~hystcomp._kernels.preisach.everett_basis`):
 
 * ``"polynomial"``: eq. (5)'s monomials of any degree with ``X(v, v) = 0`` built in (eq. 2);
 * ``"table"``: non-negative masses on the cells of a uniform grid of the limiting triangle
@@ -35,7 +35,7 @@ import math
 
 import numpy as np
 
-from hystcomp import preisach_kernels as pk
+from hystcomp._kernels import preisach as pk
 from hystcomp.errors import IdentificationError
 from hystcomp.identify.lsq import solve_inequality_qp
 from hystcomp.identify.scoring import transient_end

@@ -11,7 +11,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from hystcomp import operators
+from hystcomp._kernels import chain
 from hystcomp._validation import as_signal
 from hystcomp.models.system import PackedSystem, Stepper
 
@@ -64,7 +64,7 @@ class Compensator(PackedSystem):
         self._chain = packed
         self.kind = kind
         self.voltage_range = voltage_range
-        self.max_step = float(packed[operators.MAX_STEP])
+        self.max_step = float(packed[chain.MAX_STEP])
 
     def _packed(self) -> np.ndarray:
         return self._chain

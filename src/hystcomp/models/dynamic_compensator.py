@@ -4,7 +4,7 @@
 :mod:`hystcomp.models.dynamics` for the model and why the inverse is stable);
 ``model.inverse(dynamics=dyn)`` puts it in front of the hysteresis compensator as a
 :class:`DynamicCompensator` (:func:`with_dynamics`). The filter loop is the kernel of
-:mod:`hystcomp.dynamics_kernels`, shared by the batch run, the stepper and (as C) the export.
+:mod:`hystcomp._kernels.dynamics`, shared by the batch run, the stepper and (as C) the export.
 """
 
 from __future__ import annotations
@@ -14,8 +14,8 @@ import math
 
 import numpy as np
 
-from hystcomp import dynamics_kernels as dk
-from hystcomp import operators
+from hystcomp._kernels import dynamics as dk
+from hystcomp._kernels._jit import step_function
 from hystcomp._validation import as_signal, check_int
 from hystcomp.errors import InvalidTypeError
 
@@ -151,7 +151,7 @@ class DynamicsInverseStepper:
         self._initial = packed
         self._p = packed.copy()
         self.step = functools.partial(  # type: ignore[method-assign]  # bound fast path
-            operators.step_function(dk.inverse_step), self._p
+            step_function(dk.inverse_step), self._p
         )
 
     def step(self, x_ref: float) -> float:

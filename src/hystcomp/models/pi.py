@@ -12,8 +12,9 @@ from typing import Any, ClassVar, Self
 
 import numpy as np
 
-from hystcomp import operators, paper
+from hystcomp import paper
 from hystcomp._hyperparameters import check_constraints, check_margin
+from hystcomp._kernels import chain
 from hystcomp._validation import as_vector, check_int, check_range, check_real, check_thresholds
 from hystcomp.identify.compensation import compensation_error
 from hystcomp.identify.pi import fit_pi, paper_thresholds
@@ -233,7 +234,7 @@ class PrandtlIshlinskii(HysteresisModel):
 
     def _packed(self) -> np.ndarray:
         self._check_fitted()
-        return operators.pack_chain(
+        return chain.pack_chain(
             plays=(self.thresholds_, self.weights_, self.initial_state_),
             post=self._saturation(),
             in_offset=self.input_offset_,
@@ -271,7 +272,7 @@ class PrandtlIshlinskii(HysteresisModel):
         max_step = slew_to_step(slew_rate, sample_rate, owner)
         lo, hi = self._clamp_range(voltage_range, f"{owner}.inverse")
         saturation = self._saturation()
-        packed = operators.pack_chain(
+        packed = chain.pack_chain(
             pre=None if saturation is None else invert_superposition(*saturation),
             plays=(
                 *invert_superposition(self.thresholds_, self.weights_),

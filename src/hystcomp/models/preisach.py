@@ -1,6 +1,6 @@
 """The classical Preisach model (paper eqs. 1-5) and its compensators (eqs. 7-10).
 
-The model is evaluated by :mod:`hystcomp.preisach_kernels`: eqs. (3)-(4) over a bounded
+The model is evaluated by :mod:`hystcomp._kernels.preisach`: eqs. (3)-(4) over a bounded
 memory of alternating dominant extrema with the wipe-out property, at a cost per sample that
 does not grow with the depth of the memory.
 """
@@ -10,8 +10,8 @@ from __future__ import annotations
 import numpy as np
 
 from hystcomp import paper
-from hystcomp import preisach_kernels as pk
 from hystcomp._hyperparameters import MAX_DEGREE, check_options
+from hystcomp._kernels import preisach as pk
 from hystcomp._validation import (
     MAX_MAGNITUDE,
     _first_out_of_bounds,
@@ -295,7 +295,7 @@ class Preisach(HysteresisModel):
         return {name: value for name, value in out.items() if value is not None}
 
     def _packed(self, mode=pk.FORWARD, rho=1.0, max_step=np.inf, clamp=None) -> np.ndarray:
-        """The packed Preisach system of :mod:`hystcomp.preisach_kernels` (not a play chain)."""
+        """The packed Preisach system of :mod:`hystcomp._kernels.preisach` (not a play chain)."""
         self._check_fitted()
         depth = check_int(self.max_extrema, "max_extrema", type(self).__name__, minimum=3)
         lo, hi = self.voltage_range_

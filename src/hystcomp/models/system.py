@@ -1,8 +1,8 @@
 """The packed-system base: a packed parameter/state array run by one kernel family.
 
 A :class:`PackedSystem` (a forward model or a compensator) holds a packed array (see
-:mod:`hystcomp.operators` for play chains, :mod:`hystcomp.preisach_kernels` for Preisach
-systems) whose state part is the initial state. It is immutable: ``simulate`` runs a copy, so
+:mod:`hystcomp._kernels.chain` for play chains, :mod:`hystcomp._kernels.preisach` for
+Preisach systems) whose state part is the initial state. It is immutable: ``simulate`` runs a copy, so
 calling it twice gives the same answer; a :class:`Stepper` owns its own copy and can be reset
 or copied. The :class:`Stepper` serves every packed system of the package through the
 kernels its class names.
@@ -16,7 +16,8 @@ from typing import ClassVar
 
 import numpy as np
 
-from hystcomp import operators
+from hystcomp._kernels import chain
+from hystcomp._kernels._jit import step_function
 from hystcomp._validation import as_signal
 from hystcomp.errors import InvalidSignalError, InvalidTypeError
 
@@ -66,12 +67,13 @@ class Stepper:
     in blocks can use :meth:`step_block`, faster per sample.
 
     The same class serves every kind of packed system: the class attribute ``kernels``
-    (:class:`~hystcomp.operators.StepKernels`) names its step and batch kernels and where
-    its state lies; it is the play chain's here and the Preisach system's in
-    :class:`~hystcomp.models.preisach.PreisachStepper`.
+    (:class:`~hystcomp._kernels._jit.StepKernels`) names its step and batch kernels and where
+    its state lies; it is the play chain's here, the Preisach system's in
+    :class:`~hystcomp.models.preisach.PreisachStepper` and the simulated axis's in
+    :class:`~hystcomp.plant.twin.TwinStepper`.
     """
 
-    kernels = operators.CHAIN_KERNELS
+    kernels = chain.CHAIN_KERNELS
 
     def __init__(self, packed: np.ndarray):
         self._initial = packed
@@ -80,7 +82,7 @@ class Stepper:
         self._run = self.kernels.run  # looked up once: a block call is short too
         # an instance attribute hides the method below, which documents it
         self.step = _checked_step(  # type: ignore[method-assign]
-            operators.step_function(self.kernels.step), self._p
+            step_function(self.kernels.step), self._p
         )
 
     def step(self, u: float) -> float:
@@ -150,7 +152,7 @@ class Stepper:
         """How many outputs the voltage range clamped since the last reset.
 
         An output counts when the compensator asked for a voltage beyond the range by more
-        than :data:`~hystcomp.operators.CLAMP_TOLERANCE` of it (or, for the exact Preisach
+        than :data:`~hystcomp._kernels.chain.CLAMP_TOLERANCE` of it (or, for the exact Preisach
         inverse, stopped at a range end short of the reference): the reference was out of
         the actuator's reach there. Always 0 for a forward model.
         """

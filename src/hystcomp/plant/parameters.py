@@ -35,7 +35,7 @@ Notes
 -----
 * The hysteresis is a rate-independent Bouc-Wen model (``n = 1``, normalised form) whose
   output passes through an input-dependent gain and adds to a smooth anhysteretic curve
-  (see :mod:`hystcomp.plant._kernels`). It is none of the compensators' families (PI, MPI,
+  (see :mod:`hystcomp._kernels.twin`). It is none of the compensators' families (PI, MPI,
   polynomial-Everett Preisach): no method matches it by construction. The hysteretic gain
   ``w0 (1 - exp(-u / u_w))`` vanishes at the low end of the range, so that every loop that
   returns to 0 V closes at the rest position, as the paper's nested loops do (Fig. 5); the

@@ -13,17 +13,19 @@ from __future__ import annotations
 
 import numpy as np
 
+from hystcomp._kernels import twin as k
+from hystcomp._kernels._jit import step_function
 from hystcomp._validation import as_signal, check_int, check_real
 from hystcomp.errors import InvalidTypeError
-from hystcomp.plant import _kernels as k
+from hystcomp.models.system import Stepper
 from hystcomp.plant.parameters import TwinParameters, dynamics_matrices
 
 #: The Bouc-Wen state at rest: the actuator was last driven down to the low rail.
 REST_STATE = -1.0
 
 
-def _pack(params: TwinParameters) -> tuple[np.ndarray, np.ndarray]:
-    """Packed parameters and rest state for the kernels (see :mod:`._kernels`)."""
+def _pack(params: TwinParameters) -> np.ndarray:
+    """Packed parameters and rest state for the kernels (see :mod:`hystcomp._kernels.twin`)."""
     ad, bd = dynamics_matrices(params)
     lo, hi = params.voltage_range
     taus = np.asarray(params.creep_time_constants, dtype=np.float64)
@@ -34,11 +36,11 @@ def _pack(params: TwinParameters) -> tuple[np.ndarray, np.ndarray]:
     head = [lo, hi, params.amplifier_gain, *params.anhysteretic, params.hysteresis_amplitude]
     head += [params.hysteresis_onset, params.bouc_wen_rate, params.bouc_wen_shape]
     head += [ad[0, 0], ad[0, 1], ad[1, 0], ad[1, 1], bd[0], bd[1], taus.size]
-    p = np.concatenate([np.asarray(head, dtype=np.float64), lags, gains])
-    p.setflags(write=False)
     state = np.zeros(k.S_CREEP + taus.size)
     state[k.S_Z] = REST_STATE
-    return p, state
+    packed = np.concatenate([np.asarray(head, dtype=np.float64), lags, gains, state])
+    packed.setflags(write=False)
+    return packed
 
 
 class Twin:
@@ -75,7 +77,10 @@ class Twin:
         self.params = params
         self.seed = check_int(seed, "seed", "Twin", minimum=0)
         self._rng = np.random.default_rng(self.seed)
-        self._p, self._rest = _pack(params)
+        self._packed = _pack(params)
+        start = k.state_start.py_func(self._packed)
+        self._p = self._packed[:start]  # the parameters
+        self._rest = self._packed[start:]  # the state at rest
 
     @property
     def sample_rate(self) -> float:
@@ -96,7 +101,7 @@ class Twin:
         """Displacement in µm for the command ``v`` in V, from rest, without sensor noise."""
         u = as_signal(v, "v")
         out = np.empty_like(u)
-        k.twin_run(self._p, self._rest.copy(), u, out)
+        k.twin_run(self._packed.copy(), u, out)
         return out + self.params.sensor_offset
 
     def run(self, v) -> np.ndarray:
@@ -111,12 +116,12 @@ class Twin:
         """The quasi-static displacement ``H[v]`` in µm (no creep, no dynamics, no noise)."""
         u = as_signal(v, "v")
         out = np.empty_like(u)
-        k.hysteresis_run(self._p, self._rest.copy(), u, out)
+        k.hysteresis_run(self._packed.copy(), u, out)
         return out
 
     def stepper(self) -> TwinStepper:
         """A streaming twin, one sample per call, with its own noise generator."""
-        return TwinStepper(self._p, self._rest, self.params, self._rng.spawn(1)[0])
+        return TwinStepper(self._packed, self.params, self._rng.spawn(1)[0])
 
     def _noise(self, n: int) -> np.ndarray:
         sigma = self.params.sensor_noise / self.params.sensor_gain
@@ -128,32 +133,45 @@ class Twin:
         return f"Twin({self.params!r}, seed={self.seed})"
 
 
-class TwinStepper:
-    """The twin one sample at a time; the same kernel as :meth:`Twin.run`.
+class TwinStepper(Stepper):
+    """The twin one sample at a time: the package's :class:`~hystcomp.models.system.Stepper`
+    over the twin's kernel (the same as :meth:`Twin.run`'s), plus the sensor's offset and noise.
 
     Use it in a loop with a compensator's stepper: ``x_k = twin.step(comp.step(x_ref_k))``.
+    Unlike a compensator's stepper it refuses a non-finite command (a simulation has no
+    reason to send one), so :attr:`nonfinite_count` and :attr:`clamped_count` stay 0.
     """
 
-    def __init__(self, p, rest, params: TwinParameters, rng: np.random.Generator):
-        self._p = p
-        self._rest = rest
-        self._s = rest.copy()
+    kernels = k.TWIN_KERNELS
+
+    def __init__(self, packed, params: TwinParameters, rng: np.random.Generator):
+        super().__init__(packed)
+        self._params = params
         self._offset = params.sensor_offset
         self._sigma = params.sensor_noise / params.sensor_gain
         self._rng = rng
+        self._kernel = step_function(self.kernels.step)
+        del self.step  # the base class binds a step without the sensor; use the method below
 
     def step(self, v: float) -> float:
         """Apply one command sample (V) and return the measured displacement (µm)."""
         v = check_real(v, "v", "TwinStepper.step")
-        return k.twin_step(self._p, self._s, v) + self._offset + self._sigma * self._rng.normal()
+        return self._kernel(self._p, v) + self._offset + self._sigma * self._rng.normal()
 
     def step_block(self, v) -> np.ndarray:
         """Apply a block of command samples and return the measured displacements."""
         u = as_signal(v, "v")
-        out = np.empty_like(u)
-        k.twin_run(self._p, self._s, u, out)
-        return out + self._offset + self._sigma * self._rng.standard_normal(u.size)
+        return (
+            super().step_block(u) + self._offset + self._sigma * self._rng.standard_normal(u.size)
+        )
+
+    def copy(self) -> TwinStepper:
+        """An independent stepper in the same state, with a noise generator spawned from this
+        one's."""
+        twin = type(self)(self._initial, self._params, self._rng.spawn(1)[0])
+        twin._p[:] = self._p
+        return twin
 
     def reset(self) -> None:
         """Back to rest (the noise generator keeps going)."""
-        self._s[:] = self._rest
+        super().reset()

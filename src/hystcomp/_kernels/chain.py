@@ -1,4 +1,4 @@
-"""Elementary hysteresis operators as compiled kernels (the bottom layer).
+"""The play / dead-zone chain as compiled kernels: the PI-type models and their inverses.
 
 * the play (backlash) operator of eq. (11), ``y[k] = max(v[k] - r, min(v[k] + r, y[k-1]))``;
 * the one-sided dead-zone of eq. (13), ``s_r(z) = max(z - r, 0)`` for ``r > 0`` and ``z``
@@ -14,9 +14,11 @@ with any stage possibly empty: the PI model (eq. 12) is the plays alone, the MPI
 is *packed* into one float64 array (parameters, then state), so that a streaming step is one
 compiled call on one array. Batch runs and steppers both go through :func:`chain_blocks`
 (a step is a one-sample run), which uses the one play loop (:func:`play_step`) and the one
-dead-zone loop (:func:`deadzone_block`) of the package. :func:`step_kernel` and
-:func:`step_function` make such a one-call step for any packed system (the Preisach kernels
-use them too), and :data:`StepKernels` tells a stepper what it needs of one.
+dead-zone loop (:func:`deadzone_block`) of the package; :data:`CHAIN_KERNELS` tells the
+streaming stepper how to run a chain. The layout of a packed chain is named by the slot
+constants below (header ``N_PRE`` .. ``MAX_STEP``, state ``STATE_LAST`` .. ``STATE_PLAYS``);
+:func:`pack_chain` and :func:`unpack_chain` write and read it and live here, beside the
+layout they must agree with.
 
 Speed: a batch run takes the samples in blocks and the chain stage by stage. The dead-zones
 are stateless, so each is a pass over the block that vectorises over samples; the plays are
@@ -29,52 +31,11 @@ These functions trust their input; validation happens in the public classes abov
 
 from __future__ import annotations
 
-import functools
 from collections import namedtuple
 
-import numba
 import numpy as np
 
-# Fast-math without 'nnan'/'ninf': reassociation lets the reductions vectorise, while the
-# finiteness test on the input must survive compilation.
-FASTMATH = {"reassoc", "contract", "nsz", "arcp"}
-
-
-def _kernel(func):
-    return numba.njit(cache=True, fastmath=FASTMATH, nogil=True)(func)
-
-
-def _inline_kernel(func):
-    # Inlined into the calling kernel at numba-IR level: the stages of a chain then sit in
-    # one function that LLVM optimises as a whole (a call per stage and sample would cost
-    # more than the stage).
-    return numba.njit(cache=True, fastmath=FASTMATH, nogil=True, inline="always")(func)
-
-
-def step_kernel(func):
-    """Compile ``func(p, u) -> float``, one sample through packed system ``p``, as a step kernel.
-
-    One sample per call, so the fixed cost of a call is what counts: the kernel keeps the GIL
-    (releasing and taking it back costs more than the sample) and is compiled without
-    reference counting (the packed array and each view of it would otherwise cost an atomic
-    increment and decrement, a third of the chain's call); it must not allocate. Its
-    fastmath flags are those of every batch kernel of the package (:data:`FASTMATH`), so
-    that a step and the batch run it mirrors agree bit for bit. :func:`step_function` gives
-    its fast entry point.
-    """
-    return numba.njit(cache=True, fastmath=FASTMATH, _nrt=False)(func)
-
-
-@functools.cache
-def step_function(kernel):
-    """Step kernel ``kernel`` compiled for a float64 array and a float, as a plain ``f(p, u)``.
-
-    It skips numba's dispatch on argument types (a third of the cost of a call) and so
-    trusts its arguments more still: ``p`` must be a writable, C-contiguous float64 array.
-    The first call compiles the kernel or loads it from the on-disk cache.
-    """
-    return kernel.compile((numba.types.float64[::1], numba.types.float64))
-
+from hystcomp._kernels._jit import StepKernels, inline_kernel, kernel, step_kernel
 
 # Layout of a packed chain: header slots, then parameters, then state.
 N_PRE, N_PLAY, N_POST, IN_OFFSET, OUT_OFFSET, LOW, HIGH, MAX_STEP = range(8)
@@ -106,7 +67,7 @@ ChainParts = namedtuple(
 ChainParts.__doc__ = """Views into a packed chain: its scalars, stage parameters and state."""
 
 
-@_inline_kernel
+@inline_kernel
 def play_step(v, r, w, y):
     """Advance a bank of play operators by one sample, in place, and weigh them.
 
@@ -137,13 +98,13 @@ def play_step(v, r, w, y):
     return acc
 
 
-@_inline_kernel
+@inline_kernel
 def play_update(v, r, y):
     """Advance a bank of play operators by one sample, in place (eq. 11), without weights."""
     play_step(v, r, r, y)  # the weighted sum is unused and compiled away
 
 
-@_inline_kernel
+@inline_kernel
 def deadzone_block(x, shift, r, w, out):
     """Weighted one-sided dead-zones (eqs. 13-14) of every sample of a block.
 
@@ -163,7 +124,7 @@ def deadzone_block(x, shift, r, w, out):
             out[k] += wj * max(x[k] - rj, 0.0)
 
 
-@_kernel
+@kernel
 def deadzone_sum(z, r, w):
     """Weighted superposition of one-sided dead-zones (eqs. 13-14) at one point ``z``."""
     out = np.empty(1)
@@ -171,7 +132,7 @@ def deadzone_sum(z, r, w):
     return out[0]
 
 
-@_kernel
+@kernel
 def deadzone_values(z, r, out):
     """Each one-sided dead-zone of eq. (13) at ``z``: ``out[j] = s_{r_j}(z)``.
 
@@ -181,13 +142,13 @@ def deadzone_values(z, r, out):
         out[j] = max(z - r[j], 0.0) if r[j] > 0.0 else z
 
 
-@_inline_kernel
+@inline_kernel
 def chain_state_start(p):
     """Index of the first state slot of packed chain ``p``."""
     return HEADER + 2 * (int(p[N_PRE]) + int(p[N_PLAY]) + int(p[N_POST]))
 
 
-@_inline_kernel
+@inline_kernel
 def chain_parts(p):
     """The :data:`ChainParts` of packed chain ``p`` (views that share its memory)."""
     n_pre = int(p[N_PRE])
@@ -213,7 +174,7 @@ def chain_parts(p):
     )
 
 
-@_inline_kernel
+@inline_kernel
 def chain_blocks(p, u, out, work):
     """Run every sample of ``u`` through packed chain ``p`` into ``out``; state kept in ``p``.
 
@@ -289,13 +250,16 @@ def chain_step(p, u):
     the streaming step and the batch run are the same code, bit for bit. A non-finite ``u``
     holds the last output and increments the non-finite counter.
     """
-    s = chain_state_start(p) + STATE_INPUT
-    p[s] = u
-    chain_blocks(p, p[s : s + 1], p[s + 1 : s + 2], p[s + 2 : s + 3])
-    return p[s + 1]
+    s = chain_state_start(p)
+    i = s + STATE_INPUT
+    o = s + STATE_OUTPUT
+    w = s + STATE_WORK
+    p[i] = u
+    chain_blocks(p, p[i : i + 1], p[o : o + 1], p[w : w + 1])
+    return p[o]
 
 
-@_kernel
+@kernel
 def chain_run(p, u, out):
     """Run every sample of ``u`` through packed chain ``p`` into ``out`` (state kept in ``p``).
 
@@ -306,23 +270,13 @@ def chain_run(p, u, out):
     chain_blocks(p, u, out, work)
 
 
-StepKernels = namedtuple("StepKernels", "step run state_start last nonfinite clamped")
-StepKernels.__doc__ = """What a streaming stepper needs to know of a kind of packed system.
-
-``step`` is its :func:`step_kernel`, ``run(p, u, out)`` the batch kernel that the step equals
-bit for bit, ``state_start(p)`` a plain Python function giving the index of the first state
-slot, and ``last``, ``nonfinite`` and ``clamped`` the offsets from there of the last output,
-of the count of non-finite inputs and of the count of clamped outputs. :data:`CHAIN_KERNELS` is that of a packed chain; the Preisach
-kernels have theirs.
-"""
-
 #: The :class:`StepKernels` of a packed chain.
 CHAIN_KERNELS = StepKernels(
     chain_step, chain_run, chain_state_start.py_func, STATE_LAST, STATE_NONFINITE, STATE_CLAMPED
 )
 
 
-@_kernel
+@kernel
 def play_outputs(v, r, y0, out):
     """Outputs of each play operator for every sample: ``out[k, i] = play_{r_i}(v)[k]``.
 
@@ -376,7 +330,8 @@ def pack_chain(
         pad = np.zeros(-len(plays[0]) % PLAY_MULTIPLE)
         play_r, play_w, play_y0 = (np.concatenate([np.asarray(a, np.float64), pad]) for a in plays)
     header = [len(pre_r), len(play_r), len(post_r), in_offset, out_offset, low, high, max_step]
-    state = [min(max(0.0, low), high), 0.0, 0.0, 0.0, 0.0, 0.0]
+    state = np.zeros(STATE_PLAYS)
+    state[STATE_LAST] = min(max(0.0, low), high)
     parts = [header, pre_r, pre_w, play_r, play_w, post_r, post_w, state, play_y0]
     return np.concatenate([np.asarray(a, dtype=np.float64) for a in parts])
 

@@ -3,7 +3,7 @@
 The inverse filter (see :mod:`hystcomp.models.dynamics`) is a FIR stage (non-negative taps
 fitted so that the resonance times them is close to 1 in the band) in series with the
 exact inverse of the creep bank. Its parameters and state are one packed
-float64 array, as the chain's (:mod:`hystcomp.operators`)::
+float64 array, as the chain's (:mod:`hystcomp._kernels.chain`)::
 
     [N_FIR, N_CREEP, SCALE, DIRECT, LOW, HIGH, BIAS, h_0 .. h_{N_FIR-1}, a_1 .. a_n, c_1 .. c_n,
      delay line (N_FIR samples, newest first), creep lag states (n)]
@@ -23,13 +23,13 @@ from __future__ import annotations
 
 import math
 
-from hystcomp.operators import _kernel, step_kernel
+from hystcomp._kernels._jit import kernel, step_kernel
 
 N_FIR, N_CREEP, SCALE, DIRECT, LOW, HIGH, BIAS = range(7)
 HEADER = 7
 
 
-@_kernel
+@kernel
 def state_start(p):
     """Index of the first state slot (the newest sample of the delay line)."""
     return HEADER + int(p[N_FIR]) + 2 * int(p[N_CREEP])
@@ -66,7 +66,7 @@ def inverse_step(p, u):
     return y
 
 
-@_kernel
+@kernel
 def inverse_run(p, u, out):
     """Run :func:`inverse_step` over every sample of ``u`` (state kept in ``p``)."""
     for k in range(u.size):

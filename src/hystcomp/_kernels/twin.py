@@ -1,9 +1,11 @@
 """Compiled kernels of the simulated axis (the twin): one step, and a batch loop over it.
 
-The parameters and the state of a twin are each one packed float64 array (see the slot
-constants below), so that a streaming step is one compiled call and the batch run is a
-loop over the very same step. Kernels trust their input; :mod:`hystcomp.plant.twin`
-validates and packs.
+The parameters and the state of a twin are one packed float64 array, parameters then state
+(see the slot constants below), so that a streaming step is one compiled call and the batch
+run is a loop over the very same step; :data:`TWIN_KERNELS` lets the package's one streaming
+stepper (:class:`hystcomp.models.system.Stepper`) run it. :func:`axis_step` takes the
+parameters and the state apart, for callers that keep the state elsewhere. Kernels trust
+their input; :mod:`hystcomp.plant.twin` validates and packs.
 
 Hysteresis (rate independent, asymmetric, saturating), in the normalised input
 ``u = (v_px - low) / (high - low)``::
@@ -20,7 +22,7 @@ from __future__ import annotations
 
 import math
 
-import numba
+from hystcomp._kernels._jit import StepKernels, inline_kernel, kernel, step_kernel
 
 # Parameter slots.
 (
@@ -43,16 +45,20 @@ import numba
     P_N_CREEP,
 ) = range(17)
 P_CREEP = 17  # then n_creep lag factors a_i, then n_creep gains g_i
-# State slots: last normalised input, Bouc-Wen state, position and velocity of D(s), creep lags.
-S_U, S_Z, S_POS, S_VEL = range(4)
-S_CREEP = 4
+# State slots, from state_start(p): last normalised input, Bouc-Wen state, position and
+# velocity of D(s), last output, count of non-finite commands, count of clamped outputs
+# (always 0: the axis has no output clamp), then the creep lags.
+S_U, S_Z, S_POS, S_VEL, S_LAST, S_NONFINITE, S_CLAMPED = range(7)
+S_CREEP = 7
 
 
-def _kernel(func):
-    return numba.njit(cache=True, nogil=True)(func)
+@inline_kernel
+def state_start(p):
+    """Index of the first state slot of packed twin ``p`` (after the creep parameters)."""
+    return P_CREEP + 2 * int(p[P_N_CREEP])
 
 
-@_kernel
+@inline_kernel
 def bw_rise(z, s, c):
     """Advance the Bouc-Wen state along an *increasing* input by ``s = rho * du >= 0``.
 
@@ -73,13 +79,20 @@ def bw_rise(z, s, c):
     return 1.0 - (1.0 - z) * math.exp(-s)
 
 
-@_kernel
+@inline_kernel
 def hysteresis_step(p, s, v):
-    """Amplifier and hysteresis for one command sample ``v`` (V): the displacement in µm."""
+    """Amplifier and hysteresis for one command sample ``v`` (V): the displacement in µm.
+
+    A non-finite command holds the last one (the amplifier keeps its voltage) and is counted.
+    """
     lo = p[P_LOW]
     hi = p[P_HIGH]
-    v_px = min(max(p[P_GAIN] * v, lo), hi)  # the amplifier's rails
-    u = (v_px - lo) / (hi - lo)
+    if v - v == 0.0:  # finite
+        v_px = min(max(p[P_GAIN] * v, lo), hi)  # the amplifier's rails
+        u = (v_px - lo) / (hi - lo)
+    else:
+        s[S_NONFINITE] += 1.0
+        u = s[S_U]
     du = u - s[S_U]
     s[S_U] = u
     z = s[S_Z]
@@ -93,8 +106,10 @@ def hysteresis_step(p, s, v):
     return anhysteretic + p[P_W0] * math.expm1(-u / p[P_UW]) * z
 
 
-@_kernel
-def twin_step(p, s, v):
+# A called kernel, not an inlined one: the step and the batch loop then run the same
+# machine code, so they agree bit for bit (inlined, the fast-math contractions differed).
+@kernel
+def axis_step(p, s, v):
     """One sample of the whole axis: returns the displacement (µm) seen by the sensor now.
 
     Amplifier and hysteresis, optional creep (first-order lags), then the piezo dynamics
@@ -114,18 +129,34 @@ def twin_step(p, s, v):
     vel = s[S_VEL]
     s[S_POS] = p[P_A11] * pos + p[P_A12] * vel + p[P_B1] * q
     s[S_VEL] = p[P_A21] * pos + p[P_A22] * vel + p[P_B2] * q
+    s[S_LAST] = pos
     return pos
 
 
-@_kernel
-def twin_run(p, s, v, out):
-    """Run :func:`twin_step` over every sample of ``v`` (state kept in ``s``)."""
+@step_kernel
+def twin_step(p, v):
+    """One command sample ``v`` (V) through packed twin ``p`` (state kept in ``p``).
+
+    :func:`axis_step` on the state part of ``p``: the displacement (µm) seen by the sensor now.
+    """
+    return axis_step(p, p[state_start(p) :], v)
+
+
+@kernel
+def twin_run(p, v, out):
+    """Run :func:`twin_step` over every sample of ``v`` (state kept in ``p``)."""
+    s = p[state_start(p) :]
     for k in range(v.size):
-        out[k] = twin_step(p, s, v[k])
+        out[k] = axis_step(p, s, v[k])
 
 
-@_kernel
-def hysteresis_run(p, s, v, out):
+@kernel
+def hysteresis_run(p, v, out):
     """Run :func:`hysteresis_step` over every sample (quasi-static: no creep, no dynamics)."""
+    s = p[state_start(p) :]
     for k in range(v.size):
         out[k] = hysteresis_step(p, s, v[k])
+
+
+#: The :class:`~hystcomp._kernels._jit.StepKernels` of a packed twin.
+TWIN_KERNELS = StepKernels(twin_step, twin_run, state_start.py_func, S_LAST, S_NONFINITE, S_CLAMPED)

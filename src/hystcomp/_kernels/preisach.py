@@ -29,7 +29,7 @@ as a coefficient matrix ``C[i, j]`` of ``b**i a**j``, or a table on a uniform gr
 the diagonal, so that the interpolant vanishes on the diagonal as eq. (2) requires.
 
 Everything (parameters, state, memory) is packed into one float64 array, so a streaming step
-is one compiled call on one array, as :mod:`hystcomp.operators` does for the play chain.
+is one compiled call on one array, as :mod:`hystcomp._kernels.chain` does for the play chain.
 The same :func:`preisach_step` serves the forward model, the inverse multiplicative structure
 (eq. 10) and the exact inverse, in batch and streaming use. These functions trust their input.
 """
@@ -38,10 +38,11 @@ from __future__ import annotations
 
 import numba
 import numpy as np
-from llvmlite import ir
+from llvmlite import ir  # type: ignore[import-untyped]
 from numba.extending import intrinsic
 
-from hystcomp.operators import CLAMP_TOLERANCE, FASTMATH, StepKernels, step_kernel
+from hystcomp._kernels._jit import StepKernels, inline_kernel, kernel, step_kernel
+from hystcomp._kernels.chain import CLAMP_TOLERANCE
 
 # Modes of a packed system: what a step maps.
 FORWARD, MULTIPLICATIVE, EXACT = 0, 1, 2
@@ -57,19 +58,6 @@ ST_TOP, ST_INPUT, ST_H, ST_LAST, ST_NONFINITE, ST_CLAMPED = range(6)
 N_STATE = 6
 #: Default bound on the stored extrema: 512 nested reversals, far beyond measured signals.
 DEFAULT_DEPTH = 1024
-
-
-def _kernel(func):
-    return numba.njit(cache=True, fastmath=FASTMATH, nogil=True)(func)
-
-
-def _inline_kernel(func):
-    # Inlined into its callers at numba-IR level, as the chain's stages are: a call per
-    # evaluation of X (several per sample) cost more than the evaluation, and LLVM does not
-    # inline across numba's separately compiled functions. Only small functions: each
-    # inlined copy is compiled again, and the first run's compile time grows with them
-    # (preisach_apply stays a call: inlined, it made preisach_run take minutes to compile).
-    return numba.njit(cache=True, fastmath=FASTMATH, nogil=True, inline="always")(func)
 
 
 @intrinsic
@@ -179,14 +167,14 @@ def pack_preisach(
     return np.concatenate([*parts, np.zeros(depth)])
 
 
-@_inline_kernel
+@inline_kernel
 def state_start(p):
     """Index of the first state slot of packed system ``p``."""
     n = int(p[N_COEF])
     return HEADER + n * n
 
 
-@_inline_kernel
+@inline_kernel
 def everett(p, alpha, beta):
     """``X(alpha, beta)`` of eq. (2) in µm, for voltages inside the plane."""
     a = alpha - p[V_MIN]
@@ -220,14 +208,14 @@ def everett(p, alpha, beta):
     )
 
 
-@_kernel
+@kernel
 def everett_many(p, alpha, beta, out):
     """``out[k] = X(alpha[k], beta[k])`` for voltages inside the plane."""
     for k in range(alpha.size):
         out[k] = everett(p, alpha[k], beta[k])
 
 
-@_inline_kernel
+@inline_kernel
 def _push(p, e, q, top, value):
     """Push a turning point (a maximum on an even top, a minimum on an odd one)."""
     if top + 1 >= int(p[DEPTH]):
@@ -243,7 +231,8 @@ def _push(p, e, q, top, value):
     return top + 1
 
 
-@_kernel
+# not an inline kernel: inlined, it made preisach_run take minutes to compile
+@kernel
 def preisach_apply(p, v):
     """Apply input ``v`` (clamped to the plane) and return ``H(v)`` without offset, eqs. (3)-(4)."""
     s = state_start(p)
@@ -269,14 +258,14 @@ def preisach_apply(p, v):
     return h
 
 
-@_inline_kernel
+@inline_kernel
 def _branch(p, base, pivot, rising, v):
     """A monotone branch: ``base + X(v, pivot)`` rising, ``base - X(pivot, v)`` falling."""
     alpha, beta, sign = (v, pivot, 1.0) if rising else (pivot, v, -1.0)
     return base + sign * everett(p, alpha, beta)  # one inlined copy of X; the sign is exact
 
 
-@_kernel
+@kernel
 def _root(p, base, pivot, rising, lo, hi, target, b_lo, b_hi):
     """``v`` in ``[lo, hi]`` with branch(v) = target, given branch(lo) < target <= branch(hi).
 
@@ -319,7 +308,7 @@ def _root(p, base, pivot, rising, lo, hi, target, b_lo, b_hi):
     return lo if -f_lo < f_hi else hi
 
 
-@_kernel
+@kernel
 def _solve_up(p, e, q, top, previous, target):
     """Smallest rise of the input whose branch output reaches ``target`` (> h)."""
     if top % 2 == 1:
@@ -352,7 +341,7 @@ def _solve_up(p, e, q, top, previous, target):
         k -= 2
 
 
-@_kernel
+@kernel
 def _solve_down(p, e, q, top, previous, target):
     """Smallest fall of the input whose branch output reaches ``target`` (< h)."""
     if top % 2 == 0:
@@ -385,7 +374,7 @@ def _solve_down(p, e, q, top, previous, target):
         k -= 2
 
 
-@_kernel
+@kernel
 def exact_input(p, target):
     """The input that makes ``H`` reach ``target`` (µm, no offset) from the current memory.
 
@@ -406,7 +395,7 @@ def exact_input(p, target):
     return previous
 
 
-@_kernel
+@kernel
 def _count_clamped(p, s, u, v, h):
     """Count a compensator's sample as clamped if ``v``, at an end of the range, leaves
     ``x_0 + H(v)`` short of the reference ``u`` (eq. 10 may ask beyond a range end for a
@@ -417,7 +406,7 @@ def _count_clamped(p, s, u, v, h):
         p[s + ST_CLAMPED] += 1.0
 
 
-@_inline_kernel
+@inline_kernel
 def _step(p, u):
     """The body of :func:`preisach_step`, inlined into it and into :func:`preisach_run`."""
     s = state_start(p)
@@ -448,7 +437,7 @@ def _step(p, u):
 def preisach_step(p, u):
     """One sample through packed system ``p``; updates its state and returns the output.
 
-    The streaming step (a :func:`~hystcomp.operators.step_kernel`) and the body of the batch
+    The streaming step (a :func:`~hystcomp._kernels._jit.step_kernel`) and the body of the batch
     :func:`preisach_run`, so the two agree bit for bit.
 
     FORWARD maps a voltage to ``x_0 + H(v)``; MULTIPLICATIVE is eq. (10),
@@ -458,76 +447,22 @@ def preisach_step(p, u):
     A non-finite ``u`` holds the last output and increments the non-finite counter. A
     compensator's sample counts as clamped (out of reach) when ``v`` sits at an end of the
     range and ``x_0 + H(v)`` still falls short of ``x_ref`` there by more than
-    :data:`~hystcomp.operators.CLAMP_TOLERANCE` of it.
+    :data:`~hystcomp._kernels.chain.CLAMP_TOLERANCE` of it.
     """
     return _step(p, u)
 
 
-@_kernel
+@kernel
 def preisach_run(p, u, out):
     """Run every sample of ``u`` through packed system ``p`` into ``out`` (state kept in ``p``)."""
     for k in range(u.size):
         out[k] = _step(p, u[k])
 
 
-#: The :class:`~hystcomp.operators.StepKernels` of a packed Preisach system.
+#: The :class:`~hystcomp._kernels._jit.StepKernels` of a packed Preisach system.
 PREISACH_KERNELS = StepKernels(
     preisach_step, preisach_run, state_start.py_func, ST_LAST, ST_NONFINITE, ST_CLAMPED
 )
-
-
-@_kernel
-def turning_points(v, delta, out):
-    """Indices of the alternating extrema of ``v``, ignoring reversals smaller than ``delta``.
-
-    A maximum is confirmed once the signal falls more than ``delta`` below it, a minimum once
-    it rises more than ``delta`` above it (the last index of a plateau is the turning point).
-    ``out`` receives the indices, the last one being the running extremum at the end of the
-    data (not confirmed). Returns ``(count, first_is_max)``; ``count`` is 0 if ``v`` never
-    moves by more than ``delta``.
-    """
-    n = v.size
-    i_hi = 0
-    i_lo = 0
-    k = 1
-    direction = 0
-    while k < n:
-        if v[k] >= v[i_hi]:
-            i_hi = k
-        if v[k] <= v[i_lo]:
-            i_lo = k
-        if v[k] - v[i_lo] > delta:
-            direction = 1
-            break
-        if v[i_hi] - v[k] > delta:
-            direction = -1
-            break
-        k += 1
-    if direction == 0:
-        return 0, False
-    count = 1
-    first_is_max = direction == -1
-    out[0] = i_hi if first_is_max else i_lo
-    candidate = k
-    for k in range(candidate + 1, n):
-        if direction == 1:
-            if v[k] >= v[candidate]:
-                candidate = k
-            elif v[candidate] - v[k] > delta:
-                out[count] = candidate
-                count += 1
-                direction = -1
-                candidate = k
-        else:
-            if v[k] <= v[candidate]:
-                candidate = k
-            elif v[k] - v[candidate] > delta:
-                out[count] = candidate
-                count += 1
-                direction = 1
-                candidate = k
-    out[count] = candidate
-    return count + 1, first_is_max
 
 
 # --- Regressors of the general least-squares identification ------------------------------
@@ -543,7 +478,7 @@ def turning_points(v, delta, out):
 BASIS_POLYNOMIAL, BASIS_CELLS = 0, 1
 
 
-@_kernel
+@kernel
 def everett_basis(kind, exps, n_seg, v_min, v_max, alpha, beta, out):
     """``out[m] = X_m(alpha, beta)``, the Everett function of basis element ``m`` alone.
 
@@ -579,7 +514,7 @@ def everett_basis(kind, exps, n_seg, v_min, v_max, alpha, beta, out):
             m += 1
 
 
-@_kernel
+@kernel
 def _push_basis(kind, exps, n_seg, v_min, v_max, e, q, top, value, work):
     """:func:`_push` on the basis: a turning point and its prefix-sum vector."""
     if top + 1 >= e.size:
@@ -596,7 +531,7 @@ def _push_basis(kind, exps, n_seg, v_min, v_max, e, q, top, value, work):
     return top + 1
 
 
-@_kernel
+@kernel
 def preisach_rows(kind, exps, n_seg, v_min, v_max, v, x, first, start, stride, memory, rows):
     """Regressor rows ``[R_0[k] .. R_(p-1)[k], 1, x[k]]`` of samples ``k = first, ...``.
 
@@ -647,7 +582,7 @@ def preisach_rows(kind, exps, n_seg, v_min, v_max, v, x, first, start, stride, m
     return k, count
 
 
-@_kernel
+@kernel
 def gram_update(rows, count, gram):
     """Add ``rows[:count]^T rows[:count]`` to the upper triangle of ``gram``.
 
