@@ -1,4 +1,4 @@
-"""The identification workflow as a library function, and ``hystcomp calibrate``."""
+"""The library functions behind ``hystcomp identify`` and ``excite``, and ``hystcomp calibrate``."""
 
 from __future__ import annotations
 
@@ -10,7 +10,13 @@ from hystcomp import presets
 from hystcomp.cli import main
 from hystcomp.data import Record
 from hystcomp.errors import IdentificationError, InvalidParameterError, InvalidTypeError
-from hystcomp.identify.excitation import triangle_sequence
+from hystcomp.identify.excitation import (
+    PREISACH_AMPLITUDES,
+    excitation_signal,
+    scaled_amplitudes,
+    sinusoid_sequence,
+    triangle_sequence,
+)
 from hystcomp.identify.workflow import IdentificationResult, build_estimator, identify_record
 
 FS = 1000.0  # Hz
@@ -118,3 +124,14 @@ def test_calibrate_prints_the_twins_figures():
     assert abs(stroke - 37.0) < 0.5  # the calibration target (µm at 120 V)
     assert "630.00 Hz" in lines[3]
     assert len(lines) == 9
+
+
+def test_excitation_signal_is_the_papers_signal_scaled_to_the_range():
+    t, v = excitation_signal("preisach", sample_rate=200.0, voltage_range=(-10.0, 50.0))
+    amplitudes = scaled_amplitudes(PREISACH_AMPLITUDES, voltage_range=(-10.0, 50.0))
+    t_ref, v_ref = sinusoid_sequence(amplitudes, sample_rate=200.0, v_min=-10.0)
+    np.testing.assert_array_equal(t, t_ref)
+    np.testing.assert_array_equal(v, v_ref)
+    assert (float(v.min()), float(v.max())) == (-10.0, 50.0)
+    with pytest.raises(InvalidParameterError, match="'kind' argument of excitation_signal"):
+        excitation_signal("nosuch")
