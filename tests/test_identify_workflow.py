@@ -10,6 +10,7 @@ from hystcomp import presets
 from hystcomp.cli import main
 from hystcomp.data import Record
 from hystcomp.errors import IdentificationError, InvalidParameterError, InvalidTypeError
+from hystcomp.identify.dynamics import dynamics_excitation
 from hystcomp.identify.excitation import (
     PREISACH_AMPLITUDES,
     excitation_signal,
@@ -17,7 +18,13 @@ from hystcomp.identify.excitation import (
     sinusoid_sequence,
     triangle_sequence,
 )
-from hystcomp.identify.workflow import IdentificationResult, build_estimator, identify_record
+from hystcomp.identify.workflow import (
+    IdentificationResult,
+    build_estimator,
+    identify_dynamics_record,
+    identify_record,
+)
+from hystcomp.models.dynamics import LinearDynamics
 
 FS = 1000.0  # Hz
 
@@ -135,3 +142,22 @@ def test_excitation_signal_is_the_papers_signal_scaled_to_the_range():
     assert (float(v.min()), float(v.max())) == (-10.0, 50.0)
     with pytest.raises(InvalidParameterError, match="'kind' argument of excitation_signal"):
         excitation_signal("nosuch")
+
+
+def test_dynamics_from_a_record_with_its_report_lines():
+    true = LinearDynamics.from_parameters(
+        sample_rate=20_000.0,
+        resonance_hz=780.0,
+        damping_ratio=0.05,
+        creep_time_constants=[0.004, 0.04, 0.4, 2.0],
+        creep_weights=[0.0075] * 4,
+    )
+    t, v = dynamics_excitation()
+    x = 0.3 * true.simulate(v, initial=0.0) + 0.003 * np.random.default_rng(7).standard_normal(
+        v.size
+    )
+    result = identify_dynamics_record(Record(t, v, x, source="stage"))
+    assert result.model.resonance_hz_ == pytest.approx(780.0, rel=0.005)
+    assert result.lines[0] == "linear dynamics (creep and first resonance) from stage"
+    assert result.lines[2].startswith(f"  resonance: {result.model.resonance_hz_:.5g} Hz, ")
+    assert len(result.lines) == 6

@@ -182,4 +182,3 @@ def calibration_report(params: TwinParameters | None = None, seed: int = 0) -> s
         cells = ", ".join(f"{rms:.2f}/{peak:.2f}" for rms, peak in errors.values())
         lines.append(f"  {name:<22} k = {gain:.4f}, 0..{amplitude:.1f} µm: {cells}")
     return "\n".join(lines)
-

@@ -5,7 +5,8 @@ MPI, Preisach), usable from Python: it leaves out the start-up transient, holds 
 of the record if asked, fits the model, scores the fit (:mod:`hystcomp.identify.scoring`),
 estimates the compensator's tracking error (:mod:`hystcomp.identify.compensation`), and
 returns all of it with the report lines and the warnings in an
-:class:`IdentificationResult`. It prints and writes nothing.
+:class:`IdentificationResult`. :func:`identify_dynamics_record` does the same for the linear
+dynamics (beyond the paper). Neither prints nor writes anything.
 """
 
 from __future__ import annotations
@@ -21,7 +22,13 @@ from hystcomp.errors import IdentificationError, InvalidParameterError, InvalidT
 from hystcomp.identify.compensation import compensation_error
 from hystcomp.identify.scoring import error_report, holdout_report, transient_end
 
-__all__ = ["IdentificationResult", "build_estimator", "identify_record"]
+__all__ = [
+    "DynamicsResult",
+    "IdentificationResult",
+    "build_estimator",
+    "identify_dynamics_record",
+    "identify_record",
+]
 
 #: The number of plays (and dead-zones) when none is given: the paper's n + 1 = 16.
 DEFAULT_OPERATORS = paper.N_OPERATORS
@@ -460,6 +467,78 @@ def identify_record(
         lines=lines,
         warnings=warnings,
     )
+
+
+@dataclass(frozen=True, eq=False)
+class DynamicsResult:
+    """What :func:`identify_dynamics_record` found.
+
+    Attributes
+    ----------
+    model : hystcomp.models.dynamics.LinearDynamics
+        The fitted dynamics.
+    source : str
+        Where the record came from.
+    lines : list of str
+        The report, one line each, as ``hystcomp identify --model dynamics`` prints it.
+    """
+
+    model: object
+    source: str
+    lines: list[str] = field(repr=False)
+
+
+def identify_dynamics_record(record) -> DynamicsResult:
+    """Fit the linear dynamics (creep and first resonance) to a record and report the fit.
+
+    Beyond the paper: the record is the answer to
+    :func:`~hystcomp.identify.dynamics.dynamics_excitation` (a step, then a multisine);
+    the fit is :meth:`hystcomp.models.dynamics.LinearDynamics.fit`.
+
+    Parameters
+    ----------
+    record : hystcomp.data.Record
+        The measured record: time (s), voltage (V), displacement (µm).
+
+    Returns
+    -------
+    DynamicsResult
+        The fitted model and the report lines (resonance in Hz, creep in %, fit errors).
+    """
+    from hystcomp.models.dynamics import LinearDynamics
+
+    for name in ("t", "v", "x", "source", "sample_rate"):
+        if not hasattr(record, name):
+            raise InvalidTypeError(
+                "The 'record' argument of identify_dynamics_record must be a "
+                f"hystcomp.data.Record (t, v, x); got {type(record).__name__}."
+            )
+    model = LinearDynamics().fit(record.v, record.x, record.sample_rate)
+    report = model.fit_report_
+    lo, hi = report["fit_band_hz"]
+    taus = model.creep_time_constants_
+    lines = [f"linear dynamics (creep and first resonance) from {record.source}"]
+    lines.append(
+        f"  record:    {len(record)} samples at {record.sample_rate:.6g} Hz "
+        f"({record.t[-1] - record.t[0]:.4g} s)"
+    )
+    lines.append(
+        f"  resonance: {model.resonance_hz_:.5g} Hz, damping ratio {model.damping_ratio_:.3g}"
+    )
+    lines.append(
+        f"  creep:     {100 * model.creep_fraction(0.0):.3g} % of the final displacement, "
+        f"{100 * model.creep_fraction(1.0):.3g} % of it after 1 s "
+        f"({taus.size} modes, {taus[0]:.3g} .. {taus[-1]:.3g} s)"
+    )
+    lines.append(
+        f"  fit, {lo:.4g} .. {hi:.4g} Hz: {report['fit_percent']:.3g} % "
+        f"(frequency response), largest magnitude error {report['max_magnitude_error_db']:.3g} dB"
+    )
+    lines.append(
+        f"  step:      rms error {report['step_rms_um']:.4g} µm on a step of "
+        f"{report['step_height_um']:.4g} µm"
+    )
+    return DynamicsResult(model=model, source=str(record.source), lines=lines)
 
 
 def _verdict(improvement: float) -> str:
