@@ -149,12 +149,12 @@ def _record(tmp_path, v, x):
 def test_identify_warns_when_no_better_than_a_line_is_predicted(tmp_path, monkeypatch):
     _, v = triangle_sequence(sample_rate=1000.0)
     path = _record(tmp_path, v, presets.paper_mpi().simulate(v))
-    import hystcomp.cli.identify as cli_identify
+    from hystcomp.identify import workflow
 
     def pessimistic(model, v, x, *, start=0):
         return {"tracking_rms_um": 2.0, "baseline_rms_um": 1.0, "ratio": 2.0}
 
-    monkeypatch.setattr(cli_identify, "compensation_error", pessimistic)
+    monkeypatch.setattr(workflow, "compensation_error", pessimistic)
     result = run("identify", path, "--model", "pi", "-o", tmp_path / "m.json")
     assert result.exit_code == 0
     warnings = [line for line in result.output.splitlines() if line.startswith("hystcomp: warn")]

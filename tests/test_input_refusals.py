@@ -13,7 +13,6 @@ from click.testing import CliRunner
 import hystcomp
 from hystcomp import presets
 from hystcomp.cli import main
-from hystcomp.cli.identify import _verdict
 from hystcomp.codegen import check_prefix, generate_c
 from hystcomp.data import write_table
 from hystcomp.errors import (
@@ -23,6 +22,7 @@ from hystcomp.errors import (
     ModelFileError,
     NotFittedError,
 )
+from hystcomp.identify.workflow import _verdict
 from hystcomp.io import model_from_dict, model_to_dict
 
 

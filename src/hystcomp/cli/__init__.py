@@ -65,6 +65,10 @@ def _one_line(text: str) -> str:
 #: shell completion load neither numba nor SciPy (tests/test_cli_lazy.py checks that this
 #: table matches the commands).
 COMMANDS = {
+    "calibrate": (
+        "hystcomp.cli.calibrate",
+        "Print how the simulated axis (the twin) compares with the paper's figures.",
+    ),
     "compare": (
         "hystcomp.cli.compare",
         "Identify the Preisach, PI and MPI models on the twin and compare the four methods.",

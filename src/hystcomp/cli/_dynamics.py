@@ -11,31 +11,12 @@ from hystcomp.models.dynamics import LinearDynamics
 
 def identify_dynamics(rec, output: str, plot: str | None) -> None:
     """Fit :class:`LinearDynamics` to ``rec``, print the fit, write the model (and figure)."""
-    model = LinearDynamics().fit(rec.v, rec.x, rec.sample_rate)
-    report = model.fit_report_
-    lo, hi = report["fit_band_hz"]
-    click.echo(f"linear dynamics (creep and first resonance) from {rec.source}")
-    click.echo(
-        f"  record:    {len(rec)} samples at {rec.sample_rate:.6g} Hz "
-        f"({rec.t[-1] - rec.t[0]:.4g} s)"
-    )
-    click.echo(
-        f"  resonance: {model.resonance_hz_:.5g} Hz, damping ratio {model.damping_ratio_:.3g}"
-    )
-    click.echo(
-        f"  creep:     {100 * model.creep_fraction(0.0):.3g} % of the final displacement, "
-        f"{100 * model.creep_fraction(1.0):.3g} % of it after 1 s "
-        f"({model.creep_time_constants_.size} modes, "
-        f"{model.creep_time_constants_[0]:.3g} .. {model.creep_time_constants_[-1]:.3g} s)"
-    )
-    click.echo(
-        f"  fit, {lo:.4g} .. {hi:.4g} Hz: {report['fit_percent']:.3g} % "
-        f"(frequency response), largest magnitude error {report['max_magnitude_error_db']:.3g} dB"
-    )
-    click.echo(
-        f"  step:      rms error {report['step_rms_um']:.4g} µm on a step of "
-        f"{report['step_height_um']:.4g} µm"
-    )
+    from hystcomp.identify.workflow import identify_dynamics_record
+
+    result = identify_dynamics_record(rec)
+    for line in result.lines:
+        click.echo(line)
+    model = result.model
     text = model_text(model)
     outputs = [output] if plot is None else [output, plot]
     with atomic_paths(*outputs) as (tmp_model, *tmp_plot):

@@ -15,26 +15,11 @@ from hystcomp.cli._options import (
     voltage_range,
 )
 from hystcomp.data import format_csv, write_table
-from hystcomp.identify.excitation import (
-    DEFAULT_SAMPLE_RATE,
-    PI_AMPLITUDES,
-    PREISACH_AMPLITUDES,
-    rich_sequence,
-    scaled_amplitudes,
-    sinusoid_sequence,
-    triangle_sequence,
-)
-
-#: Signal shape and paper amplitudes (on 0..120 V) for each model kind.
-SIGNALS = {
-    "pi": (triangle_sequence, PI_AMPLITUDES),
-    "mpi": (triangle_sequence, PI_AMPLITUDES),
-    "preisach": (sinusoid_sequence, PREISACH_AMPLITUDES),
-}
+from hystcomp.identify.excitation import DEFAULT_SAMPLE_RATE, SIGNAL_KINDS, excitation_signal
 
 
 @main.command("excite")
-@click.argument("model", type=click.Choice([*sorted(SIGNALS), "rich", "dynamics"]))
+@click.argument("model", type=click.Choice(SIGNAL_KINDS))
 @output_option(required=False, what="signal; CSV on standard output if omitted")
 @click.option(
     "--fs",
@@ -79,23 +64,9 @@ def excite(model, output, sample_rate, voltage_range, frequency, quiet):
     """
     if output is not None:
         check_data_output(output, what="signal file")
-    lo, hi = voltage_range
-    if model == "dynamics":
-        from hystcomp.identify.dynamics import dynamics_excitation
-
-        t, v = dynamics_excitation(sample_rate=sample_rate, voltage_range=voltage_range)
-    elif model == "rich":
-        t, v = rich_sequence(
-            rate=2.0 * (hi - lo) * frequency, sample_rate=sample_rate, v_min=lo, v_max=hi
-        )
-    else:
-        shape, amplitudes = SIGNALS[model]
-        t, v = shape(
-            scaled_amplitudes(amplitudes, voltage_range=voltage_range),
-            frequency=frequency,
-            sample_rate=sample_rate,
-            v_min=lo,
-        )
+    t, v = excitation_signal(
+        model, sample_rate=sample_rate, voltage_range=voltage_range, frequency=frequency
+    )
     if output is None:
         click.echo(format_csv({"t": t, "v": v}), nl=False)
     else:

@@ -1,13 +1,15 @@
-"""``hystcomp identify``: a model from a measured record, with an optional hold-out test."""
+"""``hystcomp identify``: a model from a measured record, with an optional hold-out test.
+
+The work is :func:`hystcomp.identify.workflow.identify_record`; this module parses the
+options, prints the result and writes the files.
+"""
 
 from __future__ import annotations
 
 from pathlib import Path
 
 import click
-import numpy as np
 
-from hystcomp import paper
 from hystcomp._hyperparameters import EVERETT_KINDS, MAX_DEGREE
 from hystcomp.cli import main
 from hystcomp.cli._options import (
@@ -25,91 +27,32 @@ from hystcomp.cli._options import (
 )
 from hystcomp.data import read_record
 from hystcomp.errors import IdentificationError
-from hystcomp.identify.compensation import compensation_error
 from hystcomp.identify.preisach import FIT_METHODS
 from hystcomp.identify.preisach_lsq import MAX_LSQ_GRID
-from hystcomp.identify.scoring import error_report, holdout_report, straight_line, transient_end
-from hystcomp.io import MODEL_KINDS, atomic_paths, check_output_path, model_text
+from hystcomp.identify.scoring import straight_line
+from hystcomp.identify.workflow import (
+    LABELS,
+    SIZE_OPTIONS,
+    build_estimator,
+    extrapolation_error,
+    fit_samples,
+    identify_record,
+)
+from hystcomp.io import atomic_paths, check_output_path, model_text
 
-DEFAULT_OPERATORS = paper.N_OPERATORS
-
-#: What each --model builds, and which size options it takes.
-LABELS = {"pi": "PI", "mpi": "MPI", "preisach": "Preisach", "dynamics": "dynamics"}
-SIZE_OPTIONS = {
-    "pi": ("operators", "constraints"),
-    "mpi": ("operators", "deadzones", "regularization", "constraints"),
-    "preisach": ("degree", "fit", "everett", "grid"),
-    "dynamics": (),
-}
 #: Largest --grid (the least-squares table fit has about grid^2 / 2 unknowns).
 MAX_GRID = MAX_LSQ_GRID
 
 
-def build_estimator(
-    kind: str,
-    *,
-    operators,
-    deadzones,
-    voltage_range,
-    regularization=None,
-    degree=None,
-    fit=None,
-    everett=None,
-    grid=None,
-    constraints=None,
-):
-    """An unfitted model of ``kind`` from the registry :data:`hystcomp.io.MODEL_KINDS`."""
-    cls = MODEL_KINDS.get(kind)
-    if cls is None:
-        raise IdentificationError(
-            f"The {LABELS[kind]} model is not available in this version of hystcomp; "
-            f"choose --model {' or '.join(k for k in LABELS if k in MODEL_KINDS)}."
-        )
-    given = {
-        "operators": operators,
-        "deadzones": deadzones,
-        "regularization": regularization,
-        "degree": degree,
-        "fit": fit,
-        "everett": everett,
-        "grid": grid,
-        "constraints": constraints,
-    }
+def _check_options(kind: str, given: dict) -> None:
+    """Refuse, in the command's words, an option that --model (or --everett) does not take."""
     for name, value in given.items():
         if value is not None and name not in SIZE_OPTIONS[kind]:
             raise click.UsageError(f"--{name} does not apply to --model {kind}.")
-    params = {"voltage_range": voltage_range}
-    if "operators" in SIZE_OPTIONS[kind]:
-        params["n_operators"] = DEFAULT_OPERATORS if operators is None else operators
-    if "deadzones" in SIZE_OPTIONS[kind]:
-        params["n_deadzones"] = DEFAULT_OPERATORS if deadzones is None else deadzones
-    if regularization is not None:
-        params["regularization"] = regularization
-    if degree is not None:
-        params["degree"] = degree
-    if kind == "preisach":
-        params.update(_everett_params(fit, everett, degree, grid))
-    if constraints is not None:
-        params["constraints"] = constraints
-    return cls(**params)
-
-
-def _everett_params(fit, everett, degree, grid) -> dict:
-    """The Preisach estimator's ``fit_method``, ``everett`` and ``grid_size`` from the options."""
-    if everett == "table" and degree is not None:
+    if given["everett"] == "table" and given["degree"] is not None:
         raise click.UsageError("--degree applies to --everett polynomial; a table has --grid.")
-    if grid is not None and everett == "polynomial":
+    if given["grid"] is not None and given["everett"] == "polynomial":
         raise click.UsageError("--grid applies to --everett table.")
-    if degree is not None and everett is None:
-        everett = "polynomial"  # a degree names the polynomial of eq. 5, not the default table
-    params = {}
-    if fit is not None:
-        params["fit_method"] = fit
-    if everett is not None:
-        params["everett"] = everett
-    if grid is not None:
-        params["grid_size"] = grid
-    return params
 
 
 def _regularization(ctx, param, value):
@@ -123,38 +66,6 @@ def _regularization(ctx, param, value):
     if not number >= 0 or number == float("inf"):
         raise click.BadParameter(f"must be 'auto' or a number >= 0; got {value!r}.", param=param)
     return number
-
-
-def _refuse_extrapolation(voltage_range, v) -> None:
-    """Refuse a --voltage-range that reaches beyond the input the model is fitted on."""
-    lo, hi = voltage_range
-    v_lo, v_hi = float(v.min()), float(v.max())
-    slack = 1e-9 * (v_hi - v_lo)
-    if lo < v_lo - slack or hi > v_hi + slack:
-        raise click.BadParameter(
-            f"{lo:g} {hi:g} V reaches beyond the record's input ({v_lo:.6g} .. {v_hi:.6g} V): "
-            "the compensator would command voltages the model never saw. Give a range "
-            "within the record, record over the whole range, or pass --allow-extrapolation.",
-            param_hint="'--voltage-range'",
-        )
-
-
-def _verdict(improvement: float) -> str:
-    """``line rms / model rms`` in words: "2.5x better", or "1.14x worse" below 1."""
-    if improvement >= 1.0:
-        return f"{improvement:.3g}x better"
-    if improvement > 0.0:
-        return f"{1.0 / improvement:.3g}x worse"
-    return "no better (the line fits the held-out part exactly)"
-
-
-def _sizes(model) -> str:
-    parts = []
-    if hasattr(model, "n_operators"):
-        parts.append(f"{model.n_operators} plays")
-    if hasattr(model, "n_deadzones"):
-        parts.append(f"{model.n_deadzones} dead-zones")
-    return f" ({', '.join(parts)})" if parts else ""
 
 
 @main.command("identify")
@@ -319,127 +230,50 @@ def identify(
                 raise click.UsageError(f"{name} does not apply to --model dynamics.")
         identify_dynamics(read_record(data, **read_options(columns, sample_rate)), output, plot)
         return
-    model = build_estimator(
-        kind,
-        operators=operators,
-        deadzones=deadzones,
-        voltage_range=voltage_range,
-        regularization=regularization,
-        degree=degree,
-        fit=fit,
-        everett=everett,
-        grid=grid,
-        constraints=constraints,
-    )
+    options = {"operators": operators, "deadzones": deadzones}
+    options.update(regularization=regularization, degree=degree, fit=fit, everett=everett)
+    options.update(grid=grid, constraints=constraints)
+    _check_options(kind, options)
+    model = build_estimator(kind, voltage_range=voltage_range, **options)
     rec = read_record(data, **read_options(columns, sample_rate, x_unit, quiet, data))
     warn_x_unit(rec.x, data, quiet)
     n = len(rec)
-    n_fit = n if holdout is None else n - round(holdout * n)
+    n_fit = fit_samples(n, holdout)
     if holdout is not None and not 2 <= n_fit < n:
         raise IdentificationError(
             f"--holdout {holdout} leaves {n_fit} of {n} samples to fit on; choose a fraction "
             "that keeps samples on both sides."
         )
-    v, x = rec.v[:n_fit], rec.x[:n_fit]
-    if voltage_range is not None and not allow_extrapolation:
-        _refuse_extrapolation(voltage_range, v)
-    if transient is None:
-        start = transient_end(v)
-    else:
-        start = int(np.searchsorted(rec.t - rec.t[0], transient, side="left"))
-    with progress(f"identifying the {LABELS[kind]} model", quiet).ticking():
-        if "transient" in model.get_params():
-            if transient is not None:
-                model.transient = start
-            model.fit(v, x)
-        else:  # a model without its own transient option is fitted on the settled part only
-            model.fit(v[start:], x[start:])
-    x_model = model.simulate(v)
-    report = error_report(x, x_model, start)
-
-    label = LABELS[kind]
-    click.echo(f"{label} model{_sizes(model)} from {rec.source}")
-    click.echo(
-        f"  record:    {n} samples at {rec.sample_rate:.6g} Hz ({rec.t[-1] - rec.t[0]:.4g} s), "
-        f"v {rec.v.min():.4g} .. {rec.v.max():.4g} V, x {rec.x.min():.4g} .. {rec.x.max():.4g} µm"
-    )
-    skipped = f" (first {start} left out: start-up transient)" if start else ""
-    click.echo(f"  fitted on: samples {start + 1}..{n_fit}{skipped}")
-    if model.get_params().get("regularization") == "auto":
-        chosen = model.fit_report_["regularization"]
-        click.echo(
-            f"  regularization: {chosen:g} (auto: the best predicted tracking of 0, 1e-4 .. 1e-1)"
+    why = None if voltage_range is None else extrapolation_error(voltage_range, rec.v[:n_fit])
+    if why is not None and not allow_extrapolation:
+        raise click.BadParameter(
+            f"{why}: the compensator would command voltages the model never saw. Give a "
+            "range within the record, record over the whole range, or pass "
+            "--allow-extrapolation.",
+            param_hint="'--voltage-range'",
         )
-    if kind == "preisach":
-        click.echo(f"  Everett fit: {_preisach_fit_line(model)}")
-    click.echo(
-        f"  fit error: rms {report['rms_error_um']:.4g} µm "
-        f"({report['rms_error_percent']:.3g} % of {report['displacement_range_um']:.4g} µm), "
-        f"max {report['max_error_um']:.4g} µm ({report['max_error_percent']:.3g} %)"
+    result = identify_record(
+        rec,
+        model,
+        allow_extrapolation=allow_extrapolation,
+        transient=transient,
+        holdout=holdout,
+        progress=progress(f"identifying the {LABELS[kind]} model", quiet).ticking(),
     )
-    est = compensation_error(model, v, x, start=start)
-    click.echo(
-        f"  compensation (estimated): tracking rms {est['tracking_rms_um']:.4g} µm, straight "
-        f"line v = x/k_lin {est['baseline_rms_um']:.4g} µm ({est['ratio']:.2g}x)"
-    )
-    if not est["ratio"] < 1.0:
-        click.echo(
-            f"hystcomp: warning: the {label} compensator is predicted to track no better than "
-            f"a straight line ({est['tracking_rms_um']:.3g} vs {est['baseline_rms_um']:.3g} µm "
-            "rms); record a signal with turning points across the range (hystcomp excite "
-            "rich) or try another model.",
-            err=True,
-        )
-    if holdout is not None:
-        held = holdout_report(model, rec.v, rec.x, n_fit, start)
-        click.echo(
-            f"  hold-out:  last {held['n_holdout']} samples ({100 * holdout:g} %): model rms "
-            f"{held['model_rms_um']:.4g} µm, straight line rms {held['line_rms_um']:.4g} µm: "
-            f"{_verdict(held['improvement'])}"
-        )
-        lo, hi = float(v.min()), float(v.max())
-        held_v = rec.v[n_fit:]
-        if held_v.min() < lo or held_v.max() > hi:
-            click.echo(
-                f"hystcomp: warning: the hold-out drives {held_v.min():.4g} .. "
-                f"{held_v.max():.4g} V, beyond the fitted range {lo:.4g} .. {hi:.4g} V; the "
-                "model extrapolates there. Hold out a part that stays inside the range.",
-                err=True,
-            )
+    for line in result.lines:
+        click.echo(line)
+    for warning in result.warnings:
+        click.echo(f"hystcomp: warning: {warning}", err=True)
     # Everything is computed; now write all outputs at once (a failure writes none of them).
-    text = model_text(model)
+    text = model_text(result.model)
     outputs = [output] if plot is None else [output, plot]
     with atomic_paths(*outputs) as (tmp_model, *tmp_plot):
         tmp_model.write_text(text, encoding="utf-8")
         if plot is not None:
-            a, b = straight_line(v[start:], x[start:])
-            line = a * v[start:] + b
-            plot_identification(
-                v[start:], x[start:], line, x_model[start:], tmp_plot[0], model_name=label
-            )
+            fitted = slice(result.start, result.n_fit)
+            v, x = rec.v[fitted], rec.x[fitted]
+            a, b = straight_line(v, x)
+            x_model = result.x_model[result.start :]
+            plot_identification(v, x, a * v + b, x_model, tmp_plot[0], model_name=result.label)
     for path in outputs[::-1]:
         click.echo(f"  wrote {path}")
-
-
-def _preisach_fit_line(model) -> str:
-    """How a Preisach model was fitted, in a few words."""
-    report = model.fit_report_
-    what = (
-        f"{model.grid_size} x {model.grid_size} table"
-        if model.everett == "table"
-        else f"degree-{model.degree} polynomial"
-    )
-    if report["fit"] == "reversal-curves":
-        how = f"reversal curves from {report['n_curves']} maxima"
-        if model.everett == "polynomial":
-            how += " (paper, Section III-A)"
-    else:
-        how = "least squares over the record, non-negative density"
-    why = ""
-    if model.fit_method == "auto":
-        why = (
-            " (auto: first-order descending curves from 8 or more maxima)"
-            if report["fit"] == "reversal-curves"
-            else " (auto: the record has too few first-order descending curves)"
-        )
-    return f"{what}, {how}{why}"

@@ -7,8 +7,8 @@ the saturation zone of the uncompensated loop (Section V). :func:`fit_twin_hyste
 fits the twin's seven hysteresis parameters to the first, with the other two as targets;
 its result, rounded, is the default :class:`~hystcomp.plant.TwinParameters`.
 
-Run ``python -m hystcomp.experiment.calibration`` to print the calibration figures of the
-default twin (add ``--refit`` to run the fit again first, a few seconds).
+``hystcomp calibrate`` prints the calibration figures of the default twin
+(:func:`calibration_report`; add ``--refit`` to run the fit again first, a few seconds).
 """
 
 from __future__ import annotations
@@ -182,19 +182,3 @@ def calibration_report(params: TwinParameters | None = None, seed: int = 0) -> s
         cells = ", ".join(f"{rms:.2f}/{peak:.2f}" for rms, peak in errors.values())
         lines.append(f"  {name:<22} k = {gain:.4f}, 0..{amplitude:.1f} µm: {cells}")
     return "\n".join(lines)
-
-
-def main(argv=None) -> None:
-    """``python -m hystcomp.experiment.calibration [--refit]``."""
-    import sys
-
-    args = sys.argv[1:] if argv is None else argv
-    params = None
-    if "--refit" in args:
-        params = fit_twin_hysteresis()
-        print(params)
-    print(calibration_report(params))
-
-
-if __name__ == "__main__":
-    main()

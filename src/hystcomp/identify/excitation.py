@@ -270,3 +270,69 @@ def rich_sequence(
     v_min, v_max = check_range((v_min, v_max), "voltage range (v_min, v_max)", owner)
     points = rich_turning_points(v_min=v_min, v_max=v_max, seed=seed)
     return _ramps(points, rate, sample_rate, owner)
+
+
+#: The kinds :func:`excitation_signal` knows.
+SIGNAL_KINDS = ("mpi", "pi", "preisach", "rich", "dynamics")
+
+
+def excitation_signal(
+    kind: str,
+    *,
+    sample_rate: float = DEFAULT_SAMPLE_RATE,
+    voltage_range=paper.VOLTAGE_RANGE,
+    frequency: float = 1.0,
+) -> tuple[np.ndarray, np.ndarray]:
+    """The identification input for a model kind, as ``hystcomp excite`` writes it.
+
+    Parameters
+    ----------
+    kind : {'pi', 'mpi', 'preisach', 'rich', 'dynamics'}
+        ``'pi'``, ``'mpi'``: :func:`triangle_sequence` of :data:`PI_AMPLITUDES`
+        (Section IV-A); ``'preisach'``: :func:`sinusoid_sequence` of
+        :data:`PREISACH_AMPLITUDES` (Section III-A), both scaled from 0..120 V to
+        ``voltage_range`` (:func:`scaled_amplitudes`); ``'rich'`` (not in the paper):
+        :func:`rich_sequence` at the slope of the major triangle; ``'dynamics'`` (beyond the
+        paper): :func:`hystcomp.identify.dynamics.dynamics_excitation`.
+    sample_rate : float, optional
+        Samples per second (Hz).
+    voltage_range : (float, float), optional
+        Amplifier range in V.
+    frequency : float, optional
+        Period rate in Hz (the rich signal's slope scales with it; unused by ``'dynamics'``).
+
+    Returns
+    -------
+    t, v : ndarray
+        Time in s and voltage in V.
+
+    Examples
+    --------
+    >>> t, v = excitation_signal("pi", sample_rate=100.0)
+    >>> t.size, float(v.max())
+    (401, 120.0)
+    """
+    lo, hi = check_range(voltage_range, "voltage_range", "excitation_signal")
+    if kind == "dynamics":
+        from hystcomp.identify.dynamics import dynamics_excitation
+
+        return dynamics_excitation(sample_rate=sample_rate, voltage_range=(lo, hi))
+    if kind == "rich":
+        return rich_sequence(
+            rate=2.0 * (hi - lo) * frequency, sample_rate=sample_rate, v_min=lo, v_max=hi
+        )
+    if kind in ("pi", "mpi"):
+        shape, amplitudes = triangle_sequence, PI_AMPLITUDES
+    elif kind == "preisach":
+        shape, amplitudes = sinusoid_sequence, PREISACH_AMPLITUDES
+    else:
+        raise InvalidParameterError(
+            f"The 'kind' argument of excitation_signal must be one of {', '.join(SIGNAL_KINDS)}; "
+            f"got {kind!r}."
+        )
+    return shape(
+        scaled_amplitudes(amplitudes, voltage_range=(lo, hi)),
+        frequency=frequency,
+        sample_rate=sample_rate,
+        v_min=lo,
+    )

@@ -1,0 +1,583 @@
+"""The identification workflow: a measured record in, a fitted model and its figures out.
+
+:func:`identify_record` is what ``hystcomp identify`` runs for the hysteresis models (PI,
+MPI, Preisach), usable from Python: it leaves out the start-up transient, holds out the end
+of the record if asked, fits the model, scores the fit (:mod:`hystcomp.identify.scoring`),
+estimates the compensator's tracking error (:mod:`hystcomp.identify.compensation`), and
+returns all of it with the report lines and the warnings in an
+:class:`IdentificationResult`. :func:`identify_dynamics_record` does the same for the linear
+dynamics (beyond the paper). Neither prints nor writes anything.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import numbers
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from hystcomp import paper
+from hystcomp.errors import IdentificationError, InvalidParameterError, InvalidTypeError
+from hystcomp.identify.compensation import compensation_error
+from hystcomp.identify.scoring import error_report, holdout_report, transient_end
+
+__all__ = [
+    "DynamicsResult",
+    "IdentificationResult",
+    "build_estimator",
+    "identify_dynamics_record",
+    "identify_record",
+]
+
+#: The number of plays (and dead-zones) when none is given: the paper's n + 1 = 16.
+DEFAULT_OPERATORS = paper.N_OPERATORS
+
+#: Model kinds and their names in the report.
+LABELS = {"pi": "PI", "mpi": "MPI", "preisach": "Preisach", "dynamics": "dynamics"}
+
+#: The options each kind takes (beside ``voltage_range``); ``dynamics`` has its own fit.
+SIZE_OPTIONS = {
+    "pi": ("operators", "constraints"),
+    "mpi": ("operators", "deadzones", "regularization", "constraints"),
+    "preisach": ("degree", "fit", "everett", "grid"),
+    "dynamics": (),
+}
+
+_OWNER = "identify_record"
+
+
+def _estimator_class(kind: str):
+    """The estimator class of a hysteresis model kind (imported here: models import this layer)."""
+    if kind == "pi":
+        from hystcomp.models.pi import PrandtlIshlinskii
+
+        return PrandtlIshlinskii
+    if kind == "mpi":
+        from hystcomp.models.mpi import ModifiedPrandtlIshlinskii
+
+        return ModifiedPrandtlIshlinskii
+    if kind == "preisach":
+        from hystcomp.models.preisach import Preisach
+
+        return Preisach
+    raise InvalidParameterError(
+        f"The 'kind' argument of {_OWNER} must be 'pi', 'mpi' or 'preisach'; got {kind!r}. "
+        "Linear dynamics are fitted by hystcomp.models.dynamics.LinearDynamics().fit."
+    )
+
+
+def build_estimator(
+    kind: str,
+    *,
+    voltage_range=None,
+    operators=None,
+    deadzones=None,
+    regularization=None,
+    degree=None,
+    fit=None,
+    everett=None,
+    grid=None,
+    constraints=None,
+):
+    """An unfitted hysteresis model of ``kind`` from the options of ``hystcomp identify``.
+
+    Parameters
+    ----------
+    kind : {'pi', 'mpi', 'preisach'}
+        The model family.
+    voltage_range : (float, float), optional
+        Amplifier range in V, the compensator's clamp [the fitted record's range].
+    operators, deadzones : int, optional
+        Number of plays n + 1 (pi, mpi) and of dead-zones m + 1 (mpi)
+        [:data:`DEFAULT_OPERATORS`, the paper's 16].
+    regularization : float or 'auto', optional
+        Penalty on the inverse dead-zone weights (mpi) [the estimator's default].
+    degree : int, optional
+        Degree of the Everett polynomial of eq. 5 (preisach); implies
+        ``everett='polynomial'``.
+    fit : str, optional
+        How a Preisach model is fitted (``Preisach``'s ``fit_method``).
+    everett : {'table', 'polynomial'}, optional
+        The Preisach model's Everett function.
+    grid : int, optional
+        Nodes per axis of a Preisach Everett table.
+    constraints : {'physical', 'paper'}, optional
+        Weight constraints of PI and MPI (eqs. 12, 19).
+
+    Returns
+    -------
+    estimator
+        A :class:`~hystcomp.models.pi.PrandtlIshlinskii`,
+        :class:`~hystcomp.models.mpi.ModifiedPrandtlIshlinskii` or
+        :class:`~hystcomp.models.preisach.Preisach`, not fitted.
+
+    Raises
+    ------
+    InvalidParameterError
+        An unknown kind, an option the kind does not take (:data:`SIZE_OPTIONS`), ``degree``
+        with ``everett='table'`` or ``grid`` with ``everett='polynomial'``.
+
+    Examples
+    --------
+    >>> build_estimator("mpi", operators=8).n_deadzones
+    16
+    """
+    cls = _estimator_class(kind)
+    given = {
+        "operators": operators,
+        "deadzones": deadzones,
+        "regularization": regularization,
+        "degree": degree,
+        "fit": fit,
+        "everett": everett,
+        "grid": grid,
+        "constraints": constraints,
+    }
+    for name, value in given.items():
+        if value is not None and name not in SIZE_OPTIONS[kind]:
+            raise InvalidParameterError(
+                f"The {name!r} option of build_estimator does not apply to kind {kind!r}, "
+                f"which takes {', '.join(SIZE_OPTIONS[kind])}; got {name}={value!r}. Leave it out."
+            )
+    params = {"voltage_range": voltage_range}
+    if "operators" in SIZE_OPTIONS[kind]:
+        params["n_operators"] = DEFAULT_OPERATORS if operators is None else operators
+    if "deadzones" in SIZE_OPTIONS[kind]:
+        params["n_deadzones"] = DEFAULT_OPERATORS if deadzones is None else deadzones
+    if regularization is not None:
+        params["regularization"] = regularization
+    if degree is not None:
+        params["degree"] = degree
+    if kind == "preisach":
+        params.update(_everett_params(fit, everett, degree, grid))
+    if constraints is not None:
+        params["constraints"] = constraints
+    return cls(**params)
+
+
+def _everett_params(fit, everett, degree, grid) -> dict:
+    """The Preisach estimator's ``fit_method``, ``everett`` and ``grid_size`` from the options."""
+    if everett == "table" and degree is not None:
+        raise InvalidParameterError(
+            f"The 'degree' option of build_estimator applies to everett='polynomial'; got "
+            f"degree={degree!r} with everett='table'. A table takes 'grid'."
+        )
+    if grid is not None and everett == "polynomial":
+        raise InvalidParameterError(
+            f"The 'grid' option of build_estimator applies to everett='table'; got "
+            f"grid={grid!r} with everett='polynomial'. A polynomial takes 'degree'."
+        )
+    if degree is not None and everett is None:
+        everett = "polynomial"  # a degree names the polynomial of eq. 5, not the default table
+    params = {}
+    if fit is not None:
+        params["fit_method"] = fit
+    if everett is not None:
+        params["everett"] = everett
+    if grid is not None:
+        params["grid_size"] = grid
+    return params
+
+
+def fit_samples(n: int, holdout: float | None) -> int:
+    """How many samples of ``n`` are fitted on when the last ``holdout`` fraction is held out.
+
+    Examples
+    --------
+    >>> fit_samples(1000, None), fit_samples(1000, 0.25)
+    (1000, 750)
+    """
+    return n if holdout is None else n - round(holdout * n)
+
+
+def extrapolation_error(voltage_range, v) -> str | None:
+    """Why ``voltage_range`` (V) is refused for a model fitted on the input ``v``, or None.
+
+    A range reaching beyond the input the model is fitted on would let the compensator
+    command voltages the model never saw; a relative slack of 1e-9 of the input's span
+    forgives rounding.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> extrapolation_error((0.0, 100.0), np.array([0.0, 120.0])) is None
+    True
+    >>> extrapolation_error((0.0, 200.0), np.array([0.0, 120.0]))
+    "0 200 V reaches beyond the record's input (0 .. 120 V)"
+    """
+    lo, hi = voltage_range
+    v_lo, v_hi = float(np.min(v)), float(np.max(v))
+    slack = 1e-9 * (v_hi - v_lo)
+    if lo < v_lo - slack or hi > v_hi + slack:
+        return f"{lo:g} {hi:g} V reaches beyond the record's input ({v_lo:.6g} .. {v_hi:.6g} V)"
+    return None
+
+
+@dataclass(frozen=True, eq=False)
+class IdentificationResult:
+    """What :func:`identify_record` found.
+
+    Attributes
+    ----------
+    model : estimator
+        The fitted model (PI, MPI or Preisach).
+    kind : str
+        ``'pi'``, ``'mpi'`` or ``'preisach'``.
+    source : str
+        Where the record came from (its ``source``).
+    start : int
+        Index of the first fitted sample; the samples before it (the start-up transient)
+        are left out of the fit and of the errors.
+    n_fit : int
+        Samples ``0 .. n_fit - 1`` are the fitted part; the rest is held out.
+    x_model : ndarray
+        The model's displacement in µm over the fitted part (``n_fit`` samples).
+    fit : dict
+        The fit errors over ``start .. n_fit`` (:func:`~hystcomp.identify.scoring.error_report`).
+    tracking : dict
+        The compensator's estimated tracking error beside a straight line's
+        (:func:`~hystcomp.identify.compensation.compensation_error`).
+    holdout : dict or None
+        The hold-out figures (:func:`~hystcomp.identify.scoring.holdout_report`), or None
+        without a hold-out.
+    lines : list of str
+        The report, one line each, as ``hystcomp identify`` prints it.
+    warnings : list of str
+        Each a sentence (without the ``hystcomp: warning:`` prefix of the command line):
+        the compensator is predicted to track no better than a straight line, or the
+        hold-out leaves the fitted input range.
+    """
+
+    model: object
+    kind: str
+    source: str
+    start: int
+    n_fit: int
+    x_model: np.ndarray = field(repr=False)
+    fit: dict
+    tracking: dict
+    holdout: dict | None
+    lines: list[str] = field(repr=False)
+    warnings: list[str]
+
+    @property
+    def label(self) -> str:
+        """The model family's name in the report: ``'PI'``, ``'MPI'`` or ``'Preisach'``."""
+        return LABELS[self.kind]
+
+
+def identify_record(
+    record,
+    model,
+    *,
+    voltage_range=None,
+    allow_extrapolation: bool = False,
+    transient: float | None = None,
+    holdout: float | None = None,
+    progress=None,
+    **options,
+) -> IdentificationResult:
+    """Fit a hysteresis model to a measured record and score it.
+
+    The fit starts after the start-up transient: by default at the first sample where the
+    input reaches an end of its range (:func:`~hystcomp.identify.scoring.transient_end`),
+    else ``transient`` seconds into the record. With ``holdout`` the last fraction of the
+    record is left out of the fit and the model's prediction of it is scored against a
+    straight line. The compensator's tracking error is estimated by running its inverse on
+    the measured displacement (:func:`~hystcomp.identify.compensation.compensation_error`).
+
+    Parameters
+    ----------
+    record : hystcomp.data.Record
+        The measured record: time (s), voltage (V), displacement (µm).
+    model : {'pi', 'mpi', 'preisach'} or estimator, optional
+        The kind to build with ``voltage_range`` and ``options`` (:func:`build_estimator`),
+        or an unfitted estimator (then give neither).
+    voltage_range : (float, float), optional
+        Amplifier range in V, the compensator's clamp [the fitted input's range].
+    allow_extrapolation : bool, optional
+        Accept a ``voltage_range`` reaching beyond the fitted input; refused by default,
+        since the compensator would command voltages the model never saw.
+    transient : float, optional
+        Seconds at the start of the record left out of the fit, >= 0.
+    holdout : float, optional
+        Fraction of the record, strictly between 0 and 1, held out at its end.
+    progress : context manager, optional
+        Entered around the fit, e.g. ``hystcomp._progress.Progress(...).ticking()``.
+    **options
+        ``operators``, ``deadzones``, ``regularization``, ``degree``, ``fit``,
+        ``everett``, ``grid``, ``constraints``: see :func:`build_estimator`.
+
+    Returns
+    -------
+    IdentificationResult
+        The fitted model, its errors, the hold-out and tracking figures, the report lines
+        and the warnings.
+
+    Raises
+    ------
+    InvalidParameterError
+        A bad option, ``holdout`` or ``transient``, or a ``voltage_range`` beyond the fitted
+        input without ``allow_extrapolation``.
+    IdentificationError
+        The hold-out leaves fewer than 2 samples to fit on, or the fit fails.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from hystcomp.data import Record
+    >>> from hystcomp.plant import Twin
+    >>> t = np.arange(5000) / 1000.0  # 5 s at 1 kHz, a loop with inner loops each second
+    >>> v = 60.0 - 40.0 * np.cos(2 * np.pi * t) - 20.0 * np.cos(6 * np.pi * t)
+    >>> record = Record(t, v, Twin().hysteresis(v), source="twin")
+    >>> result = identify_record(record, "pi", operators=8, holdout=0.2)
+    >>> result.model.n_operators, result.n_fit, result.holdout["n_holdout"]
+    (8, 4000, 1000)
+    >>> bool(result.fit["rms_error_percent"] < 2.0), bool(result.tracking["ratio"] < 1.0)
+    (True, True)
+    >>> result.warnings
+    []
+    >>> result.lines[0]
+    'PI model (8 plays) from twin'
+    """
+    for name in ("t", "v", "x", "source", "sample_rate"):
+        if not hasattr(record, name):
+            raise InvalidTypeError(
+                f"The 'record' argument of {_OWNER} must be a hystcomp.data.Record (t, v, x); "
+                f"got {type(record).__name__}. Read a file with hystcomp.data.read_record or "
+                "build a Record from arrays."
+            )
+    if isinstance(model, str):
+        model = build_estimator(model, voltage_range=voltage_range, **options)
+    elif options or voltage_range is not None:
+        raise InvalidParameterError(
+            f"{_OWNER} takes options ({', '.join(sorted(options) or ['voltage_range'])}) only "
+            "with a model kind; got an estimator. Set them on the estimator instead."
+        )
+    kind = getattr(model, "kind", None)
+    if kind not in ("pi", "mpi", "preisach") or not hasattr(model, "get_params"):
+        raise InvalidTypeError(
+            f"The 'model' argument of {_OWNER} must be 'pi', 'mpi', 'preisach' or an unfitted "
+            f"PI, MPI or Preisach estimator; got {type(model).__name__}."
+        )
+    if holdout is not None and not (isinstance(holdout, numbers.Real) and 0.0 < holdout < 1.0):
+        raise InvalidParameterError(
+            f"The 'holdout' argument of {_OWNER} must be a fraction strictly between 0 and 1; "
+            f"got {holdout!r}."
+        )
+    if transient is not None and not (
+        isinstance(transient, numbers.Real) and 0.0 <= transient < float("inf")
+    ):
+        raise InvalidParameterError(
+            f"The 'transient' argument of {_OWNER} must be a finite number of seconds >= 0; "
+            f"got {transient!r}."
+        )
+    n = len(record)
+    n_fit = fit_samples(n, holdout)
+    if holdout is not None and not 2 <= n_fit < n:
+        raise IdentificationError(
+            f"The 'holdout' argument of {_OWNER}, {holdout}, leaves {n_fit} of {n} samples to "
+            "fit on; choose a fraction that keeps samples on both sides."
+        )
+    v, x = record.v[:n_fit], record.x[:n_fit]
+    chosen_range = model.get_params().get("voltage_range")
+    if chosen_range is not None and not allow_extrapolation:
+        why = extrapolation_error(chosen_range, v)
+        if why is not None:
+            raise InvalidParameterError(
+                f"The 'voltage_range' of {_OWNER}, {why}: the compensator would command "
+                "voltages the model never saw. Give a range within the record, record over "
+                "the whole range, or pass allow_extrapolation=True."
+            )
+    if transient is None:
+        start = transient_end(v)
+    else:
+        start = int(np.searchsorted(record.t - record.t[0], transient, side="left"))
+    with contextlib.nullcontext() if progress is None else progress:
+        if "transient" in model.get_params():
+            if transient is not None:
+                model.transient = start
+            model.fit(v, x)
+        else:  # a model without its own transient option is fitted on the settled part only
+            model.fit(v[start:], x[start:])
+    x_model = model.simulate(v)
+    fit = error_report(x, x_model, start)
+    tracking = compensation_error(model, v, x, start=start)
+    held = None if holdout is None else holdout_report(model, record.v, record.x, n_fit, start)
+
+    label = LABELS[kind]
+    lines = [f"{label} model{_sizes(model)} from {record.source}"]
+    lines.append(
+        f"  record:    {n} samples at {record.sample_rate:.6g} Hz "
+        f"({record.t[-1] - record.t[0]:.4g} s), v {record.v.min():.4g} .. "
+        f"{record.v.max():.4g} V, x {record.x.min():.4g} .. {record.x.max():.4g} µm"
+    )
+    skipped = f" (first {start} left out: start-up transient)" if start else ""
+    lines.append(f"  fitted on: samples {start + 1}..{n_fit}{skipped}")
+    if model.get_params().get("regularization") == "auto":
+        chosen = model.fit_report_["regularization"]
+        lines.append(
+            f"  regularization: {chosen:g} (auto: the best predicted tracking of 0, 1e-4 .. 1e-1)"
+        )
+    if kind == "preisach":
+        lines.append(f"  Everett fit: {_preisach_fit_line(model)}")
+    lines.append(
+        f"  fit error: rms {fit['rms_error_um']:.4g} µm "
+        f"({fit['rms_error_percent']:.3g} % of {fit['displacement_range_um']:.4g} µm), "
+        f"max {fit['max_error_um']:.4g} µm ({fit['max_error_percent']:.3g} %)"
+    )
+    lines.append(
+        f"  compensation (estimated): tracking rms {tracking['tracking_rms_um']:.4g} µm, "
+        f"straight line v = x/k_lin {tracking['baseline_rms_um']:.4g} µm "
+        f"({tracking['ratio']:.2g}x)"
+    )
+    warnings = []
+    if not tracking["ratio"] < 1.0:
+        warnings.append(
+            f"the {label} compensator is predicted to track no better than a straight line "
+            f"({tracking['tracking_rms_um']:.3g} vs {tracking['baseline_rms_um']:.3g} µm "
+            "rms); record a signal with turning points across the range (hystcomp excite "
+            "rich) or try another model."
+        )
+    if held is not None:
+        lines.append(
+            f"  hold-out:  last {held['n_holdout']} samples ({100 * holdout:g} %): model rms "
+            f"{held['model_rms_um']:.4g} µm, straight line rms {held['line_rms_um']:.4g} µm: "
+            f"{_verdict(held['improvement'])}"
+        )
+        lo, hi = float(v.min()), float(v.max())
+        held_v = record.v[n_fit:]
+        if held_v.min() < lo or held_v.max() > hi:
+            warnings.append(
+                f"the hold-out drives {held_v.min():.4g} .. {held_v.max():.4g} V, beyond the "
+                f"fitted range {lo:.4g} .. {hi:.4g} V; the model extrapolates there. Hold out "
+                "a part that stays inside the range."
+            )
+    return IdentificationResult(
+        model=model,
+        kind=kind,
+        source=str(record.source),
+        start=start,
+        n_fit=n_fit,
+        x_model=x_model,
+        fit=fit,
+        tracking=tracking,
+        holdout=held,
+        lines=lines,
+        warnings=warnings,
+    )
+
+
+@dataclass(frozen=True, eq=False)
+class DynamicsResult:
+    """What :func:`identify_dynamics_record` found.
+
+    Attributes
+    ----------
+    model : hystcomp.models.dynamics.LinearDynamics
+        The fitted dynamics.
+    source : str
+        Where the record came from.
+    lines : list of str
+        The report, one line each, as ``hystcomp identify --model dynamics`` prints it.
+    """
+
+    model: object
+    source: str
+    lines: list[str] = field(repr=False)
+
+
+def identify_dynamics_record(record) -> DynamicsResult:
+    """Fit the linear dynamics (creep and first resonance) to a record and report the fit.
+
+    Beyond the paper: the record is the answer to
+    :func:`~hystcomp.identify.dynamics.dynamics_excitation` (a step, then a multisine);
+    the fit is :meth:`hystcomp.models.dynamics.LinearDynamics.fit`.
+
+    Parameters
+    ----------
+    record : hystcomp.data.Record
+        The measured record: time (s), voltage (V), displacement (µm).
+
+    Returns
+    -------
+    DynamicsResult
+        The fitted model and the report lines (resonance in Hz, creep in %, fit errors).
+    """
+    from hystcomp.models.dynamics import LinearDynamics
+
+    for name in ("t", "v", "x", "source", "sample_rate"):
+        if not hasattr(record, name):
+            raise InvalidTypeError(
+                "The 'record' argument of identify_dynamics_record must be a "
+                f"hystcomp.data.Record (t, v, x); got {type(record).__name__}."
+            )
+    model = LinearDynamics().fit(record.v, record.x, record.sample_rate)
+    report = model.fit_report_
+    lo, hi = report["fit_band_hz"]
+    taus = model.creep_time_constants_
+    lines = [f"linear dynamics (creep and first resonance) from {record.source}"]
+    lines.append(
+        f"  record:    {len(record)} samples at {record.sample_rate:.6g} Hz "
+        f"({record.t[-1] - record.t[0]:.4g} s)"
+    )
+    lines.append(
+        f"  resonance: {model.resonance_hz_:.5g} Hz, damping ratio {model.damping_ratio_:.3g}"
+    )
+    lines.append(
+        f"  creep:     {100 * model.creep_fraction(0.0):.3g} % of the final displacement, "
+        f"{100 * model.creep_fraction(1.0):.3g} % of it after 1 s "
+        f"({taus.size} modes, {taus[0]:.3g} .. {taus[-1]:.3g} s)"
+    )
+    lines.append(
+        f"  fit, {lo:.4g} .. {hi:.4g} Hz: {report['fit_percent']:.3g} % "
+        f"(frequency response), largest magnitude error {report['max_magnitude_error_db']:.3g} dB"
+    )
+    lines.append(
+        f"  step:      rms error {report['step_rms_um']:.4g} µm on a step of "
+        f"{report['step_height_um']:.4g} µm"
+    )
+    return DynamicsResult(model=model, source=str(record.source), lines=lines)
+
+
+def _verdict(improvement: float) -> str:
+    """``line rms / model rms`` in words: "2.5x better", or "1.14x worse" below 1."""
+    if improvement >= 1.0:
+        return f"{improvement:.3g}x better"
+    if improvement > 0.0:
+        return f"{1.0 / improvement:.3g}x worse"
+    return "no better (the line fits the held-out part exactly)"
+
+
+def _sizes(model) -> str:
+    parts = []
+    if hasattr(model, "n_operators"):
+        parts.append(f"{model.n_operators} plays")
+    if hasattr(model, "n_deadzones"):
+        parts.append(f"{model.n_deadzones} dead-zones")
+    return f" ({', '.join(parts)})" if parts else ""
+
+
+def _preisach_fit_line(model) -> str:
+    """How a Preisach model was fitted, in a few words."""
+    report = model.fit_report_
+    what = (
+        f"{model.grid_size} x {model.grid_size} table"
+        if model.everett == "table"
+        else f"degree-{model.degree} polynomial"
+    )
+    if report["fit"] == "reversal-curves":
+        how = f"reversal curves from {report['n_curves']} maxima"
+        if model.everett == "polynomial":
+            how += " (paper, Section III-A)"
+    else:
+        how = "least squares over the record, non-negative density"
+    why = ""
+    if model.fit_method == "auto":
+        why = (
+            " (auto: first-order descending curves from 8 or more maxima)"
+            if report["fit"] == "reversal-curves"
+            else " (auto: the record has too few first-order descending curves)"
+        )
+    return f"{what}, {how}{why}"

@@ -1,0 +1,163 @@
+"""The library functions behind ``hystcomp identify`` and ``excite``, and ``hystcomp calibrate``."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from hystcomp import presets
+from hystcomp.cli import main
+from hystcomp.data import Record
+from hystcomp.errors import IdentificationError, InvalidParameterError, InvalidTypeError
+from hystcomp.identify.dynamics import dynamics_excitation
+from hystcomp.identify.excitation import (
+    PREISACH_AMPLITUDES,
+    excitation_signal,
+    scaled_amplitudes,
+    sinusoid_sequence,
+    triangle_sequence,
+)
+from hystcomp.identify.workflow import (
+    IdentificationResult,
+    build_estimator,
+    identify_dynamics_record,
+    identify_record,
+)
+from hystcomp.models.dynamics import LinearDynamics
+
+FS = 1000.0  # Hz
+
+
+def _loops(seconds: float = 4.0) -> Record:
+    """Loops with inner loops over 0..120 V every second, through the paper's MPI model."""
+    t = np.arange(round(seconds * FS)) / FS
+    v = 60.0 - 40.0 * np.cos(2 * np.pi * t) - 20.0 * np.cos(6 * np.pi * t)
+    rng = np.random.default_rng(7)
+    x = presets.paper_mpi().simulate(v) + rng.normal(0.0, 0.01, v.size)
+    return Record(t, v, x, source="loops")
+
+
+def test_a_record_in_gives_a_result_with_its_named_fields():
+    rec = _loops()
+    result = identify_record(rec, "pi", operators=8, holdout=0.25)
+    assert isinstance(result, IdentificationResult)
+    assert (result.kind, result.label, result.source) == ("pi", "PI", "loops")
+    assert result.model.n_operators == 8
+    assert (result.n_fit, result.start) == (3000, 0)  # the signal starts at an end (0 V)
+    # The stored output is the fitted model's, and the errors are computed from it.
+    np.testing.assert_array_equal(result.x_model, result.model.simulate(rec.v[:3000]))
+    rms = float(np.sqrt(np.mean((rec.x[:3000] - result.x_model) ** 2)))
+    assert result.fit["rms_error_um"] == pytest.approx(rms, rel=1e-9)
+    assert result.fit["rms_error_um"] < 0.02 * np.ptp(rec.x)  # PI fits an MPI loop to 2 %
+    assert result.holdout["n_holdout"] == 1000
+    assert result.holdout["improvement"] > 2.0  # far better than a line on unseen loops
+    assert result.tracking["ratio"] < 0.5
+    assert result.warnings == []
+    assert result.lines[0] == "PI model (8 plays) from loops"
+    assert result.lines[2] == "  fitted on: samples 1..3000"
+    assert result.lines[-1].startswith("  hold-out:  last 1000 samples (25 %): model rms ")
+    assert result.lines[-1].endswith("x better")
+
+
+def test_an_estimator_given_is_fitted_as_its_kind_would_be():
+    rec = _loops(2.0)
+    by_kind = identify_record(rec, "pi", operators=6, transient=0.5)
+    by_estimator = identify_record(rec, build_estimator("pi", operators=6), transient=0.5)
+    assert by_kind.start == by_estimator.start == 500  # 0.5 s at 1 kHz
+    assert (
+        by_kind.lines[2]
+        == "  fitted on: samples 501..2000 (first 500 left out: start-up transient)"
+    )
+    np.testing.assert_allclose(by_kind.x_model, by_estimator.x_model, rtol=0, atol=1e-12)
+    with pytest.raises(InvalidParameterError, match="only with a model kind"):
+        identify_record(rec, build_estimator("pi"), operators=6)
+
+
+def test_a_holdout_beyond_the_fitted_range_is_a_warning():
+    _, v = triangle_sequence(sample_rate=FS)  # amplitudes grow: the end reaches 120 V
+    rec = Record(np.arange(v.size) / FS, v, presets.paper_mpi().simulate(v))
+    result = identify_record(rec, "pi", operators=8, holdout=0.3)
+    assert len(result.warnings) == 1
+    assert result.warnings[0].startswith("the hold-out drives 0 .. 120 V, beyond the fitted")
+    assert "hystcomp: warning" not in result.warnings[0]  # the command line adds the prefix
+
+
+def test_a_record_without_hysteresis_warns_that_a_line_does_as_well():
+    rec = _loops(2.0)
+    line = Record(rec.t, rec.v, 0.3 * rec.v, source="line")  # a straight line tracks exactly
+    result = identify_record(line, "pi", operators=4)
+    assert not result.tracking["ratio"] < 1.0
+    assert len(result.warnings) == 1
+    assert "no better than a straight line" in result.warnings[0]
+
+
+@pytest.mark.parametrize(
+    ("args", "options", "error", "match"),
+    [
+        (("pi",), {"degree": 3}, InvalidParameterError, "'degree' option .* does not apply"),
+        (("preisach",), {"everett": "table", "degree": 3}, InvalidParameterError, "applies to"),
+        (("nosuch",), {}, InvalidParameterError, "'kind' argument"),
+        (("pi",), {"voltage_range": (0.0, 200.0)}, InvalidParameterError, "allow_extrapolation"),
+        (("pi",), {"holdout": 0.9999}, IdentificationError, "leaves 0 of 2000 samples"),
+        (("pi",), {"holdout": 1.5}, InvalidParameterError, "strictly between 0 and 1"),
+        (("pi",), {"transient": -1.0}, InvalidParameterError, "'transient' argument"),
+        ((object(),), {}, InvalidTypeError, "'model' argument"),
+    ],
+)
+def test_bad_arguments_are_refused_with_a_message_naming_them(args, options, error, match):
+    with pytest.raises(error, match=match):
+        identify_record(_loops(2.0), *args, **options)
+
+
+def test_a_wide_voltage_range_is_accepted_when_extrapolation_is_allowed():
+    result = identify_record(
+        _loops(2.0), "pi", operators=4, voltage_range=(0.0, 150.0), allow_extrapolation=True
+    )
+    assert result.model.voltage_range_ == (0.0, 150.0)
+
+
+def test_a_record_must_be_a_record():
+    with pytest.raises(InvalidTypeError, match="'record' argument"):
+        identify_record(np.zeros((3, 10)), "pi")
+
+
+def test_calibrate_prints_the_twins_figures():
+    result = CliRunner().invoke(main, ["calibrate"])
+    assert result.exit_code == 0, result.output
+    lines = result.output.splitlines()
+    assert lines[0].startswith("stroke: ")
+    stroke = float(lines[0].split()[1])
+    assert abs(stroke - 37.0) < 0.5  # the calibration target (µm at 120 V)
+    assert "630.00 Hz" in lines[3]
+    assert len(lines) == 9
+
+
+def test_excitation_signal_is_the_papers_signal_scaled_to_the_range():
+    t, v = excitation_signal("preisach", sample_rate=200.0, voltage_range=(-10.0, 50.0))
+    amplitudes = scaled_amplitudes(PREISACH_AMPLITUDES, voltage_range=(-10.0, 50.0))
+    t_ref, v_ref = sinusoid_sequence(amplitudes, sample_rate=200.0, v_min=-10.0)
+    np.testing.assert_array_equal(t, t_ref)
+    np.testing.assert_array_equal(v, v_ref)
+    assert (float(v.min()), float(v.max())) == (-10.0, 50.0)
+    with pytest.raises(InvalidParameterError, match="'kind' argument of excitation_signal"):
+        excitation_signal("nosuch")
+
+
+def test_dynamics_from_a_record_with_its_report_lines():
+    true = LinearDynamics.from_parameters(
+        sample_rate=20_000.0,
+        resonance_hz=780.0,
+        damping_ratio=0.05,
+        creep_time_constants=[0.004, 0.04, 0.4, 2.0],
+        creep_weights=[0.0075] * 4,
+    )
+    t, v = dynamics_excitation()
+    x = 0.3 * true.simulate(v, initial=0.0) + 0.003 * np.random.default_rng(7).standard_normal(
+        v.size
+    )
+    result = identify_dynamics_record(Record(t, v, x, source="stage"))
+    assert result.model.resonance_hz_ == pytest.approx(780.0, rel=0.005)
+    assert result.lines[0] == "linear dynamics (creep and first resonance) from stage"
+    assert result.lines[2].startswith(f"  resonance: {result.model.resonance_hz_:.5g} Hz, ")
+    assert len(result.lines) == 6
