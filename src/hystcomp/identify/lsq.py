@@ -118,6 +118,23 @@ class LsqSolution:
 RIDGE = 1e-10
 
 
+def _centred(gram: np.ndarray):
+    """The parts of an augmented Gram matrix ``[X 1 z]^T [X 1 z]``, and its centred block.
+
+    Returns ``G, g, zz`` (the blocks ``[X 1]^T [X 1]``, ``[X 1]^T z`` and ``z^T z``), the
+    sample count, the regressor means and the mean of ``z``, and the centred ``X^T X`` and
+    ``X^T z`` (the intercept eliminated).
+    """
+    p = gram.shape[0] - 1
+    G, g, zz = gram[:p, :p], gram[:p, p], gram[p, p]
+    count = G[-1, -1]
+    mean = G[-1, :-1] / count
+    z_mean = g[-1] / count
+    G_c = G[:-1, :-1] - count * np.outer(mean, mean)
+    g_c = g[:-1] - count * mean * z_mean
+    return G, g, zz, count, mean, z_mean, G_c, g_c
+
+
 def constrained_lsq(
     gram, *, blocks, scales, floors=(), caps=(), flat_tol=1e-6, ridge=RIDGE
 ) -> LsqSolution:
@@ -169,12 +186,7 @@ def constrained_lsq(
         regressor of each block varies; the message says what to check otherwise).
     """
     p = gram.shape[0] - 1
-    G, g, zz = gram[:p, :p], gram[:p, p], gram[p, p]
-    count = G[-1, -1]
-    mean = G[-1, :-1] / count
-    z_mean = g[-1] / count
-    g_c = g[:-1] - count * mean * z_mean
-    G_c = G[:-1, :-1] - count * np.outer(mean, mean)
+    G, g, zz, count, mean, z_mean, G_c, g_c = _centred(gram)
     spread = np.sqrt(np.maximum(np.diag(G_c), 0.0) / count)
     varies = spread > flat_tol * np.asarray(scales, dtype=np.float64)
     blocks = [(a, b, bound) for a, b, bound in blocks if b > a]
@@ -258,12 +270,7 @@ def solve_inequality_qp(
         If quadprog finds no solution.
     """
     p = gram.shape[0] - 1
-    G, g, zz = gram[:p, :p], gram[:p, p], gram[p, p]
-    count = G[-1, -1]
-    mean = G[-1, :-1] / count
-    z_mean = g[-1] / count
-    g_c = g[:-1] - count * mean * z_mean
-    quad_full = G[:-1, :-1] - count * np.outer(mean, mean)
+    G, g, zz, _, mean, z_mean, quad_full, g_c = _centred(gram)
     if penalty is not None:
         quad_full = quad_full + penalty
     diag = np.maximum(np.diag(quad_full), 0.0)
