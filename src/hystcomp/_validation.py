@@ -28,15 +28,16 @@ def check_int(value, name: str, owner: str, *, minimum: int = 1, maximum: int | 
             f"The {name!r} parameter of {owner} must be an int >= {minimum}. "
             f"Got {value!r} of type {type(value).__name__} instead."
         )
-    if value < minimum:
+    number = int(value)
+    if number < minimum:
         raise InvalidParameterError(
             f"The {name!r} parameter of {owner} must be an int >= {minimum}. Got {value!r} instead."
         )
-    if maximum is not None and value > maximum:
+    if maximum is not None and number > maximum:
         raise InvalidParameterError(
             f"The {name!r} parameter of {owner} must be an int <= {maximum}. Got {value!r} instead."
         )
-    return int(value)
+    return number
 
 
 def check_real(

@@ -48,7 +48,8 @@ class DiscreteSystem:
     state : ndarray
         The initial state ``s[0]`` (1-D float64).
     update : callable
-        ``update(s, u) -> s_next``: the state after applying input ``u`` in state ``s``.
+        ``update(s, u) -> s_next``: the state after applying input ``u`` in state ``s``
+        (``u`` is the input vector, of one element, as python-control passes it).
     output : callable
         ``output(s, u) -> y``: the output for input ``u`` in state ``s`` (direct feedthrough
         allowed).
@@ -57,8 +58,8 @@ class DiscreteSystem:
     """
 
     state: np.ndarray
-    update: Callable[[np.ndarray, float], np.ndarray]
-    output: Callable[[np.ndarray, float], float]
+    update: Callable[[np.ndarray, np.ndarray], np.ndarray]
+    output: Callable[[np.ndarray, np.ndarray], float]
     inputs: tuple[str, ...]
     outputs: tuple[str, ...]
 

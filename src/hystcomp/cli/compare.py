@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import time
 from pathlib import Path
+from typing import Any
 
 import click
 
@@ -44,7 +45,9 @@ def compare(out_dir: Path, seed: int, periods: int | None, quick: bool) -> None:
 
     start = time.perf_counter()
     prepare_output_dir(out_dir)  # refuse a bad --out before the work
-    changes = {"seed": seed} if periods is None else {"seed": seed, "periods": periods}
+    changes: dict[str, Any] = (
+        {"seed": seed} if periods is None else {"seed": seed, "periods": periods}
+    )
     config = CompareConfig.quick(**changes) if quick else CompareConfig(**changes)
 
     def progress(line: str) -> None:

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import Any
+
 import click
 import numpy as np
 
@@ -33,7 +35,7 @@ def inverse_options(model, table, *, slew_rate, narrow_range) -> dict:
     The slew-rate limit is per sample, so it needs the reference's own sample rate. With
     uneven sampling the shortest interval is taken: the limit then holds on every interval.
     """
-    options = {}
+    options: dict[str, Any] = {}
     if slew_rate is not None:
         shortest = float(np.min(np.diff(table["t"])))
         options.update(slew_rate=slew_rate, sample_rate=1.0 / shortest)

@@ -52,7 +52,7 @@ class DynamicsComparison:
     """
 
     record: Record
-    dynamics: object
+    dynamics: LinearDynamics
     results: dict
     step: dict
     step_error: dict

@@ -10,6 +10,7 @@ drawing a figure; lines are thinned to a few thousand points (:func:`_thin`).
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from matplotlib.figure import Figure
@@ -40,7 +41,7 @@ def figure_9(results: dict, path: Path) -> None:
     ax = fig.add_subplot()
     top = max(float(r.x_ref.max()) for r in results.values())
     zone = SATURATION_ZONE * top
-    inset = ax.inset_axes([0.52, 0.06, 0.45, 0.42])
+    inset = ax.inset_axes((0.52, 0.06, 0.45, 0.42))
     low_y, high_y = np.inf, -np.inf
     for method in METHODS:
         r = results[method]
@@ -49,7 +50,7 @@ def figure_9(results: dict, path: Path) -> None:
         near = ref >= zone
         low_y, high_y = min(low_y, float(x[near].min())), max(high_y, float(x[near].max()))
         ref, x = ref[_thin(ref.size)], x[_thin(x.size)]
-        style = {"color": COLOURS[method], "lw": 0.9}
+        style: dict[str, Any] = {"color": COLOURS[method], "lw": 0.9}
         label = f"{LABELS[method]} ({r.saturation_zone_pct:.1f} % in the saturation zone)"
         ax.plot(ref, x, label=label, **style)
         inset.plot(ref, x, **style)

@@ -153,7 +153,7 @@ def _ratio(ours: float, theirs: float) -> str:
 
 
 def _order(values: dict[str, float]) -> list[str]:
-    return sorted(values, key=values.get)
+    return sorted(values, key=values.__getitem__)
 
 
 def _order_text(order: list[str]) -> str:
@@ -202,8 +202,8 @@ def report_markdown(comparison, figure_notes: dict[str, str | None]) -> str:
         "|---|---:|---:|---:|",
     ]
     for m, r in c.results[low].items():
-        ref = paper.SATURATION_ZONE_PCT.get(m) if low == paper.FIG9_FREQUENCY else None
-        theirs = f"{ref:g}" if ref is not None else "-"
+        zone_ref = paper.SATURATION_ZONE_PCT.get(m) if low == paper.FIG9_FREQUENCY else None
+        theirs = f"{zone_ref:g}" if zone_ref is not None else "-"
         parts.append(
             f"| {LABELS[m]} | {r.hysteresis_pct:.2f} | {r.saturation_zone_pct:.2f} | {theirs} |"
         )
@@ -331,11 +331,11 @@ def _reading(c) -> list[str]:
     low = min(c.results)
     zone = {m: r.saturation_zone_pct for m, r in c.results[low].items()}
     compensated = {m: zone[m] for m in METHODS[1:]}
-    worst = max(compensated, key=compensated.get)
-    best = min(compensated, key=compensated.get)
+    worst = max(compensated, key=compensated.__getitem__)
+    best = min(compensated, key=compensated.__getitem__)
     paper_zone = paper.SATURATION_ZONE_PCT
-    p_worst = max(METHODS[1:], key=paper_zone.get)
-    p_best = min(METHODS[1:], key=paper_zone.get)
+    p_worst = max(METHODS[1:], key=paper_zone.__getitem__)
+    p_best = min(METHODS[1:], key=paper_zone.__getitem__)
     lines.append(
         f"In the saturation zone at {low:g} Hz the uncompensated loop has {zone['uncompensated']:.1f} % "
         f"of hysteresis (paper {paper_zone['uncompensated']:g} %); among the compensated methods "

@@ -163,7 +163,8 @@ class EverettBasis:
         if self.kind == pk.BASIS_POLYNOMIAL:
             return np.zeros((self.size, self.size))
         n = self.n_seg
-        index = {}
+        # Keys: ("d", s) for diagonal segment s, (sa, sb) for the cell of segments sa > sb.
+        index: dict[tuple[str | int, int], int] = {}
         for s in range(n):
             index[("d", s)] = s
         m = n

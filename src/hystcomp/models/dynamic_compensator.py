@@ -48,7 +48,7 @@ def inverse_fir(resonance, bandwidth_hz: float, sample_rate: float):
     span; zero taps at the ends are dropped, and the preview is the look-ahead of the
     first tap left.
     """
-    from scipy.optimize import nnls  # type: ignore[import-untyped]  # no stubs
+    from scipy.optimize import nnls
 
     b, a = resonance
     fn = _resonance_hz(a, sample_rate)
