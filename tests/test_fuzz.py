@@ -21,11 +21,9 @@ from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
 
 import hystcomp
-from hystcomp import io as model_io
 from hystcomp import presets
 from hystcomp._validation import MAX_MAGNITUDE
 from hystcomp.codegen import generate_c
-from hystcomp.data import read_record, read_table
 from hystcomp.errors import (
     HystcompError,
     InvalidParameterError,
@@ -34,6 +32,8 @@ from hystcomp.errors import (
     NotInvertibleError,
 )
 from hystcomp.identify.preisach import MAX_DEGREE
+from hystcomp.io import models as model_io
+from hystcomp.io.records import read_record, read_table
 from hystcomp.models.preisach import Preisach
 from hystcomp.preisach_kernels import monomial_exponents, n_monomials
 from tests.conftest import examples

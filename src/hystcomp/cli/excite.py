@@ -14,7 +14,6 @@ from hystcomp.cli._options import (
     quiet_option,
     voltage_range,
 )
-from hystcomp.data import format_csv, write_table
 from hystcomp.identify.excitation import (
     DEFAULT_SAMPLE_RATE,
     PI_AMPLITUDES,
@@ -24,6 +23,7 @@ from hystcomp.identify.excitation import (
     sinusoid_sequence,
     triangle_sequence,
 )
+from hystcomp.io.records import format_csv, write_table
 
 #: Signal shape and paper amplitudes (on 0..120 V) for each model kind.
 SIGNALS = {

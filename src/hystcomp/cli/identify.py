@@ -23,13 +23,14 @@ from hystcomp.cli._options import (
     warn_x_unit,
     x_unit_option,
 )
-from hystcomp.data import read_record
 from hystcomp.errors import IdentificationError
 from hystcomp.identify.compensation import compensation_error
 from hystcomp.identify.preisach import FIT_METHODS
 from hystcomp.identify.preisach_lsq import MAX_LSQ_GRID
 from hystcomp.identify.scoring import error_report, holdout_report, straight_line, transient_end
-from hystcomp.io import MODEL_KINDS, atomic_paths, check_output_path, model_text
+from hystcomp.io.atomic import atomic_paths, check_output_path
+from hystcomp.io.models import MODEL_KINDS, model_text
+from hystcomp.io.records import read_record
 
 DEFAULT_OPERATORS = paper.N_OPERATORS
 
@@ -58,7 +59,7 @@ def build_estimator(
     grid=None,
     constraints=None,
 ):
-    """An unfitted model of ``kind`` from the registry :data:`hystcomp.io.MODEL_KINDS`."""
+    """An unfitted model of ``kind`` from the registry :data:`hystcomp.io.models.MODEL_KINDS`."""
     cls = MODEL_KINDS.get(kind)
     if cls is None:
         raise IdentificationError(
