@@ -22,6 +22,7 @@ from hypothesis.extra import numpy as hnp
 
 import hystcomp
 from hystcomp import presets
+from hystcomp._hyperparameters import MAX_DEGREE
 from hystcomp._validation import MAX_MAGNITUDE
 from hystcomp.codegen import generate_c
 from hystcomp.errors import (
@@ -31,7 +32,6 @@ from hystcomp.errors import (
     InvalidTypeError,
     NotInvertibleError,
 )
-from hystcomp.identify.preisach import MAX_DEGREE
 from hystcomp.io import models as model_io
 from hystcomp.io.records import read_record, read_table
 from hystcomp.models.preisach import Preisach
