@@ -34,7 +34,7 @@ SAMPLES = int(float(os.environ.get("BENCH_IO_SAMPLES", "1e7")))
 _SETUP = """
 import resource, sys, time
 import numpy as np
-from hystcomp.data import read_record, write_table
+from hystcomp.io.records import read_record, write_table
 n, path, source, size = int(sys.argv[1]), sys.argv[2], sys.argv[3], int(sys.argv[4])
 def peak():  # MB; VmHWM, as ru_maxrss keeps the parent's peak across fork and exec
     with open("/proc/self/status") as status:

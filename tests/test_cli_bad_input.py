@@ -24,8 +24,8 @@ import scipy.io
 
 import hystcomp
 from hystcomp import presets
-from hystcomp.data import write_table
 from hystcomp.identify.excitation import triangle_sequence
+from hystcomp.io.records import write_table
 
 SRC = Path(hystcomp.__file__).parents[1]
 PRECIOUS = b"precious: an earlier result that a failing command must not touch\n"
@@ -258,7 +258,7 @@ def test_a_mat_file_that_crashes_scipy_is_a_clean_error(tmp_path):
     path = tmp_path / "crash.mat"
     path.write_bytes(crashing_mat_bytes())
     with pytest.raises(hystcomp.errors.DataFileError, match=r"not a readable MATLAB .*corrupt"):
-        hystcomp.data.read_table(path)
+        hystcomp.io.records.read_table(path)
     code = f"import scipy.io; scipy.io.loadmat({str(path)!r})"
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, check=False)
     if result.returncode >= 0:

@@ -10,7 +10,7 @@ from click.testing import CliRunner
 
 import hystcomp
 from hystcomp.cli import main
-from hystcomp.data import read_table, write_table
+from hystcomp.io.records import read_table, write_table
 from tests.conftest import random_walk
 from tests.test_codegen import build_preisach, needs_cc
 

@@ -13,9 +13,9 @@ from click.testing import CliRunner
 import hystcomp
 from hystcomp import presets
 from hystcomp.cli import main
-from hystcomp.data import read_record, read_table, write_table
 from hystcomp.identify.excitation import triangle_sequence
 from hystcomp.identify.scoring import holdout_report
+from hystcomp.io.records import read_record, read_table, write_table
 from hystcomp.plant import Twin
 
 # A real record (MIT licence, see the README and LICENSE beside it).

@@ -8,8 +8,8 @@ import pytest
 
 import hystcomp
 from hystcomp import presets
-from hystcomp.data import read_table, write_table
 from hystcomp.identify.excitation import triangle_sequence
+from hystcomp.io.records import read_table, write_table
 from tests.test_cli_identify import REAL_RECORD, assert_one_line_error, run
 
 

@@ -15,10 +15,10 @@ from click.testing import CliRunner
 import hystcomp
 from hystcomp import presets
 from hystcomp.cli import main
-from hystcomp.data import read_table, write_table
 from hystcomp.errors import HystcompError, InvalidParameterError, OutputPathError
 from hystcomp.identify.excitation import triangle_sequence
-from hystcomp.io import atomic_paths
+from hystcomp.io.atomic import atomic_paths
+from hystcomp.io.records import read_table, write_table
 from tests.conftest import invertible_weights
 
 ABSURD = np.array([1e6, -1e6, 0.0, 1e6, -5.0, 30.0, -1e6, 1e6, 12.0, -1e3])

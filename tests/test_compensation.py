@@ -10,11 +10,11 @@ from click.testing import CliRunner
 import hystcomp
 from hystcomp import presets
 from hystcomp.cli import main
-from hystcomp.data import read_record, read_table, write_table
 from hystcomp.errors import InvalidParameterError
 from hystcomp.identify.compensation import compensation_error
 from hystcomp.identify.excitation import rich_sequence, triangle_sequence
 from hystcomp.identify.scoring import holdout_report, thin, transient_end
+from hystcomp.io.records import read_record, read_table, write_table
 from hystcomp.plant import Twin
 
 REAL_RECORD = Path(__file__).parent / "data" / "piezo-micromanipulator" / "Model_Vi_Do.dat"

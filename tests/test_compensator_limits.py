@@ -11,8 +11,8 @@ from click.testing import CliRunner
 import hystcomp
 from hystcomp import presets
 from hystcomp.cli import main
-from hystcomp.data import read_table, write_table
 from hystcomp.identify.excitation import triangle_sequence
+from hystcomp.io.records import read_table, write_table
 from tests.test_codegen import CC, _compile, _run_c, needs_cc
 
 COMPENSATORS = {

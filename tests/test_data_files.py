@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 import scipy.io
 
-from hystcomp.data import Record, parse_columns, read_record, read_table, write_table
 from hystcomp.errors import DataFileError, InvalidParameterError
+from hystcomp.io.records import Record, parse_columns, read_record, read_table, write_table
 
 
 @pytest.fixture

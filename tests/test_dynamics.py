@@ -11,9 +11,9 @@ from click.testing import CliRunner
 import hystcomp
 from hystcomp._lti import resonance_zoh
 from hystcomp.cli import main
-from hystcomp.data import read_table, write_table
 from hystcomp.errors import IdentificationError, InvalidParameterError, InvalidTypeError
 from hystcomp.identify.dynamics import dynamics_excitation
+from hystcomp.io.records import read_table, write_table
 from hystcomp.models.dynamic_compensator import MAX_PREVIEW
 from hystcomp.models.dynamics import DynamicCompensator, LinearDynamics
 from hystcomp.plant import Twin, creep_twin

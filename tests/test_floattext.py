@@ -4,7 +4,7 @@ import numpy as np
 from hypothesis import given
 from hypothesis import strategies as st
 
-from hystcomp._floattext import format_rows
+from hystcomp.io._floattext import format_rows
 
 
 def _reprs(values):

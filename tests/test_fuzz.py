@@ -21,13 +21,11 @@ from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
 
 import hystcomp
-from hystcomp import io as model_io
 from hystcomp import presets
 from hystcomp._hyperparameters import MAX_DEGREE
 from hystcomp._kernels.preisach import monomial_exponents, n_monomials
 from hystcomp._validation import MAX_MAGNITUDE
 from hystcomp.codegen import generate_c
-from hystcomp.data import read_record, read_table
 from hystcomp.errors import (
     HystcompError,
     InvalidParameterError,
@@ -35,6 +33,8 @@ from hystcomp.errors import (
     InvalidTypeError,
     NotInvertibleError,
 )
+from hystcomp.io import models as model_io
+from hystcomp.io.records import read_record, read_table
 from hystcomp.models.preisach import Preisach
 from tests.conftest import examples
 

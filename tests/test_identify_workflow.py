@@ -8,7 +8,6 @@ from click.testing import CliRunner
 
 from hystcomp import presets
 from hystcomp.cli import main
-from hystcomp.data import Record
 from hystcomp.errors import IdentificationError, InvalidParameterError, InvalidTypeError
 from hystcomp.identify.dynamics import dynamics_excitation
 from hystcomp.identify.excitation import (
@@ -24,6 +23,7 @@ from hystcomp.identify.workflow import (
     identify_dynamics_record,
     identify_record,
 )
+from hystcomp.io.records import Record
 from hystcomp.models.dynamics import LinearDynamics
 
 FS = 1000.0  # Hz

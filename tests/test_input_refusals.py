@@ -14,7 +14,6 @@ import hystcomp
 from hystcomp import presets
 from hystcomp.cli import main
 from hystcomp.codegen import check_prefix, generate_c
-from hystcomp.data import write_table
 from hystcomp.errors import (
     InvalidParameterError,
     InvalidSignalError,
@@ -23,7 +22,8 @@ from hystcomp.errors import (
     NotFittedError,
 )
 from hystcomp.identify.workflow import _verdict
-from hystcomp.io import model_from_dict, model_to_dict
+from hystcomp.io.models import model_from_dict, model_to_dict
+from hystcomp.io.records import write_table
 
 
 def run(*args):

@@ -10,10 +10,10 @@ import pytest
 import scipy.io
 from click.testing import CliRunner
 
-from hystcomp._formats import MAX_SAMPLES, max_samples
 from hystcomp.cli import main
-from hystcomp.data import read_record, read_table, write_table, x_unit_warning
 from hystcomp.errors import DataFileError, InvalidParameterError
+from hystcomp.io._formats import MAX_SAMPLES, max_samples
+from hystcomp.io.records import read_record, read_table, write_table, x_unit_warning
 
 
 @pytest.fixture
@@ -194,8 +194,8 @@ def test_declared_sizes_are_refused_before_loading(tmp_path, monkeypatch):
 
 
 def test_chunked_read_and_write_round_trip_across_chunks(tmp_path, rng, monkeypatch):
-    import hystcomp._text as text
-    from hystcomp._formats import read_raw
+    import hystcomp.io._text as text
+    from hystcomp.io._formats import read_raw
 
     monkeypatch.setattr(text, "CHUNK_BYTES", 1000)  # many chunks, rows cut anywhere
     monkeypatch.setattr(text, "SMALL_TABLE", 0)  # the compiled formatter, even for few rows
@@ -226,8 +226,8 @@ def test_chunked_read_and_write_round_trip_across_chunks(tmp_path, rng, monkeypa
 _PEAK = (
     "import resource, sys\n"
     "import numpy as np\n"
-    "from hystcomp.data import read_record, write_table\n"
-    "import hystcomp._floattext  # numba, which the writer loads on first use\n"
+    "from hystcomp.io.records import read_record, write_table\n"
+    "import hystcomp.io._floattext  # numba, which the writer loads on first use\n"
     "def peak():  # MB; VmHWM, as ru_maxrss keeps the parent's peak across fork and exec\n"
     "    for line in open('/proc/self/status'):\n"
     "        if line.startswith('VmHWM:'):\n"

@@ -20,10 +20,10 @@ import hystcomp
 from hystcomp import presets
 from hystcomp.cli import main
 from hystcomp.codegen import export_c
-from hystcomp.data import read_table, write_table
 from hystcomp.errors import OutputPathError
 from hystcomp.experiment import report
-from hystcomp.io import atomic_paths, replace_all
+from hystcomp.io.atomic import atomic_paths, replace_all
+from hystcomp.io.records import read_table, write_table
 from tests.test_codegen import CC, STRICT, needs_cc
 
 
@@ -236,7 +236,7 @@ def test_a_header_and_source_of_two_exports_do_not_compile_together(tmp_path):
 STALLED = textwrap.dedent(
     """
     import sys, time
-    import hystcomp.data
+    import hystcomp.io.records
     from hystcomp.io import atomic_path
     from hystcomp.cli import main, compensate
 

@@ -7,9 +7,9 @@ import pandas as pd
 import pytest
 
 from hystcomp import ModifiedPrandtlIshlinskii, PrandtlIshlinskii, Record, presets, read_record
-from hystcomp.data import write_table
 from hystcomp.errors import InvalidTypeError
 from hystcomp.identify.excitation import triangle_sequence
+from hystcomp.io.records import write_table
 
 
 @pytest.fixture(scope="module")

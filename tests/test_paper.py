@@ -66,7 +66,7 @@ def _published_numbers() -> set[float]:
 
 
 #: Names whose value equals a published number by coincidence (the line is not flagged).
-COINCIDENCES = {"MAT_TIMEOUT"}  # _formats.py: 120 s to parse a MAT file, not 120 V
+COINCIDENCES = {"MAT_TIMEOUT"}  # io/_formats.py: 120 s to parse a MAT file, not 120 V
 
 #: Literal tuples/lists that are the paper's, written out.
 PUBLISHED_SEQUENCES = {

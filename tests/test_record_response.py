@@ -10,10 +10,10 @@ from click.testing import CliRunner
 import hystcomp
 from hystcomp import presets
 from hystcomp.cli import main
-from hystcomp.data import write_table
 from hystcomp.errors import IdentificationError
 from hystcomp.identify.excitation import sinusoid_sequence, triangle_sequence
 from hystcomp.identify.scoring import MIN_EXPLAINED, check_response
+from hystcomp.io.records import write_table
 
 FITS = {
     "pi": lambda: hystcomp.PrandtlIshlinskii(n_operators=8),

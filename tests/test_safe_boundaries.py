@@ -11,10 +11,8 @@ import numpy as np
 import pytest
 
 import hystcomp
-from hystcomp import io as model_io
 from hystcomp import presets
 from hystcomp._validation import MAX_MAGNITUDE, as_signal, as_vector, check_int, check_real
-from hystcomp.data import Record, parse_columns, read_table
 from hystcomp.errors import (
     DataFileError,
     InvalidParameterError,
@@ -24,6 +22,8 @@ from hystcomp.errors import (
     NotInvertibleError,
 )
 from hystcomp.identify.excitation import scaled_amplitudes, sinusoid_sequence, triangle_sequence
+from hystcomp.io import models as model_io
+from hystcomp.io.records import Record, parse_columns, read_table
 
 SRC = Path(hystcomp.__file__).parent
 
@@ -256,9 +256,9 @@ PUBLIC = {
     "save_model": lambda a: hystcomp.save_model(a, a),
     "read_table": lambda a: read_table(a),
     "read_table columns": lambda a: read_table(SRC / "py.typed", columns=a, sample_rate=a),
-    "write_table": lambda a: hystcomp.data.write_table(a, {"t": a}),
-    "format_csv": lambda a: hystcomp.data.format_csv(a),
-    "rate_of": lambda a: hystcomp.data.rate_of(a),
+    "write_table": lambda a: hystcomp.io.records.write_table(a, {"t": a}),
+    "format_csv": lambda a: hystcomp.io.records.format_csv(a),
+    "rate_of": lambda a: hystcomp.io.records.rate_of(a),
     "Record": lambda a: Record(a, a, a),
     "parse_columns": lambda a: parse_columns(a),
     "triangle_sequence": lambda a: triangle_sequence(a, sample_rate=a, frequency=a),

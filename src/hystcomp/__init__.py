@@ -29,13 +29,13 @@ _LAZY = {
     "ModifiedPrandtlIshlinskii": ("hystcomp.models.mpi", "ModifiedPrandtlIshlinskii"),
     "PrandtlIshlinskii": ("hystcomp.models.pi", "PrandtlIshlinskii"),
     "Preisach": ("hystcomp.models.preisach", "Preisach"),
-    "Record": ("hystcomp.data", "Record"),
+    "Record": ("hystcomp.io.records", "Record"),
     "Stepper": ("hystcomp.models.system", "Stepper"),
     "errors": ("hystcomp.errors", None),
-    "load_model": ("hystcomp.io", "load_model"),
+    "load_model": ("hystcomp.io.models", "load_model"),
     "presets": ("hystcomp.presets", None),
-    "read_record": ("hystcomp.data", "read_record"),
-    "save_model": ("hystcomp.io", "save_model"),
+    "read_record": ("hystcomp.io.records", "read_record"),
+    "save_model": ("hystcomp.io.models", "save_model"),
     "to_control": ("hystcomp.control", "to_control"),
 }
 
@@ -59,8 +59,8 @@ __all__ = [  # written out for static tools; tests/test_cli_lazy.py checks it ag
 if TYPE_CHECKING:  # what static tools see; at run time __getattr__ imports on first use
     from hystcomp import errors, presets
     from hystcomp.control import to_control
-    from hystcomp.data import Record, read_record
-    from hystcomp.io import load_model, save_model
+    from hystcomp.io.models import load_model, save_model
+    from hystcomp.io.records import Record, read_record
     from hystcomp.models.compensator import Compensator
     from hystcomp.models.dynamics import LinearDynamics
     from hystcomp.models.mpi import ModifiedPrandtlIshlinskii

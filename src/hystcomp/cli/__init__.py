@@ -29,9 +29,9 @@ EXIT_SIGTERM = 143  # 128 + SIGTERM
 
 def remove_pending() -> None:
     """Remove the temporary outputs of an interrupted write (none if no file module ran)."""
-    io = sys.modules.get("hystcomp.io")  # not imported here: it pulls in the models
-    if io is not None:
-        io.remove_pending()
+    atomic = sys.modules.get("hystcomp.io.atomic")  # not imported here if no file was written
+    if atomic is not None:
+        atomic.remove_pending()
 
 
 class _Terminated(BaseException):

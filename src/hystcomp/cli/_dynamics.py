@@ -5,7 +5,8 @@ from __future__ import annotations
 import click
 
 from hystcomp.errors import ModelFileError
-from hystcomp.io import atomic_paths, load_model, model_text
+from hystcomp.io.atomic import atomic_paths
+from hystcomp.io.models import load_model, model_text
 from hystcomp.models.dynamics import LinearDynamics
 
 

@@ -12,10 +12,10 @@ import click
 
 from hystcomp._progress import Progress
 from hystcomp._validation import MAX_MAGNITUDE
-from hystcomp.data import X_UNITS  # light: data's readers load compiled code only on use
 from hystcomp.errors import InvalidParameterError
+from hystcomp.io.records import X_UNITS  # light: the readers load compiled code only on use
 
-# hystcomp.data, hystcomp.io and the models are imported where they are used: a command that
+# hystcomp.io.records, hystcomp.io.models and the models are imported where used: a command that
 # needs no kernel (``excite``) then loads neither numba nor SciPy's sparse solvers.
 
 #: Largest --operators / --deadzones (the paper uses 16; the fit's cost grows as n^2 per sample).
@@ -88,7 +88,7 @@ def voltage_range(ctx, param, value):
 
 def columns(ctx, param, value):
     """A callback: a column mapping such as ``v=1,x=5`` (see :func:`parse_columns`)."""
-    from hystcomp.data import parse_columns
+    from hystcomp.io.records import parse_columns
 
     try:
         return parse_columns(value)
@@ -148,7 +148,7 @@ quiet_option = click.option(
 def read_options(
     columns: dict | None, sample_rate: float | None, x_unit=None, quiet: bool = False, path=""
 ) -> dict:
-    """Keyword arguments for :func:`hystcomp.data.read_table` from the shared options."""
+    """Keyword arguments for :func:`hystcomp.io.records.read_table` from the shared options."""
     options = {"columns": columns, "sample_rate": sample_rate, "x_unit": x_unit}
     if not quiet:
         options["progress"] = Progress(f"reading {click.format_filename(str(path))}")
@@ -161,8 +161,8 @@ def progress(label: str, quiet: bool):
 
 
 def warn_x_unit(x, source, quiet: bool) -> None:
-    """The one-line warning of :func:`hystcomp.data.x_unit_warning`, unless --quiet."""
-    from hystcomp.data import x_unit_warning
+    """The one-line warning of :func:`hystcomp.io.records.x_unit_warning`, unless --quiet."""
+    from hystcomp.io.records import x_unit_warning
 
     message = x_unit_warning(x, str(source))
     if message and not quiet:
@@ -171,8 +171,8 @@ def warn_x_unit(x, source, quiet: bool) -> None:
 
 def check_data_output(path, *, inputs=(), what: str = "output"):
     """Refuse, before any work, a data output that cannot be written or would overwrite an input."""
-    from hystcomp.data import check_writable
-    from hystcomp.io import check_output_path
+    from hystcomp.io.atomic import check_output_path
+    from hystcomp.io.records import check_writable
 
     check_output_path(path, inputs=inputs, what=what)
     return check_writable(path)

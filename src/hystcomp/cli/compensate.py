@@ -24,9 +24,9 @@ from hystcomp.cli._options import (
     warn_x_unit,
     x_unit_option,
 )
-from hystcomp.data import read_table, write_table
 from hystcomp.errors import InvalidSignalError
-from hystcomp.io import load_model
+from hystcomp.io.models import load_model
+from hystcomp.io.records import read_table, write_table
 
 
 def inverse_options(model, table, *, slew_rate, narrow_range) -> dict:

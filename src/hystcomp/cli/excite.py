@@ -14,8 +14,8 @@ from hystcomp.cli._options import (
     quiet_option,
     voltage_range,
 )
-from hystcomp.data import format_csv, write_table
 from hystcomp.identify.excitation import DEFAULT_SAMPLE_RATE, SIGNAL_KINDS, excitation_signal
+from hystcomp.io.records import format_csv, write_table
 
 
 @main.command("excite")

@@ -12,7 +12,8 @@ from hystcomp.cli import main
 from hystcomp.cli._dynamics import load_dynamics, refuse_dynamics_as_model
 from hystcomp.cli._options import method_option, method_options
 from hystcomp.codegen import DEFAULT_PREFIX, check_prefix, export_c
-from hystcomp.io import check_output_path, load_model
+from hystcomp.io.atomic import check_output_path
+from hystcomp.io.models import load_model
 
 
 def _rate(ctx, param, value):

@@ -25,7 +25,6 @@ from hystcomp.cli._options import (
     warn_x_unit,
     x_unit_option,
 )
-from hystcomp.data import read_record
 from hystcomp.errors import IdentificationError
 from hystcomp.identify.preisach import FIT_METHODS
 from hystcomp.identify.preisach_lsq import MAX_LSQ_GRID
@@ -38,7 +37,9 @@ from hystcomp.identify.workflow import (
     fit_samples,
     identify_record,
 )
-from hystcomp.io import atomic_paths, check_output_path, model_text
+from hystcomp.io.atomic import atomic_paths, check_output_path
+from hystcomp.io.models import model_text
+from hystcomp.io.records import read_record
 
 #: Largest --grid (the least-squares table fit has about grid^2 / 2 unknowns).
 MAX_GRID = MAX_LSQ_GRID

@@ -14,8 +14,8 @@ from hystcomp.cli._options import (
     quiet_option,
     read_options,
 )
-from hystcomp.data import read_table, write_table
-from hystcomp.io import load_model
+from hystcomp.io.models import load_model
+from hystcomp.io.records import read_table, write_table
 
 
 @main.command("simulate")

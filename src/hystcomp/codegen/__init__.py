@@ -24,7 +24,7 @@ from hystcomp.codegen.c99 import CTemplate, check_prefix, render
 from hystcomp.codegen.chain import chain_template
 from hystcomp.codegen.preisach import preisach_template
 from hystcomp.errors import InvalidParameterError, InvalidTypeError
-from hystcomp.io import atomic_paths, check_output_path
+from hystcomp.io.atomic import atomic_paths, check_output_path
 
 DEFAULT_PREFIX = "hystcomp_compensator"
 

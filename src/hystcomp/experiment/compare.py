@@ -20,7 +20,6 @@ from collections.abc import Callable
 import numpy as np
 
 from hystcomp._validation import check_int, check_real
-from hystcomp.data import Record
 from hystcomp.errors import InvalidParameterError, InvalidTypeError
 from hystcomp.experiment.baseline import LinearCompensator, linear_gain
 from hystcomp.experiment.references import FREQUENCIES, REFERENCE_FRACTION, triangle_reference
@@ -30,6 +29,7 @@ from hystcomp.identify.excitation import (
     sinusoid_sequence,
     triangle_sequence,
 )
+from hystcomp.io.records import Record
 from hystcomp.models.mpi import ModifiedPrandtlIshlinskii
 from hystcomp.models.pi import PrandtlIshlinskii
 from hystcomp.models.preisach import Preisach

@@ -15,10 +15,10 @@ import dataclasses
 
 import numpy as np
 
-from hystcomp.data import Record
 from hystcomp.experiment.references import triangle_reference
 from hystcomp.experiment.tracking import TrackingResult, run_tracking
 from hystcomp.identify.dynamics import dynamics_excitation
+from hystcomp.io.records import Record
 from hystcomp.models.dynamics import LinearDynamics
 
 #: Frequencies of the rows with the dynamics (Hz): Table I's, and two faster.

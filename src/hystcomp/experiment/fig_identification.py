@@ -11,7 +11,7 @@ from matplotlib.figure import Figure
 
 from hystcomp.errors import InvalidParameterError
 from hystcomp.experiment._layout import _thin, fixed_layout
-from hystcomp.io import atomic_path
+from hystcomp.io.atomic import atomic_path
 
 FORMATS = (".png", ".pdf", ".svg")
 

@@ -11,7 +11,7 @@ from hystcomp._validation import as_signal, check_real
 from hystcomp.errors import InvalidParameterError, InvalidSignalError
 from hystcomp.experiment._layout import fixed_layout
 from hystcomp.identify.excitation import scaled_amplitudes, sinusoid_sequence
-from hystcomp.io import atomic_path
+from hystcomp.io.atomic import atomic_path
 from hystcomp.paper import FIG5_AMPLITUDES
 
 

@@ -1,7 +1,7 @@
 """Figures of the comparison: the paper's Figs. 9 and 10 here, Figs. 5 and 8 from their modules.
 
 Every figure is drawn on its own :class:`~matplotlib.figure.Figure` (no global pyplot
-state) and saved through :func:`hystcomp.io.atomic_path`, so a failure never leaves a
+state) and saved through :func:`hystcomp.io.atomic.atomic_path`, so a failure never leaves a
 broken image. The margins are fixed in inches (:func:`fixed_layout`) rather than computed by
 matplotlib's constrained layout, which measures every label again and doubled the cost of
 drawing a figure; lines are thinned to a few thousand points (:func:`_thin`).
@@ -19,7 +19,7 @@ from hystcomp.experiment._layout import _thin, fixed_layout, new_figure
 from hystcomp.experiment.fig_identification import plot_identification
 from hystcomp.experiment.fig_preisach import plot_preisach_loops
 from hystcomp.experiment.metrics import SATURATION_ZONE
-from hystcomp.io import atomic_path
+from hystcomp.io.atomic import atomic_path
 from hystcomp.paper import LABELS, METHODS
 
 COLOURS = {"uncompensated": "0.45", "preisach": "tab:green", "pi": "tab:blue", "mpi": "tab:red"}

@@ -21,7 +21,7 @@ from hystcomp import paper
 from hystcomp.errors import InvalidParameterError
 from hystcomp.experiment.figures import write_figures
 from hystcomp.experiment.metrics import SATURATION_ZONE
-from hystcomp.io import (
+from hystcomp.io.atomic import (
     atomic_path,
     check_output_path,
     replace_all,
@@ -110,7 +110,7 @@ def write_outputs(comparison, out_dir) -> list[Path]:
     """Write tables, figures and ``report.md`` into ``out_dir``; return the files written.
 
     Every file is first written into a hidden folder inside ``out_dir``, then all are
-    renamed into place together (:func:`hystcomp.io.replace_all`): a failure or an
+    renamed into place together (:func:`hystcomp.io.atomic.replace_all`): a failure or an
     interruption leaves the files of an earlier run as they were, never a mix of two runs.
     """
     out = prepare_output_dir(out_dir)

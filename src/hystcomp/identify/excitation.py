@@ -321,6 +321,7 @@ def excitation_signal(
         return rich_sequence(
             rate=2.0 * (hi - lo) * frequency, sample_rate=sample_rate, v_min=lo, v_max=hi
         )
+    amplitudes: tuple[float, ...]
     if kind in ("pi", "mpi"):
         shape, amplitudes = triangle_sequence, PI_AMPLITUDES
     elif kind == "preisach":

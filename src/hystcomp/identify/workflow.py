@@ -14,6 +14,7 @@ from __future__ import annotations
 import contextlib
 import numbers
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -21,6 +22,9 @@ from hystcomp import paper
 from hystcomp.errors import IdentificationError, InvalidParameterError, InvalidTypeError
 from hystcomp.identify.compensation import compensation_error
 from hystcomp.identify.scoring import error_report, holdout_report, transient_end
+
+if TYPE_CHECKING:  # the models import this layer; at run time they are imported where used
+    from hystcomp.models.dynamics import LinearDynamics
 
 __all__ = [
     "DynamicsResult",
@@ -289,7 +293,7 @@ def identify_record(
 
     Parameters
     ----------
-    record : hystcomp.data.Record
+    record : hystcomp.io.records.Record
         The measured record: time (s), voltage (V), displacement (µm).
     model : {'pi', 'mpi', 'preisach'} or estimator, optional
         The kind to build with ``voltage_range`` and ``options`` (:func:`build_estimator`),
@@ -326,7 +330,7 @@ def identify_record(
     Examples
     --------
     >>> import numpy as np
-    >>> from hystcomp.data import Record
+    >>> from hystcomp.io.records import Record
     >>> from hystcomp.plant import Twin
     >>> t = np.arange(5000) / 1000.0  # 5 s at 1 kHz, a loop with inner loops each second
     >>> v = 60.0 - 40.0 * np.cos(2 * np.pi * t) - 20.0 * np.cos(6 * np.pi * t)
@@ -344,8 +348,8 @@ def identify_record(
     for name in ("t", "v", "x", "source", "sample_rate"):
         if not hasattr(record, name):
             raise InvalidTypeError(
-                f"The 'record' argument of {_OWNER} must be a hystcomp.data.Record (t, v, x); "
-                f"got {type(record).__name__}. Read a file with hystcomp.data.read_record or "
+                f"The 'record' argument of {_OWNER} must be a hystcomp.io.records.Record (t, v, x); "
+                f"got {type(record).__name__}. Read a file with hystcomp.io.records.read_record or "
                 "build a Record from arrays."
             )
     if isinstance(model, str):
@@ -483,7 +487,7 @@ class DynamicsResult:
         The report, one line each, as ``hystcomp identify --model dynamics`` prints it.
     """
 
-    model: object
+    model: LinearDynamics
     source: str
     lines: list[str] = field(repr=False)
 
@@ -497,7 +501,7 @@ def identify_dynamics_record(record) -> DynamicsResult:
 
     Parameters
     ----------
-    record : hystcomp.data.Record
+    record : hystcomp.io.records.Record
         The measured record: time (s), voltage (V), displacement (µm).
 
     Returns
@@ -511,7 +515,7 @@ def identify_dynamics_record(record) -> DynamicsResult:
         if not hasattr(record, name):
             raise InvalidTypeError(
                 "The 'record' argument of identify_dynamics_record must be a "
-                f"hystcomp.data.Record (t, v, x); got {type(record).__name__}."
+                f"hystcomp.io.records.Record (t, v, x); got {type(record).__name__}."
             )
     model = LinearDynamics().fit(record.v, record.x, record.sample_rate)
     report = model.fit_report_

@@ -306,7 +306,7 @@ class LinearDynamics:
         return {}
 
     def to_dict(self) -> dict[str, Any]:
-        """Kind, parameters and fit report, ready for JSON (see :mod:`hystcomp.io`)."""
+        """Kind, parameters and fit report, ready for JSON (see :mod:`hystcomp.io.models`)."""
         out: dict[str, Any] = {"kind": self.kind, "hyperparameters": {}}
         out["parameters"] = self.parameters()
         report = getattr(self, "fit_report_", None)

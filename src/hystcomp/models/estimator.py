@@ -185,7 +185,7 @@ class Estimator:
     def from_dict(cls, data: dict[str, Any]) -> Self:
         """Inverse of :meth:`to_dict` (validates everything through ``from_parameters``).
 
-        :func:`hystcomp.io.model_from_dict` checks a whole document (keys, JSON types) first.
+        :func:`hystcomp.io.models.model_from_dict` checks a whole document (keys, JSON types) first.
         """
         if not (isinstance(data, dict) and isinstance(data.get("parameters"), dict)):
             raise InvalidParameterError(

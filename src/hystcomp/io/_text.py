@@ -22,7 +22,7 @@ guessing from statistics, unlike :class:`csv.Sniffer`):
 The data rows are parsed in chunks of :data:`CHUNK_BYTES` by :func:`numpy.loadtxt` (its C
 parser) into one preallocated array, so a read needs about the memory of the values
 (8 bytes each) and no more; rows are counted first and a file with more than the limit of
-samples (:func:`hystcomp._formats.max_samples`) is refused before any large allocation.
+samples (:func:`hystcomp.io._formats.max_samples`) is refused before any large allocation.
 """
 
 from __future__ import annotations
@@ -135,7 +135,7 @@ def sniff(path: Path) -> Layout:
 def _header(path: Path, above, delimiter, n: int):
     """Names and units from the lines above the first data row (rules 4 and 5)."""
     plain = [line for comment, line in above if not comment]
-    comments = []
+    comments: list[str] = []
     for comment, line in reversed(above):  # the comment lines directly above the data
         if not comment:
             break
@@ -268,7 +268,7 @@ def write_csv(file, columns: dict[str, np.ndarray], progress=None) -> None:
     """Write ``columns`` to the binary ``file`` as CSV with a header row, in chunks.
 
     Every value is written as Python's ``repr`` writes it (the shortest text that reads
-    back as the same float64), by the compiled formatter of :mod:`hystcomp._floattext`;
+    back as the same float64), by the compiled formatter of :mod:`hystcomp.io._floattext`;
     chunks of rows keep the memory bounded whatever the length.
     """
     names = list(columns)
@@ -279,7 +279,7 @@ def write_csv(file, columns: dict[str, np.ndarray], progress=None) -> None:
         rows = zip(*(map(repr, a.tolist()) for a in arrays), strict=True)
         file.write("".join(",".join(row) + "\n" for row in rows).encode())
         return
-    from hystcomp._floattext import WIDTH, format_rows  # compiled: loaded when writing
+    from hystcomp.io._floattext import WIDTH, format_rows  # compiled: loaded when writing
 
     step = max(1, CHUNK_BYTES // (WIDTH * max(len(arrays), 1)))
     for start in range(0, n, step):

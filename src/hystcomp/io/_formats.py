@@ -1,11 +1,11 @@
 """Parsing data files into columns, treating every file as untrusted input.
 
-Text tables (:mod:`hystcomp._text`: layout rules, chunked ``np.loadtxt``), NPZ
+Text tables (:mod:`hystcomp.io._text`: layout rules, chunked ``np.loadtxt``), NPZ
 (``np.load`` without pickle) and MAT files. A MAT file is parsed by scipy in a child
 process: scipy's MAT reader is not hardened against corrupt files (a wrong type code in a
 numeric element crashes the interpreter), so a crash there becomes a
 :class:`~hystcomp.errors.DataFileError` instead of the end of the caller's process.
-:mod:`hystcomp.data` picks and checks the columns.
+:mod:`hystcomp.io.records` picks and checks the columns.
 """
 
 from __future__ import annotations
@@ -20,8 +20,8 @@ from pathlib import Path
 
 import numpy as np
 
-from hystcomp._text import read_rows, sniff
 from hystcomp.errors import DataFileError
+from hystcomp.io._text import read_rows, sniff
 
 #: Longest time a MAT file may take to parse (s).
 MAT_TIMEOUT = 120.0

@@ -1,0 +1,618 @@
+"""Records (data files): measured records ``(t, v, x)``, inputs ``(t, v)`` and references ``(t, x)``.
+
+Formats, chosen by the file's suffix:
+
+* ``.npz`` (NumPy) and ``.mat`` (MATLAB, read with :func:`scipy.io.loadmat`): the names
+  ``t``, ``v``, ``x`` as keys or variables, or one matrix whose columns are numbered;
+* anything else (``.csv``, ``.dat``, ``.txt``, ...): a text table, with a header row
+  naming the columns (``t`` in s, ``v`` in V, ``x`` in µm; any case; extra columns are
+  ignored) or none. Separators, decimal commas, comment lines, ``# t,v,x`` headers and a
+  units row are recognised by the rules of :mod:`hystcomp.io._text`.
+
+Columns can be named explicitly: ``{"v": 1, "x": 5}`` (1-based column numbers, for text
+files and one-matrix files) or ``{"v": "volts", "x": "disp"}`` (header names or keys); on
+the command line ``--columns v=1,x=5``. A file without a time column needs the sample rate.
+Displacements in other units are converted with ``x_unit`` (``--x-unit``). A record has at
+most :data:`hystcomp.io._formats.MAX_SAMPLES` samples (``HYSTCOMP_MAX_SAMPLES``), checked
+before a large array is loaded. CSV is written in chunks with every value as its
+``repr``; writes go through :func:`hystcomp.io.atomic.atomic_path`: a failing write never
+truncates an existing file. See ``docs/data-files.md``.
+
+Files are untrusted input: every problem (not a regular file, not text, a corrupt archive,
+text or complex numbers in a column, NaN or inf, a value beyond
+:data:`~hystcomp._validation.MAX_MAGNITUDE`, a time column that does not increase) is a
+:class:`~hystcomp.errors.DataFileError` naming the file, the column and the fix. NPZ files
+are read without pickle. MAT files are parsed in a separate process, because scipy's MAT
+reader is not hardened against corrupt files (it can crash the interpreter); a crash there
+is reported as a corrupt file.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from io import BytesIO
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from hystcomp._validation import MAX_MAGNITUDE, as_path, as_signal, check_int, check_real
+from hystcomp.errors import DataFileError, InvalidParameterError, InvalidSignalError
+from hystcomp.io._formats import read_raw
+from hystcomp.io._text import UNITS, write_csv
+from hystcomp.io.atomic import atomic_path
+
+#: What each column holds, for messages.
+MEANINGS = {"t": "time in s", "v": "voltage in V", "x": "displacement in µm"}
+WRITABLE = (".csv", ".npz", ".mat")
+#: Largest relative disagreement between a time column and a given sample rate.
+RATE_TOLERANCE = 0.01
+#: Displacement units of ``x_unit`` / ``--x-unit``, converted to µm.
+X_UNITS = ("m", "mm", "um", "nm")
+#: Displacement spans (µm) below or above which :func:`x_unit_warning` suspects m or nm.
+SPAN_METRES = 0.01
+SPAN_NANOMETRES = 5000.0
+
+
+@dataclass(frozen=True, eq=False)
+class Record:
+    """A measured record: time (s), input voltage (V) and displacement (µm).
+
+    Attributes
+    ----------
+    t, v, x : ndarray
+        Read-only, finite, equally long; ``t`` strictly increasing.
+    source : str
+        Where it came from (a file name), for messages.
+
+    Examples
+    --------
+    >>> rec = Record(np.arange(4) / 200.0, np.array([0.0, 1, 2, 1]), np.array([0.0, 2, 4, 3]))
+    >>> rec.sample_rate, len(rec)
+    (200.0, 4)
+    """
+
+    t: np.ndarray
+    v: np.ndarray
+    x: np.ndarray
+    source: str = "record"
+
+    def __post_init__(self):
+        arrays = {}
+        for key in ("t", "v", "x"):
+            try:
+                arr = as_signal(getattr(self, key), key, min_samples=1)
+            except InvalidSignalError as exc:
+                raise InvalidSignalError(f"Record {key!r}: {exc}") from None
+            arr = np.array(arr)  # an own, read-only copy
+            arr.setflags(write=False)
+            arrays[key] = arr
+        if len({arr.size for arr in arrays.values()}) > 1:
+            raise InvalidSignalError(
+                "Record: 't', 'v' and 'x' must have one sample each per instant. Got "
+                f"{', '.join(f'{k}: {a.size}' for k, a in arrays.items())} samples."
+            )
+        if not np.all(np.diff(arrays["t"]) > 0):
+            raise InvalidSignalError("Record: the time 't' must be strictly increasing.")
+        for key, arr in arrays.items():
+            object.__setattr__(self, key, arr)
+
+    def __len__(self) -> int:
+        return int(self.t.size)
+
+    @property
+    def sample_rate(self) -> float:
+        """Samples per second (from the median time step), Hz."""
+        return rate_of(self.t)
+
+    def to_frame(self):
+        """The record as a ``pandas.DataFrame`` with columns ``t`` (s), ``v`` (V), ``x`` (µm).
+
+        pandas is optional (``pip install "hystcomp[pandas]"``); the frame holds copies, and
+        its columns go back into ``fit``, ``simulate`` or ``score`` as they are.
+        """
+        try:
+            import pandas as pd
+        except ImportError:
+            raise ImportError(
+                "Record.to_frame needs pandas, an optional dependency. Install it with: "
+                "pip install 'hystcomp[pandas]' (or pip install pandas)."
+            ) from None
+        frame = pd.DataFrame({"t": self.t.copy(), "v": self.v.copy(), "x": self.x.copy()})
+        frame.attrs["source"] = self.source
+        return frame
+
+
+def rate_of(t) -> float:
+    """Sample rate in Hz of strictly increasing times ``t`` (s), from the median step."""
+    t = as_signal(t, "t", min_samples=2)
+    with np.errstate(over="ignore", divide="ignore"):
+        return float(1.0 / np.median(np.diff(t)))
+
+
+def parse_columns(text: str | None) -> dict[str, int | str] | None:
+    """Parse a column mapping such as ``"v=1,x=5"`` or ``"v=volts,x=disp"``.
+
+    Numbers are 1-based column numbers; anything else is a column name.
+
+    Examples
+    --------
+    >>> parse_columns("v=1, x=5")
+    {'v': 1, 'x': 5}
+    >>> parse_columns("t=time,v=volts")
+    {'t': 'time', 'v': 'volts'}
+    """
+    if text is None:
+        return None
+    if not isinstance(text, str):
+        raise InvalidParameterError(
+            f"The 'columns' option must be text such as v=1,x=5. Got {type(text).__name__}."
+        )
+    mapping: dict[str, int | str] = {}
+    for item in text.split(","):
+        key, sep, value = (part.strip() for part in item.partition("="))
+        if not sep or key not in ("t", "v", "x") or not value or key in mapping:
+            raise InvalidParameterError(
+                "The 'columns' option must look like v=1,x=5 (1-based column numbers) or "
+                "v=volts,x=disp (header names), each of t, v, x at most once. "
+                f"Got {text!r} instead."
+            )
+        if value.isascii() and value.isdigit():
+            if int(value) < 1:
+                raise InvalidParameterError(
+                    f"Column numbers in 'columns' start at 1. Got {key}={value} in {text!r}."
+                )
+            mapping[key] = int(value)
+        else:
+            mapping[key] = value
+    _distinct(mapping, f"The 'columns' option {text!r}")
+    return mapping
+
+
+def _distinct(mapping: dict, what: str) -> None:
+    """Refuse one column named for two of t, v, x (``v=1,x=1``)."""
+    seen: dict = {}
+    for key, spec in mapping.items():
+        ident = spec.casefold() if isinstance(spec, str) else spec
+        if ident in seen:
+            raise InvalidParameterError(
+                f"{what} names column {spec!r} for both {seen[ident]!r} and {key!r}; each of "
+                "t, v, x needs its own column."
+            )
+        seen[ident] = key
+
+
+def _check_columns(columns) -> dict:
+    """A column mapping {key: 1-based number or name}, keys among t, v, x."""
+    if columns is not None and not isinstance(columns, dict):
+        raise InvalidParameterError(
+            "The 'columns' parameter of read_table must be a dict such as {'v': 1, 'x': 5}. "
+            f"Got {type(columns).__name__}."
+        )
+    columns = dict(columns or {})
+    for key, spec in columns.items():
+        number = isinstance(spec, int) and not isinstance(spec, bool) and spec >= 1
+        if key not in MEANINGS or not (number or (isinstance(spec, str) and spec)):
+            raise InvalidParameterError(
+                "The 'columns' parameter of read_table must map 't', 'v' or 'x' to a "
+                f"1-based column number or a column name. Got {key!r}: {spec!r}."
+            )
+    _distinct(columns, "The 'columns' parameter of read_table")
+    return columns
+
+
+def _find(path: Path, names, label: str) -> int | None:
+    """The index of the column named ``label``: exactly, else in any case; None if absent."""
+    exact = [i for i, name in enumerate(names) if name == label]
+    if len(exact) == 1:
+        return exact[0]
+    folded = [i for i, name in enumerate(names) if str(name).casefold() == label.casefold()]
+    if len(exact) > 1 or len(folded) > 1:
+        found = ", ".join(repr(names[i]) for i in (exact if len(exact) > 1 else folded))
+        raise DataFileError(
+            f"Data file {str(path)!r} has {len(exact) or len(folded)} columns named like "
+            f"{label!r} ({found}), so which one is meant is unclear. Rename them apart in "
+            "the file, or name the right one by number, e.g. --columns x=3."
+        )
+    return folded[0] if folded else None
+
+
+def _pick(path: Path, raw: _Raw, key: str, spec, required: bool):
+    """The column for ``key`` (``None`` if absent and not required) and its label."""
+    where = f"Data file {str(path)!r}"
+    names, arrays = raw.names, raw.arrays
+    if isinstance(spec, int):
+        if not raw.positional:
+            raise DataFileError(
+                f"{where} has named arrays ({', '.join(names or []) or 'none'}), not numbered "
+                f"columns: name the array for {key!r} instead of {spec} (for example "
+                f"{key}={names[0] if names else 'NAME'})."
+            )
+        if spec > len(arrays):
+            raise DataFileError(
+                f"{where} has {len(arrays)} columns; column {spec} for {key!r} does not exist."
+            )
+        return spec - 1, f"column {spec}"
+    if names is None:
+        if spec is None and not required:
+            return None, ""
+        raise DataFileError(
+            f"{where} {raw.nameless}, so its columns have no names: say which column "
+            f"holds {key!r} ({MEANINGS[key]}), e.g. --columns {raw.example} on the command "
+            "line (columns={'v': 1, 'x': 2} in Python; 1-based)."
+        )
+    label = spec if spec is not None else key
+    index = _find(path, names, label)
+    if index is None:
+        if not required and spec is None:
+            return None, ""
+        raise DataFileError(
+            f"{where} has no column {label!r} for {key!r} ({MEANINGS[key]}); its columns "
+            f"are {', '.join(map(str, names))}. Name the right one, e.g. --columns {key}=NAME."
+        )
+    return index, f"column {names[index]!r}"
+
+
+@dataclass
+class _Raw:
+    """What a file holds: column names (None: numbered only), arrays, units (None: unknown)."""
+
+    names: list | None
+    arrays: list
+    positional: bool
+    units: list | None
+    nameless: str = "has no header row"
+    example: str = "v=1,x=2"
+
+
+def _raw(path: Path, columns: dict, keys, progress) -> _Raw:
+    """Read the file; a NPZ/MAT file of one matrix becomes numbered columns."""
+    names, arrays, positional, units = read_raw(path, progress)
+    raw = _Raw(names, arrays, positional, units)
+    if positional and names is not None:
+        folded = [str(name).casefold() for name in names]
+        twice = sorted({name for name in names if folded.count(str(name).casefold()) > 1})
+        if twice:
+            raise DataFileError(
+                f"Data file {str(path)!r} names more than one column {' and '.join(twice)} in "
+                "its header row, so which one is meant is unclear. Give each column its own "
+                "name."
+            )
+    matrices = [
+        (name, arr)
+        for name, arr in zip(names or (), arrays, strict=False)
+        if arr.dtype.kind in "iuf" and arr.ndim == 2 and min(arr.shape) >= 2
+    ]
+    named = {str(name).casefold() for name in names or ()} & {"t", *keys}
+    numbered = any(isinstance(spec, int) for spec in columns.values())
+    if not positional and len(matrices) == 1 and (numbered or not named):
+        name, matrix = matrices[0]
+        if matrix.shape[0] < matrix.shape[1]:
+            matrix = matrix.T  # samples along the longer side
+        raw = _Raw(None, list(np.asarray(matrix).T), True, None)
+        raw.nameless = f"holds one matrix {name!r} ({matrix.shape[0]} x {matrix.shape[1]})"
+        raw.example = ",".join(f"{k}={i}" for i, k in enumerate(("t", *keys), 1))
+    return raw
+
+
+def _units(path: Path, raw: _Raw, key: str, index: int | None, x_unit) -> float:
+    """The factor to s, V or µm of column ``index`` for ``key``, from its units row or
+    ``x_unit``."""
+    given = None if raw.units is None or index is None else raw.units[index]
+    if key == "x" and x_unit is not None:
+        if given and UNITS["x"].get(given.lower()) not in (None, UNITS["x"][x_unit]):
+            raise DataFileError(
+                f"The units row of {str(path)!r} says the displacement is in {given}, but "
+                f"--x-unit says {x_unit}. Drop --x-unit, or correct the units row."
+            )
+        return UNITS["x"][x_unit]
+    if not given:
+        return 1.0
+    factor = UNITS[key].get(given.lower())
+    if factor is None:
+        raise DataFileError(
+            f"The units row of {str(path)!r} gives {given!r} for {key!r} ({MEANINGS[key]}); "
+            f"known units are {', '.join(UNITS[key])}. Convert the column, or correct the "
+            "unit in the file" + (", or give --x-unit." if key == "x" else ".")
+        )
+    return factor
+
+
+def _as_column(arr, path: Path, key: str, label: str) -> np.ndarray:
+    what = f"The {label} of {str(path)!r} ({key!r}, {MEANINGS[key]})"
+    arr = np.asarray(arr)
+    if arr.dtype.kind == "c":
+        raise DataFileError(f"{what} holds complex numbers; save the real part only.")
+    if arr.dtype.kind not in "iuf":
+        raise DataFileError(f"{what} does not hold numbers (it holds {arr.dtype} values).")
+    out = np.asarray(arr, dtype=np.float64)
+    if out.ndim > 1 and sorted(out.shape)[-2] == 1:
+        out = out.reshape(-1)
+    if out.ndim != 1:
+        raise DataFileError(
+            f"{what} has shape {out.shape}; expected one value per sample (a vector)."
+        )
+    bad = np.flatnonzero(~np.isfinite(out))
+    if bad.size:
+        raise DataFileError(
+            f"{what} has a non-finite value ({float(out[bad[0]])!r}) in data row "
+            f"{bad[0] + 1}: remove or interpolate that row."
+        )
+    if key != "t":
+        big = np.flatnonzero(np.abs(out) > MAX_MAGNITUDE)
+        if big.size:
+            raise DataFileError(
+                f"{what} has the value {float(out[big[0]]):.6g} in data row {big[0] + 1}, "
+                f"beyond {MAX_MAGNITUDE:g}: check the units and the column."
+            )
+    return out
+
+
+def read_table(
+    path,
+    keys=("v", "x"),
+    *,
+    columns=None,
+    sample_rate=None,
+    min_samples=2,
+    x_unit=None,
+    progress=None,
+):
+    """Read time and the columns ``keys`` from a data file, validated.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The data file (``.csv``, ``.npz``, ``.mat`` or a text table; see the module's notes
+        and :mod:`hystcomp.io._text` for the text layouts understood).
+    keys : sequence of str
+        The columns needed besides time, among ``"v"`` and ``"x"``.
+    columns : dict, optional
+        Which column holds which key: 1-based numbers (text files, or the columns of the one
+        matrix of an NPZ/MAT file) or names. By default each key is the column of the same
+        name, in any case (``T``, ``V``, ``X`` do).
+    sample_rate : float, optional
+        Samples per second (Hz). Needed when the file has no time column ``t``; if both are
+        given they must agree within 1 %.
+    min_samples : int, default 2
+        Fewest samples accepted.
+    x_unit : {"m", "mm", "um", "nm"}, optional
+        The unit of the displacement in the file; it is converted to µm. By default that of
+        the file's units row, else µm.
+    progress : callable, optional
+        Called with the fraction read so far (0..1), for a progress line.
+
+    Returns
+    -------
+    dict of str to ndarray
+        ``"t"`` and each of ``keys``: read-only, finite, equally long; ``t`` strictly
+        increasing.
+
+    Raises
+    ------
+    DataFileError
+        Naming the file, the column, the problem and the fix.
+    """
+    path = as_path(path, "path", "read_table")
+    keys = tuple(keys) if not isinstance(keys, str) else (keys,)
+    if not keys or any(key not in ("v", "x") for key in keys) or len(set(keys)) < len(keys):
+        raise InvalidParameterError(
+            f"The 'keys' parameter of read_table must name 'v' and/or 'x' once each. "
+            f"Got {keys!r} instead."
+        )
+    min_samples = check_int(min_samples, "min_samples", "read_table", minimum=1)
+    columns = _check_columns(columns)
+    if sample_rate is not None:
+        sample_rate = check_real(sample_rate, "sample_rate", "read_table", positive=True)
+    if x_unit is not None and x_unit not in X_UNITS:
+        raise InvalidParameterError(
+            f"The 'x_unit' parameter of read_table must be one of {', '.join(X_UNITS)}. "
+            f"Got {x_unit!r} instead."
+        )
+    try:
+        raw = _raw(path, columns, keys, progress)
+    finally:
+        if progress is not None:
+            progress(1.0)  # done, or failed: either way the progress line goes
+    out = {}
+    for key in ("t", *keys):
+        index, label = _pick(path, raw, key, columns.get(key), key != "t")
+        if index is not None:
+            arr = _as_column(raw.arrays[index], path, key, label)
+            factor = _units(path, raw, key, index, x_unit)
+            if factor != 1.0:
+                arr = _as_column(arr * factor, path, key, f"{label} (in {MEANINGS[key]})")
+            out[key] = arr
+    raw = None  # the other columns are no longer needed
+    lengths = {key: arr.size for key, arr in out.items()}
+    if len(set(lengths.values())) > 1:
+        raise DataFileError(
+            f"Data file {str(path)!r} has columns of different lengths ({lengths}); "
+            "every column must hold one value per sample."
+        )
+    n = next(iter(lengths.values()))
+    if n < min_samples:
+        raise DataFileError(
+            f"Data file {str(path)!r} has {n} samples; at least {min_samples} are needed."
+        )
+    out["t"] = _time(path, out.get("t"), n, sample_rate)
+    for arr in out.values():
+        arr.setflags(write=False)
+    return {"t": out["t"], **{key: out[key] for key in keys}}
+
+
+def x_unit_warning(x, source: str) -> str | None:
+    """A warning if the span of displacements ``x`` (µm) looks like metres or nanometres.
+
+    A piezo actuator's stroke is between about 0.01 µm and a few mm: a span below
+    :data:`SPAN_METRES` µm is likely metres, one above :data:`SPAN_NANOMETRES` µm likely
+    nanometres (give ``--x-unit``). Returns the message, or None if the span is plausible.
+
+    Examples
+    --------
+    >>> x_unit_warning([0.0, 2e-5], "rec.csv")[:52]
+    'the displacement in rec.csv spans 2e-05 µm, which lo'
+    >>> x_unit_warning([0.0, 20.0], "rec.csv") is None
+    True
+    """
+    span = float(np.ptp(np.asarray(x, dtype=np.float64)))
+    for unit, looks in (("m", 0 < span < SPAN_METRES), ("nm", span > SPAN_NANOMETRES)):
+        if looks:
+            name = {"m": "metres", "nm": "nanometres"}[unit]
+            return (
+                f"the displacement in {source} spans {span:.4g} µm, which looks like {name} "
+                f"read as µm; if it is, give --x-unit {unit}."
+            )
+    return None
+
+
+def _time(path: Path, t, n: int, sample_rate):
+    if t is None:
+        if sample_rate is None:
+            raise DataFileError(
+                f"Data file {str(path)!r} has no time column 't': give the sample rate, "
+                "--fs HZ on the command line (sample_rate=HZ in Python)."
+            )
+        return np.arange(n) / sample_rate
+    with np.errstate(over="ignore", invalid="ignore"):
+        steps = np.diff(t)
+        span = t[-1] - t[0]
+    bad = np.flatnonzero(~(steps > 0))
+    if bad.size:
+        k = int(bad[0]) + 1
+        raise DataFileError(
+            f"The time column 't' of {str(path)!r} is not strictly increasing: data row "
+            f"{k + 1} has t = {float(t[k])!r} s after t = {float(t[k - 1])!r} s. Sort the "
+            "rows and remove duplicates, or drop the time column and give the sample rate "
+            "(--fs)."
+        )
+    rate = rate_of(t)
+    if not (np.isfinite(span) and 0.0 < rate < np.inf):
+        raise DataFileError(
+            f"The time column 't' of {str(path)!r} spans {float(t[0])!r} to {float(t[-1])!r} s, "
+            "which gives no usable sample rate. Check the units of the time column, or drop "
+            "it and give the sample rate (--fs)."
+        )
+    if sample_rate is not None and abs(rate - sample_rate) > RATE_TOLERANCE * sample_rate:
+        raise DataFileError(
+            f"The time column 't' of {str(path)!r} says {rate:.6g} Hz but the sample rate "
+            f"given is {sample_rate:.6g} Hz. Give one of them, not both."
+        )
+    return t
+
+
+def read_record(path, *, columns=None, sample_rate=None, x_unit=None, progress=None) -> Record:
+    """Read an identification record ``(t, v, x)`` and check that its input varies.
+
+    Parameters are those of :func:`read_table`.
+
+    Returns
+    -------
+    Record
+    """
+    table = read_table(
+        path,
+        ("v", "x"),
+        columns=columns,
+        sample_rate=sample_rate,
+        x_unit=x_unit,
+        progress=progress,
+    )
+    v = table["v"]
+    if np.ptp(v) <= 0:
+        raise DataFileError(
+            f"The voltage column 'v' of {str(path)!r} is constant ({float(v[0])!r} V): an "
+            "identification record needs an input that sweeps the actuator's range "
+            "(see 'hystcomp excite'). Check that the right column is named."
+        )
+    return Record(table["t"], v, table["x"], source=str(path))
+
+
+def _columns(table, owner: str) -> dict[str, np.ndarray]:
+    """Column name (an ASCII identifier) to a 1-D float64 array, validated."""
+    if not isinstance(table, dict) or not table:
+        raise InvalidParameterError(
+            f"The 'table' parameter of {owner} must be a non-empty dict of column name to "
+            f"values. Got {type(table).__name__}."
+        )
+    cols = {}
+    for name, values in table.items():
+        if not (isinstance(name, str) and name.isidentifier() and name.isascii()):
+            raise InvalidParameterError(
+                f"Column names of {owner} must be ASCII identifiers such as 'x_ref'. Got {name!r}."
+            )
+        try:
+            cols[name] = np.asarray(values, dtype=np.float64).reshape(-1)
+        except (TypeError, ValueError, OverflowError):
+            raise InvalidParameterError(
+                f"Column {name!r} of {owner} does not hold numbers."
+            ) from None
+    return cols
+
+
+def format_csv(table: dict) -> str:
+    """A table of equally long columns as CSV text with a header row (shortest round-trip)."""
+    cols = _columns(table, "format_csv")
+    if len({c.size for c in cols.values()}) != 1:
+        raise InvalidParameterError("The columns given to format_csv have different lengths.")
+    buffer = BytesIO()
+    write_csv(buffer, cols)
+    return buffer.getvalue().decode()
+
+
+def check_writable(path) -> Path:
+    """``path`` as a Path if :func:`write_table` can write its format, else raise.
+
+    Raises
+    ------
+    DataFileError
+        If the suffix is not one of ``.csv``, ``.npz``, ``.mat``.
+    """
+    path = as_path(path, "path", "write_table")
+    suffix = path.suffix.lower()
+    if suffix not in WRITABLE:
+        raise DataFileError(
+            f"Cannot write {str(path)!r}: unknown format {suffix or '(no suffix)'!r}. "
+            f"Use a name ending in {', '.join(WRITABLE)}."
+        )
+    return path
+
+
+def write_table(path, table: dict, *, progress=None) -> None:
+    """Write equally long columns to ``path`` as CSV, NPZ or MAT (by suffix), atomically.
+
+    CSV is written in chunks of rows, each value as its shortest round-trip text
+    (``repr``), so memory stays bounded whatever the length and the file reads back
+    bit for bit.
+
+    Parameters
+    ----------
+    path : str or path-like
+        Output file ending in ``.csv``, ``.npz`` or ``.mat``.
+    table : dict of str to array_like
+        Column name to values, e.g. ``{"t": t, "v": v, "x": x}``.
+    progress : callable, optional
+        Called with the fraction written so far (0..1), for a progress line (CSV).
+    """
+    path = check_writable(path)
+    suffix = path.suffix.lower()
+    cols = _columns(table, "write_table")
+    lengths = {k: v.size for k, v in cols.items()}
+    if len(set(lengths.values())) != 1:
+        raise DataFileError(
+            f"Cannot write {str(path)!r}: the columns have different lengths ({lengths})."
+        )
+    with atomic_path(path) as tmp, tmp.open("wb") as file:
+        if suffix == ".csv":
+            try:
+                write_csv(file, cols, progress)
+            finally:
+                if progress is not None:
+                    progress(1.0)
+        elif suffix == ".npz":
+            arrays: dict[str, Any] = cols  # (savez types its **kwds as bool, for allow_pickle)
+            np.savez(file, **arrays)
+        else:
+            import scipy.io  # only MAT output needs it
+
+            scipy.io.savemat(file, {k: v.reshape(-1, 1) for k, v in cols.items()})
