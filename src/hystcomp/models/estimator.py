@@ -10,7 +10,7 @@ elsewhere (:class:`~hystcomp.models.system.PackedSystem`).
 from __future__ import annotations
 
 import inspect
-from typing import Any, ClassVar, Self
+from typing import TYPE_CHECKING, Any, ClassVar, Self
 
 import numpy as np
 
@@ -39,12 +39,12 @@ class Estimator:
     _learned: ClassVar[tuple[str, ...]]
     fit_report_: dict[str, Any]
 
-    def simulate(self, v) -> np.ndarray:  # given by the subclass (its system's run)
-        raise NotImplementedError
+    if TYPE_CHECKING:  # what every subclass gives (declared for the type checker only)
 
-    @classmethod
-    def from_parameters(cls, *args: Any, **parameters: Any) -> Self:  # given by the subclass
-        raise NotImplementedError
+        def simulate(self, v) -> np.ndarray: ...  # its system's run
+
+        @classmethod
+        def from_parameters(cls, *args: Any, **parameters: Any) -> Self: ...
 
     @classmethod
     def _get_param_names(cls) -> tuple[str, ...]:
