@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-from tests.test_codegen import CC, STRICT, needs_cc
+from tests.codegen.test_codegen import CC, STRICT, needs_cc
 
 DOC = Path(__file__).parent.parent / "docs" / "c-export.md"
 BLOCK = re.compile(r"^```(\w*)\n(.*?)^```$", re.DOTALL | re.MULTILINE)

@@ -24,7 +24,7 @@ from hystcomp.errors import OutputPathError
 from hystcomp.experiment import report
 from hystcomp.io.atomic import atomic_paths, replace_all
 from hystcomp.io.records import read_table, write_table
-from tests.test_codegen import CC, STRICT, needs_cc
+from tests.codegen.test_codegen import CC, STRICT, needs_cc
 
 
 def run(*args):

@@ -39,7 +39,7 @@ _LAZY = {
     "to_control": ("hystcomp.control", "to_control"),
 }
 
-__all__ = [  # written out for static tools; tests/test_cli_lazy.py checks it against _LAZY
+__all__ = [  # written out for static tools; tests/cli/test_cli_lazy.py checks it against _LAZY
     "Compensator",
     "LinearDynamics",
     "ModifiedPrandtlIshlinskii",

@@ -75,7 +75,7 @@ def paper_mpi_with(max_displacement: float) -> ModifiedPrandtlIshlinskii:
 
 #: The ``max{x_p}`` of eq. (17) behind the MPI preset, in µm: the fixed point ``M`` of
 #: ``M = max(paper MPI with M on paper_identification_triangle())`` (see the module
-#: docstring; ``tests/test_presets.py`` checks that it is one).
+#: docstring; ``tests/test_presets_and_files.py`` checks that it is one).
 PAPER_MPI_MAX_DISPLACEMENT = 35.886667354280206
 
 

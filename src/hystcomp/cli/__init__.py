@@ -62,7 +62,7 @@ def _one_line(text: str) -> str:
 
 #: Subcommand -> (its module, the first line of its help). A module is imported only when its
 #: command runs or shows its own help, so that ``hystcomp --help``, a mistyped command and
-#: shell completion load neither numba nor SciPy (tests/test_cli_lazy.py checks that this
+#: shell completion load neither numba nor SciPy (tests/cli/test_cli_lazy.py checks that this
 #: table matches the commands).
 COMMANDS = {
     "calibrate": (

@@ -11,8 +11,8 @@ from click.testing import CliRunner
 import hystcomp
 from hystcomp.cli import main
 from hystcomp.io.records import read_table, write_table
+from tests.codegen.test_codegen import build_preisach, needs_cc
 from tests.conftest import random_walk
-from tests.test_codegen import build_preisach, needs_cc
 
 
 @pytest.fixture

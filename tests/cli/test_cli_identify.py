@@ -19,7 +19,7 @@ from hystcomp.io.records import read_record, read_table, write_table
 from hystcomp.plant import Twin
 
 # A real record (MIT licence, see the README and LICENSE beside it).
-REAL_RECORD = Path(__file__).parent / "data" / "piezo-micromanipulator" / "Model_Vi_Do.dat"
+REAL_RECORD = Path(__file__).parents[1] / "data" / "piezo-micromanipulator" / "Model_Vi_Do.dat"
 
 
 def run(*args):

@@ -10,7 +10,7 @@ import hystcomp
 from hystcomp import presets
 from hystcomp.identify.excitation import triangle_sequence
 from hystcomp.io.records import read_table, write_table
-from tests.test_cli_identify import REAL_RECORD, assert_one_line_error, run
+from tests.cli.test_cli_identify import REAL_RECORD, assert_one_line_error, run
 
 
 def test_the_real_record_predicts_its_second_half_far_better_than_a_line(tmp_path):

@@ -17,7 +17,7 @@ from hystcomp.identify.scoring import holdout_report, thin, transient_end
 from hystcomp.io.records import read_record, read_table, write_table
 from hystcomp.plant import Twin
 
-REAL_RECORD = Path(__file__).parent / "data" / "piezo-micromanipulator" / "Model_Vi_Do.dat"
+REAL_RECORD = Path(__file__).parents[1] / "data" / "piezo-micromanipulator" / "Model_Vi_Do.dat"
 
 
 def run(*args):

@@ -17,8 +17,8 @@ from hystcomp.io.records import read_table, write_table
 from hystcomp.models.dynamic_compensator import MAX_PREVIEW
 from hystcomp.models.dynamics import DynamicCompensator, LinearDynamics
 from hystcomp.plant import Twin, creep_twin
+from tests.codegen.test_codegen import CC, _compile, _run_c, needs_cc
 from tests.conftest import random_walk
-from tests.test_codegen import CC, _compile, _run_c, needs_cc
 
 FS = 20_000.0
 

@@ -13,7 +13,7 @@ from hystcomp import presets
 from hystcomp.cli import main
 from hystcomp.identify.excitation import triangle_sequence
 from hystcomp.io.records import read_table, write_table
-from tests.test_codegen import CC, _compile, _run_c, needs_cc
+from tests.codegen.test_codegen import CC, _compile, _run_c, needs_cc
 
 COMPENSATORS = {
     "pi": (presets.paper_pi, {}),
@@ -114,7 +114,7 @@ def test_a_first_nan_in_c_holds_a_voltage_inside_a_narrowed_range(name, tmp_path
     comp = make().inverse(voltage_range=(10.0, 50.0), **options)
     drive = _compile(comp, tmp_path, "comp") if "preisach" not in name else None
     if drive is None:
-        from tests.test_codegen import _compile_preisach
+        from tests.codegen.test_codegen import _compile_preisach
 
         v, _depth, held = _compile_preisach(comp, tmp_path)(np.array([np.nan, np.nan, 5.0]))
     else:
