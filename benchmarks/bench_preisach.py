@@ -26,12 +26,17 @@ from __future__ import annotations
 import ctypes
 import shutil
 import subprocess
+import sys
 import tempfile
 import time
 from pathlib import Path
 
 import numba
 import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+
+from benchmarks.bench_realtime import best_of
 
 from hystcomp import presets
 from hystcomp._kernels import preisach as pk
@@ -121,16 +126,10 @@ def _exported_c(comp, tmp: Path):
 
 
 def _best_of(funcs: dict, repeat: int = REPEAT) -> dict:
-    """Shortest time in s of each callable, the rounds interleaved so that load hits all."""
+    """:func:`bench_realtime.best_of` after one call of each (compile, or load from the cache)."""
     for func in funcs.values():
-        func()  # compile, or load from the cache
-    best = dict.fromkeys(funcs, np.inf)
-    for _ in range(repeat):
-        for name, func in funcs.items():
-            start = time.perf_counter()
-            func()
-            best[name] = min(best[name], time.perf_counter() - start)
-    return best
+        func()
+    return best_of(funcs, repeat)
 
 
 def _stepper_rows(model, v: np.ndarray, x_ref: np.ndarray) -> list[dict]:
