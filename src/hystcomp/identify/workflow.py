@@ -7,6 +7,9 @@ estimates the compensator's tracking error (:mod:`hystcomp.identify.compensation
 returns all of it with the report lines and the warnings in an
 :class:`IdentificationResult`. :func:`identify_dynamics_record` does the same for the linear
 dynamics (beyond the paper). Neither prints nor writes anything.
+
+It is the one module of :mod:`hystcomp.identify` that sits above the models: it builds them,
+while the models' ``fit`` methods delegate to the array-level fits of the other modules here.
 """
 
 from __future__ import annotations
@@ -14,7 +17,6 @@ from __future__ import annotations
 import contextlib
 import numbers
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -22,9 +24,10 @@ from hystcomp import paper
 from hystcomp.errors import IdentificationError, InvalidParameterError, InvalidTypeError
 from hystcomp.identify.compensation import compensation_error
 from hystcomp.identify.scoring import error_report, holdout_report, transient_end
-
-if TYPE_CHECKING:  # the models import this layer; at run time they are imported where used
-    from hystcomp.models.dynamics import LinearDynamics
+from hystcomp.models.dynamics import LinearDynamics
+from hystcomp.models.mpi import ModifiedPrandtlIshlinskii
+from hystcomp.models.pi import PrandtlIshlinskii
+from hystcomp.models.preisach import Preisach
 
 __all__ = [
     "DynamicsResult",
@@ -48,23 +51,16 @@ SIZE_OPTIONS = {
     "dynamics": (),
 }
 
+#: The estimator class of each hysteresis model kind.
+ESTIMATORS = {"pi": PrandtlIshlinskii, "mpi": ModifiedPrandtlIshlinskii, "preisach": Preisach}
+
 _OWNER = "identify_record"
 
 
 def _estimator_class(kind: str):
-    """The estimator class of a hysteresis model kind (imported here: models import this layer)."""
-    if kind == "pi":
-        from hystcomp.models.pi import PrandtlIshlinskii
-
-        return PrandtlIshlinskii
-    if kind == "mpi":
-        from hystcomp.models.mpi import ModifiedPrandtlIshlinskii
-
-        return ModifiedPrandtlIshlinskii
-    if kind == "preisach":
-        from hystcomp.models.preisach import Preisach
-
-        return Preisach
+    """The estimator class of a hysteresis model kind."""
+    if kind in ESTIMATORS:
+        return ESTIMATORS[kind]
     raise InvalidParameterError(
         f"The 'kind' argument of {_OWNER} must be 'pi', 'mpi' or 'preisach'; got {kind!r}. "
         "Linear dynamics are fitted by hystcomp.models.dynamics.LinearDynamics().fit."
@@ -509,8 +505,6 @@ def identify_dynamics_record(record) -> DynamicsResult:
     DynamicsResult
         The fitted model and the report lines (resonance in Hz, creep in %, fit errors).
     """
-    from hystcomp.models.dynamics import LinearDynamics
-
     for name in ("t", "v", "x", "source", "sample_rate"):
         if not hasattr(record, name):
             raise InvalidTypeError(
