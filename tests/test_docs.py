@@ -10,6 +10,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -74,3 +75,18 @@ def test_closed_loop_example_quick(tmp_path, capsys):
     assert rows["both"][0] < rows["feedforward"][0]
     assert (tmp_path / "closed_loop_feedforward.png").stat().st_size > 10_000
     assert "feedforward cuts the loop's rms error" in capsys.readouterr().out
+
+
+@pytest.mark.skipif(shutil.which("cc") is None, reason="no C compiler 'cc' on this machine")
+@pytest.mark.parametrize("model", ["mpi", "preisach"])
+def test_record_to_c_example(tmp_path, capsys, model):
+    module = runpy.run_path(str(ROOT / "examples" / "record_to_c.py"))
+    found = module["main"](["--model", model, "--out", str(tmp_path)])
+    # the compiled C follows the Python stepper to rounding, inside the record's voltage range
+    assert found["difference"] < 1e-12
+    assert found["v_c"].min() >= 0.0
+    assert found["v_c"].max() <= 3.6
+    assert np.ptp(found["v_c"]) > 2.0  # it really drives the stage over most of its range
+    assert found["result"].holdout["improvement"] > 5  # the hold-out beats a straight line
+    assert sorted(p.name for p in (tmp_path / "c").glob("stage.*")) == ["stage.c", "stage.h"]
+    assert "largest difference" in capsys.readouterr().out
