@@ -1,4 +1,6 @@
-"""Compiled kernel of the inverse of the linear dynamics: one step, and a batch loop over it.
+"""Compiled kernels of the linear dynamics: the inverse (one step, and a batch loop over it)
+and the two stages of the forward model (a creep lag, the resonance) that
+:mod:`hystcomp._lti` runs for the model's output and its identification.
 
 The inverse filter (see :mod:`hystcomp.models.dynamics`) is a FIR stage (non-negative taps
 fitted so that the resonance times them is close to 1 in the band) in series with the
@@ -71,3 +73,35 @@ def inverse_run(p, u, out):
     """Run :func:`inverse_step` over every sample of ``u`` (state kept in ``p``)."""
     for k in range(u.size):
         out[k] = inverse_step(p, u[k])
+
+
+@kernel
+def lag_run(a, u, out):
+    """A first-order lag of unit gain from rest at 0: ``y[k] = a y[k-1] + (1 - a) u[k]``.
+
+    One creep mode of the forward model (``lfilter([1 - a], [1, -a], u)``).
+    """
+    y = 0.0
+    for k in range(u.size):
+        y = a * y + (1.0 - a) * u[k]
+        out[k] = y
+
+
+@kernel
+def resonance_run(b, a, u, out):
+    """``R(z) = (b0 z^-1 + b1 z^-2) / (1 + a1 z^-1 + a2 z^-2)`` from rest at 0.
+
+    The resonance of the forward model (``lfilter([0, b0, b1], a, u)``): the output of
+    sample ``k`` is the position before the input of sample ``k`` acts.
+    """
+    u1 = 0.0
+    u2 = 0.0
+    y1 = 0.0
+    y2 = 0.0
+    for k in range(u.size):
+        y = b[0] * u1 + b[1] * u2 - a[1] * y1 - a[2] * y2
+        out[k] = y
+        y2 = y1
+        y1 = y
+        u2 = u1
+        u1 = u[k]
