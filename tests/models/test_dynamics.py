@@ -375,43 +375,6 @@ def test_twin_creep_rises_about_equally_per_decade():
     assert np.all((0.003 < per_decade) & (per_decade < 0.006))  # 0.5 % a decade, +-40 %
 
 
-def test_nnls_agrees_with_scipy():
-    from scipy.optimize import nnls as scipy_nnls
-
-    from hystcomp._lti import nnls
-
-    rng = np.random.default_rng(3)
-    for m, n in [(40, 5), (200, 12), (30, 30)]:
-        a = rng.standard_normal((m, n))
-        b = rng.standard_normal(m)
-        x = nnls(a, b)
-        expected = scipy_nnls(a, b)[0]
-        assert np.all(x >= 0.0)
-        np.testing.assert_allclose(x, expected, atol=1e-9)
-        # the optimality (KKT) conditions: no descent direction into the feasible set
-        gradient = a.T @ (a @ x - b)
-        assert np.all(gradient > -1e-8)
-        assert np.abs(gradient[x > 0]).max() < 1e-8
-
-
-def test_least_squares_finds_a_nonlinear_minimum_and_keeps_to_its_bounds():
-    from hystcomp._lti import least_squares
-
-    t = np.linspace(0.0, 0.01, 400)
-    true = np.array([780.0, 0.05])
-
-    def ringing(theta):
-        fn, zeta = theta
-        w = 2 * np.pi * fn
-        return np.exp(-zeta * w * t) * np.cos(w * np.sqrt(1 - zeta**2) * t)
-
-    target = ringing(true)
-    fit = least_squares(lambda th: ringing(th) - target, [760.0, 0.08], [1.0, 1e-3], [2e3, 0.5])
-    np.testing.assert_allclose(fit, true, rtol=1e-8)
-    bounded = least_squares(lambda th: ringing(th) - target, [760.0, 0.08], [1.0, 0.06], [2e3, 0.5])
-    assert bounded[1] == 0.06
-
-
 def test_forward_filters_match_lfilter():
     from scipy.signal import lfilter
 
@@ -428,8 +391,8 @@ def test_forward_filters_match_lfilter():
     )
 
 
-def test_identification_imports_neither_scipy_optimize_nor_signal():
-    """Their import alone took 1.5-2 s in ``hystcomp compare``, twenty times the fit."""
+def test_identification_does_not_import_scipy_signal():
+    """Its import alone took about 1 s of CPU in ``hystcomp compare``, ten times the fit."""
     import subprocess
     import sys
 
@@ -441,7 +404,7 @@ def test_identification_imports_neither_scipy_optimize_nor_signal():
         " damping_ratio=0.1, creep_time_constants=[0.01, 1.0], creep_weights=[0.01, 0.01])\n"
         "fit = hystcomp.LinearDynamics().fit(v, dyn.simulate(v), 5000.0)\n"
         "fit.inverse().simulate(v[:100])\n"
-        "print(sorted(m for m in ('scipy.optimize', 'scipy.signal') if m in sys.modules))\n"
+        "print('scipy.signal' in sys.modules)\n"
     )
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
-    assert done.stdout.strip() == "[]"
+    assert done.stdout.strip() == "False"

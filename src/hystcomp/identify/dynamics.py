@@ -5,19 +5,18 @@ dynamics``), which has three parts::
 
     rest at v_min (REST s) | step to the bias, held HOLD s | multisine around the bias, PERIODS x 1 s
 
-The fit, in four short stages (about 0.1 s for a 20 kHz record, with no import of
-``scipy.optimize`` or ``scipy.signal``, which alone took 1.5-2 s):
+The fit, in four short stages (about 0.1 s for a 20 kHz record):
 
 1. The frequency response ``X(f) / V(f)`` at the multisine's lines, from the average of
    its periods after the first; the resonance ``(f_n, zeta)`` of
    :class:`~hystcomp.LinearDynamics` fitted to the lines above 20 Hz by nonlinear least
-   squares (Levenberg-Marquardt, :func:`hystcomp._lti.least_squares`), with the local gain
-   of the hysteresis around the bias a free *complex* factor: the minor loops of a rate-independent
+   squares (``scipy.optimize.least_squares``), with the local gain of the hysteresis around
+   the bias a free *complex* factor: the minor loops of a rate-independent
    hysteresis lag the input by the same phase at every frequency, and that lag belongs to
    the hysteresis inverse, not to ``D``.
 2. The creep from the step and hold: with the resonance known, the step response is linear
    in the weights of creep modes with time constants fixed on a log grid (two per decade
-   from 1 ms to the hold's length); non-negative least squares (:func:`hystcomp._lti.nnls`).
+   from 1 ms to the hold's length); non-negative least squares (``scipy.optimize.nnls``).
 3. The multisine part again, with the step's continuing creep removed, and the resonance
    fitted again with the creep in the model.
 4. The fit report: fit % and largest magnitude error in the frequency domain up to twice
@@ -44,8 +43,6 @@ from hystcomp._lti import (
     creep_response,
     frequency_response,
     lag,
-    least_squares,
-    nnls,
     output,
     resonance,
     resonance_response,
@@ -228,6 +225,8 @@ def _frf(v, x, start, n_period, periods, bins) -> np.ndarray:
 
 def _fit_resonance(measured, lines, fs, lags, weights, guess):
     """``(f_n, zeta)`` of the resonance, the local gain eliminated (relative complex error)."""
+    from scipy.optimize import least_squares
+
     use = lines >= FIT_FROM_HZ
     f, g = lines[use], measured[use]
     z1 = np.exp(-2j * np.pi * f / fs)
@@ -247,12 +246,15 @@ def _fit_resonance(measured, lines, fs, lags, weights, guess):
     theta0 = np.log(np.asarray(guess, dtype=np.float64))
     bounds = (np.log([1.0, 1e-4]), np.log([0.45 * fs, 2.0]))
     theta0 = np.clip(theta0, bounds[0] + 1e-9, bounds[1] - 1e-9)
-    fn, zeta = np.exp(least_squares(residual, theta0, *bounds))
+    result = least_squares(residual, theta0, bounds=bounds, x_scale=1.0)
+    fn, zeta = np.exp(result.x)
     return float(fn), float(zeta)
 
 
 def _fit_creep(rise, fn, zeta, fs, lags):
     """Non-negative creep weights and the step's final height from the step response."""
+    from scipy.optimize import nnls
+
     # the ringing is left out: a slightly wrong resonance there would outweigh the creep
     start = min(rise.size // 2, round(RINGING_DECAYS * fs / (2.0 * np.pi * fn * zeta)))
     # samples spaced evenly in log time: each decade of creep weighs the same, and it is fast
@@ -260,7 +262,7 @@ def _fit_creep(rise, fn, zeta, fs, lags):
     ba = resonance_zoh(fn, zeta, fs)
     unit = np.ones(rise.size)
     columns = [resonance(ba, unit)[rows]] + [resonance(ba, lag(a, unit))[rows] for a in lags]
-    coef = nnls(np.column_stack(columns), rise[rows])
+    coef, _ = nnls(np.column_stack(columns), rise[rows])
     if not coef[0] > 0:
         raise IdentificationError(
             "The step of the record gives no displacement: check that x answers v, and "

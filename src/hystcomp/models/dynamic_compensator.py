@@ -16,7 +16,6 @@ import numpy as np
 
 from hystcomp._kernels import dynamics as dk
 from hystcomp._kernels._jit import step_function
-from hystcomp._lti import nnls
 from hystcomp._validation import as_signal, check_int
 from hystcomp.errors import InvalidTypeError
 
@@ -37,7 +36,7 @@ def inverse_fir(resonance, bandwidth_hz: float, sample_rate: float):
     The taps ``g_j >= 0`` (summing to 1) of ``G(z) = sum_j g_j z^(P - j)``, ``P`` the
     half length, that bring ``R(z) G(z)`` closest to 1 on ``0 .. bandwidth_hz``, in least
     squares weighted by ``1 / (1 + (f / 0.3 bandwidth_hz)^2)`` (a triangle's harmonics fall
-    as ``1 / f^2``): :func:`hystcomp._lti.nnls` on the real and imaginary parts, the sum
+    as ``1 / f^2``): :func:`scipy.optimize.nnls` on the real and imaginary parts, the sum
     as a heavily weighted row. ``R(z)`` is the resonance with its sampling zero, fitted as
     it is (nothing is inverted, so a zero beyond ``-1`` is no matter).
 
@@ -49,6 +48,8 @@ def inverse_fir(resonance, bandwidth_hz: float, sample_rate: float):
     span; zero taps at the ends are dropped, and the preview is the look-ahead of the
     first tap left.
     """
+    from scipy.optimize import nnls
+
     b, a = resonance
     fn = _resonance_hz(a, sample_rate)
     half = min(max(2, math.ceil(0.5 * sample_rate / fn)), MAX_PREVIEW)
@@ -60,7 +61,7 @@ def inverse_fir(resonance, bandwidth_hz: float, sample_rate: float):
     w = 1.0 / (1.0 + (f / (0.3 * bandwidth_hz)) ** 2)
     design = np.vstack([m.real * w[:, None], m.imag * w[:, None], np.full(lead.size, _SUM_WEIGHT)])
     target = np.concatenate([w, np.zeros_like(w), [_SUM_WEIGHT]])
-    g = nnls(design, target)
+    g = nnls(design, target)[0]
     kept = np.flatnonzero(g > 1e-12 * g.max())
     taps = g[kept[0] : kept[-1] + 1]
     return taps / taps.sum(), int(lead[kept[0]])
