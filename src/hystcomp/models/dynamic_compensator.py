@@ -17,7 +17,6 @@ import numpy as np
 from hystcomp._kernels import dynamics as dk
 from hystcomp._kernels._jit import step_function
 from hystcomp._validation import as_signal, check_int
-from hystcomp.errors import InvalidTypeError
 
 #: Frequency (Hz) at which a hysteresis compensator and the inverse of the dynamics are
 #: matched in :func:`with_dynamics`: that of the paper's identification signals.
@@ -278,49 +277,3 @@ class DynamicStepper:
     def last_output(self) -> float:
         """The last voltage output."""
         return self._hyst.last_output
-
-
-def with_dynamics(
-    model, compensator, dynamics, *, bandwidth_hz=None, match_hz=MATCH_HZ
-) -> DynamicCompensator:
-    """``compensator`` (``model.inverse()``) in series with the inverse of ``dynamics``.
-
-    The filter starts at rest at the model's displacement for the low end of its voltage
-    range, where the compensator starts, and its output is clamped to the model's
-    displacement range (from there to the end of the ascending branch to the top of the
-    range): a reference step asks the inverse of the dynamics for a spike far beyond the
-    stroke, which the voltage clamp cuts anyway, and a hysteresis inverse fed the spike
-    would keep in its memory a turning point that the actuator never reached.
-
-    The two are matched at ``match_hz`` (:data:`MATCH_HZ`, 1 Hz): a hysteresis model
-    identified from 1 Hz records (the paper's signals, ``hystcomp excite``) already holds
-    the creep that is faster than that, so the inverse of the dynamics is scaled to unit
-    gain there, ``D^-1 |D(1 Hz)|``: it adds only what the hysteresis model lacks, the creep
-    slower than 1 Hz (after a step) and the fast dynamics. The scaling is about the middle
-    of the displacement range, where the identification triangles have their mean: the
-    creep slower than their period follows that mean, so the model holds it in full there
-    (about rest, a step to mid-range ended 0.15 µm short on a 3 % creep stage, the
-    ``1 - |D(1 Hz)|`` of the step). Deviation from "unit steady-state gain": the model file
-    keeps ``D(1) = 1``; with ``match_hz=0`` the inverse of ``D`` itself is used, which
-    leaves a static error of the fast creep's size (about 1 % of the step on a 3 % creep
-    stage).
-    """
-    from hystcomp.models.dynamics import LinearDynamics  # that module imports this one
-
-    if not isinstance(dynamics, LinearDynamics):
-        raise InvalidTypeError(
-            "The 'dynamics' parameter of inverse must be a LinearDynamics (hystcomp "
-            "identify --model dynamics, then hystcomp.load_model). Got "
-            f"{type(dynamics).__name__}."
-        )
-    lo, hi = compensator.voltage_range
-    rest, top = (float(x) for x in model.simulate([lo, hi]))
-    output_range = (min(rest, top), max(rest, top))
-    inverse = dynamics.inverse(
-        bandwidth_hz=bandwidth_hz,
-        rest=rest,
-        output_range=output_range,
-        match_hz=match_hz,
-        match_centre=0.5 * (rest + top),
-    )
-    return DynamicCompensator(compensator, inverse)

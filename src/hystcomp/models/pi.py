@@ -26,7 +26,8 @@ from hystcomp.models.base import (
     slew_to_step,
 )
 from hystcomp.models.compensator import Compensator
-from hystcomp.models.dynamic_compensator import DynamicCompensator, with_dynamics
+from hystcomp.models.dynamic_compensator import DynamicCompensator
+from hystcomp.models.dynamics import with_dynamics
 from hystcomp.models.inversion import (
     check_invertible,
     inverse_initial_state,

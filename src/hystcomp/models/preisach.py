@@ -27,7 +27,8 @@ from hystcomp.identify.preisach import identify_preisach
 from hystcomp.identify.scoring import transient_end
 from hystcomp.models.base import DEFAULT_VOLTAGE_RANGE, HysteresisModel, slew_to_step
 from hystcomp.models.compensator import Compensator
-from hystcomp.models.dynamic_compensator import DynamicCompensator, with_dynamics
+from hystcomp.models.dynamic_compensator import DynamicCompensator
+from hystcomp.models.dynamics import with_dynamics
 from hystcomp.models.system import Stepper
 
 INVERSE_METHODS = ("multiplicative", "exact")
