@@ -41,7 +41,14 @@ import numpy as np
 from llvmlite import ir  # type: ignore[import-untyped]
 from numba.extending import intrinsic
 
-from hystcomp._kernels._jit import StepKernels, inline_kernel, kernel, step_kernel
+from hystcomp._kernels._jit import (
+    StepKernels,
+    inline_kernel,
+    inner_kernel,
+    kernel,
+    loop_kernel,
+    step_kernel,
+)
 from hystcomp._kernels.chain import CLAMP_TOLERANCE
 
 # Modes of a packed system: what a step maps.
@@ -174,20 +181,35 @@ def state_start(p):
     return HEADER + n * n
 
 
-@inline_kernel
+@inner_kernel
 def everett(p, alpha, beta):
-    """``X(alpha, beta)`` of eq. (2) in µm, for voltages inside the plane."""
+    """``X(alpha, beta)`` of eq. (2) in µm, for voltages inside the plane.
+
+    The cubic of eq. (5) is written out here, small enough for LLVM to inline it where it is
+    called (the root search of the exact inverse calls it at every step); any other
+    polynomial and the table are one call of :func:`_everett_any`. Compiled once, not copied
+    into each caller: every copy would be typed and compiled again.
+    """
+    if p[KIND] == POLYNOMIAL and p[N_COEF] == 4:
+        # sum_i b^i (sum_j C[i, j] a^j), Horner in both variables, with fused multiply-adds:
+        # the loop of _everett_any unrolled (its first terms are C[i, 0])
+        a = alpha - p[V_MIN]
+        b = beta - p[V_MIN]
+        c = HEADER
+        acc = _fma(p[c + 12], b, _fma(p[c + 9], a, p[c + 8]))
+        acc = _fma(acc, b, _fma(_fma(p[c + 6], a, p[c + 5]), a, p[c + 4]))
+        inner = _fma(_fma(_fma(p[c + 3], a, p[c + 2]), a, p[c + 1]), a, p[c])
+        return _fma(acc, b, inner)
+    return _everett_any(p, alpha, beta)
+
+
+@inner_kernel
+def _everett_any(p, alpha, beta):
+    """:func:`everett` for any polynomial and for the table."""
     a = alpha - p[V_MIN]
     b = beta - p[V_MIN]
     n = int(p[N_COEF])
     if p[KIND] == POLYNOMIAL:
-        # sum_i b^i (sum_j C[i, j] a^j), Horner in both variables, with fused multiply-adds
-        if n == 4:  # the cubic of eq. (5): the loop below unrolled (its first terms are C[i, 0])
-            c = HEADER
-            acc = _fma(p[c + 12], b, _fma(p[c + 9], a, p[c + 8]))
-            acc = _fma(acc, b, _fma(_fma(p[c + 6], a, p[c + 5]), a, p[c + 4]))
-            inner = _fma(_fma(_fma(p[c + 3], a, p[c + 2]), a, p[c + 1]), a, p[c])
-            return _fma(acc, b, inner)
         acc = 0.0
         for i in range(n - 1, -1, -1):
             row = HEADER + i * n
@@ -221,7 +243,7 @@ def _push(p, e, q, top, value):
     if top + 1 >= int(p[DEPTH]):
         top -= 2  # full: wipe out the innermost stored pair first
     # X(value, e[top]) added on an even top, X(e[top], value) subtracted on an odd one: one
-    # call site of X (each is an inlined copy), the sign exact
+    # call site of X, the sign exact
     if top % 2 == 0:
         alpha, beta, sign = value, p[e + top], 1.0
     else:
@@ -231,8 +253,7 @@ def _push(p, e, q, top, value):
     return top + 1
 
 
-# not an inline kernel: inlined, it made preisach_run take minutes to compile
-@kernel
+@inline_kernel  # one call site, in _step; X is a call (inlined by LLVM), not a copy
 def preisach_apply(p, v):
     """Apply input ``v`` (clamped to the plane) and return ``H(v)`` without offset, eqs. (3)-(4)."""
     s = state_start(p)
@@ -265,7 +286,7 @@ def _branch(p, base, pivot, rising, v):
     return base + sign * everett(p, alpha, beta)  # one inlined copy of X; the sign is exact
 
 
-@kernel
+@inner_kernel
 def _root(p, base, pivot, rising, lo, hi, target, b_lo, b_hi):
     """``v`` in ``[lo, hi]`` with branch(v) = target, given branch(lo) < target <= branch(hi).
 
@@ -308,7 +329,7 @@ def _root(p, base, pivot, rising, lo, hi, target, b_lo, b_hi):
     return lo if -f_lo < f_hi else hi
 
 
-@kernel
+@inner_kernel
 def _solve_up(p, e, q, top, previous, target):
     """Smallest rise of the input whose branch output reaches ``target`` (> h)."""
     if top % 2 == 1:
@@ -341,7 +362,7 @@ def _solve_up(p, e, q, top, previous, target):
         k -= 2
 
 
-@kernel
+@inner_kernel
 def _solve_down(p, e, q, top, previous, target):
     """Smallest fall of the input whose branch output reaches ``target`` (< h)."""
     if top % 2 == 0:
@@ -374,7 +395,7 @@ def _solve_down(p, e, q, top, previous, target):
         k -= 2
 
 
-@kernel
+@inner_kernel
 def exact_input(p, target):
     """The input that makes ``H`` reach ``target`` (µm, no offset) from the current memory.
 
@@ -395,7 +416,7 @@ def exact_input(p, target):
     return previous
 
 
-@kernel
+@inner_kernel
 def _count_clamped(p, s, u, v, h):
     """Count a compensator's sample as clamped if ``v``, at an end of the range, leaves
     ``x_0 + H(v)`` short of the reference ``u`` (eq. 10 may ask beyond a range end for a
@@ -414,9 +435,8 @@ def _step(p, u):
         p[s + ST_NONFINITE] += 1.0
         return p[s + ST_LAST]
     mode = int(p[MODE])
-    if mode == FORWARD:
-        out = preisach_apply(p, u) + p[OFFSET]
-    else:
+    v = u
+    if mode != FORWARD:
         previous = p[s + ST_INPUT]
         if mode == MULTIPLICATIVE:
             v = previous + (u - p[OFFSET] - p[s + ST_H]) / p[RHO]
@@ -425,7 +445,10 @@ def _step(p, u):
         step = p[MAX_STEP]
         v = min(max(v, previous - step), previous + step)
         v = min(max(v, p[LOW]), p[HIGH])
-        h = preisach_apply(p, v)
+    h = preisach_apply(p, v)  # one call site: an inlined copy in each caller of _step
+    if mode == FORWARD:
+        out = h + p[OFFSET]
+    else:
         if v == p[HIGH] or v == p[LOW]:  # rare: only then can the reference be out of reach
             _count_clamped(p, s, u, v, h)
         out = v
@@ -452,7 +475,7 @@ def preisach_step(p, u):
     return _step(p, u)
 
 
-@kernel
+@loop_kernel
 def preisach_run(p, u, out):
     """Run every sample of ``u`` through packed system ``p`` into ``out`` (state kept in ``p``)."""
     for k in range(u.size):
