@@ -280,14 +280,15 @@ def preisach_apply(p, v):
 
 
 @inline_kernel
-def _branch(p, base, pivot, rising, v):
-    """A monotone branch: ``base + X(v, pivot)`` rising, ``base - X(pivot, v)`` falling."""
-    alpha, beta, sign = (v, pivot, 1.0) if rising else (pivot, v, -1.0)
-    return base + sign * everett(p, alpha, beta)  # one inlined copy of X; the sign is exact
+def _branch(p, base, pivot, sign, v):
+    """A monotone branch: ``base + X(v, pivot)`` rising (``sign`` 1), ``base - X(pivot, v)``
+    falling (``sign`` -1)."""
+    alpha, beta = (v, pivot) if sign > 0.0 else (pivot, v)
+    return base + sign * everett(p, alpha, beta)  # the sign is exact
 
 
 @inner_kernel
-def _root(p, base, pivot, rising, lo, hi, target, b_lo, b_hi):
+def _root(p, base, pivot, sign, lo, hi, target, b_lo, b_hi):
     """``v`` in ``[lo, hi]`` with branch(v) = target, given branch(lo) < target <= branch(hi).
 
     Illinois (modified regula falsi) with a bisection every fourth step: the bracket
@@ -311,7 +312,7 @@ def _root(p, base, pivot, rising, lo, hi, target, b_lo, b_hi):
             m = (lo * g_hi - hi * g_lo) / (g_hi - g_lo)
             if not (lo < m < hi):
                 m = 0.5 * (lo + hi)
-        g = _branch(p, base, pivot, rising, m) - target
+        g = _branch(p, base, pivot, sign, m) - target
         if abs(g) <= tol_x:
             return m
         if g < 0.0:
@@ -330,68 +331,46 @@ def _root(p, base, pivot, rising, lo, hi, target, b_lo, b_hi):
 
 
 @inner_kernel
-def _solve_up(p, e, q, top, previous, target):
-    """Smallest rise of the input whose branch output reaches ``target`` (> h)."""
-    if top % 2 == 1:
-        # a reversal: the branch starts at a new minimum beta = previous
-        base = p[q + top] - everett(p, p[e + top], previous)
+def _solve(p, e, q, top, previous, target, sign):
+    """Smallest rise (``sign`` 1) or fall (``sign`` -1) of the input from ``previous`` whose
+    branch output reaches ``target`` (above, or below, the present output).
+
+    The branch runs from the near end ``previous`` to the far end, the next stored extremum
+    in that direction (or the range end); past it, that extremum and its partner are wiped
+    out and the next outer branch goes on. A reversal first starts a branch at ``previous``.
+    """
+    rising = sign > 0.0
+    end = p[V_MAX] if rising else p[V_MIN]
+    if (top % 2 == 1) == rising:
+        # a reversal: the branch starts at a new extremum (a minimum rising, a maximum falling)
+        alpha, beta = (p[e + top], previous) if rising else (previous, p[e + top])
+        base = p[q + top] - sign * everett(p, alpha, beta)
         pivot = previous
-        hi = p[e + top]
+        far = p[e + top]
         k = top - 1
     else:
         base = p[q + top]
         pivot = p[e + top]
-        hi = p[e + top - 1] if top >= 2 else p[V_MAX]
+        far = p[e + top - 1] if top >= 1 else end
         k = top - 2
-    lo = previous
+    near = previous
     first = True
     while True:
-        b_hi = _branch(p, base, pivot, True, hi)
-        if target <= b_hi:
-            b_lo = _branch(p, base, pivot, True, lo)
-            if first and b_lo >= target:
+        b_far = _branch(p, base, pivot, sign, far)
+        if sign * target <= sign * b_far:
+            b_near = _branch(p, base, pivot, sign, near)
+            if first and sign * b_near >= sign * target:
                 return previous  # in the gap a non-zero X(v, v) opens at a reversal: hold
-            return _root(p, base, pivot, True, lo, hi, target, b_lo, b_hi)
+            if rising:
+                return _root(p, base, pivot, sign, near, far, target, b_near, b_far)
+            return _root(p, base, pivot, sign, far, near, target, b_far, b_near)
         if k < 0:
-            return p[V_MAX]
-        first = False
-        lo = hi
+            return end
+        first = False  # past a stored extremum: wiped out, the next outer branch
+        near = far
         base = p[q + k]
         pivot = p[e + k]
-        hi = p[e + k - 1] if k >= 2 else p[V_MAX]
-        k -= 2
-
-
-@inner_kernel
-def _solve_down(p, e, q, top, previous, target):
-    """Smallest fall of the input whose branch output reaches ``target`` (< h)."""
-    if top % 2 == 0:
-        # a reversal: the branch starts at a new maximum alpha = previous
-        base = p[q + top] + everett(p, previous, p[e + top])
-        pivot = previous
-        lo = p[e + top]
-        k = top - 1
-    else:
-        base = p[q + top]
-        pivot = p[e + top]
-        lo = p[e + top - 1]
-        k = top - 2
-    hi = previous
-    first = True
-    while True:
-        b_lo = _branch(p, base, pivot, False, lo)
-        if target >= b_lo:
-            b_hi = _branch(p, base, pivot, False, hi)
-            if first and b_hi <= target:
-                return previous  # in the gap a non-zero X(v, v) opens at a reversal: hold
-            return _root(p, base, pivot, False, lo, hi, target, b_lo, b_hi)
-        if k < 1:
-            return p[V_MIN]
-        first = False
-        hi = lo
-        base = p[q + k]
-        pivot = p[e + k]
-        lo = p[e + k - 1]
+        far = p[e + k - 1] if k >= 1 else end
         k -= 2
 
 
@@ -409,11 +388,9 @@ def exact_input(p, target):
     top = int(p[s + ST_TOP])
     previous = p[s + ST_INPUT]
     h = p[s + ST_H]
-    if target > h:
-        return _solve_up(p, e, q, top, previous, target)
-    if target < h:
-        return _solve_down(p, e, q, top, previous, target)
-    return previous
+    if target == h:
+        return previous
+    return _solve(p, e, q, top, previous, target, 1.0 if target > h else -1.0)
 
 
 @inner_kernel
