@@ -253,13 +253,12 @@ def _push(p, e, q, top, value):
     return top + 1
 
 
-@inline_kernel  # one call site, in _step; X is a call (inlined by LLVM), not a copy
+@inline_kernel  # one call site, in preisach_step; X is a call (LLVM inlines it), not a copy
 def preisach_apply(p, v):
-    """Apply input ``v`` (clamped to the plane) and return ``H(v)`` without offset, eqs. (3)-(4)."""
+    """Apply input ``v`` (inside the plane) and return ``H(v)`` without offset, eqs. (3)-(4)."""
     s = state_start(p)
     e = s + N_STATE
     q = e + int(p[DEPTH])
-    v = min(max(v, p[V_MIN]), p[V_MAX])
     top = int(p[s + ST_TOP])
     previous = p[s + ST_INPUT]
     if (v < previous) if top % 2 == 0 else (v > previous):
@@ -404,41 +403,14 @@ def _count_clamped(p, s, u, v, h):
         p[s + ST_CLAMPED] += 1.0
 
 
-@inline_kernel
-def _step(p, u):
-    """The body of :func:`preisach_step`, inlined into it and into :func:`preisach_run`."""
-    s = state_start(p)
-    if u - u != 0.0:  # NaN or +-inf
-        p[s + ST_NONFINITE] += 1.0
-        return p[s + ST_LAST]
-    mode = int(p[MODE])
-    v = u
-    if mode != FORWARD:
-        previous = p[s + ST_INPUT]
-        if mode == MULTIPLICATIVE:
-            v = previous + (u - p[OFFSET] - p[s + ST_H]) / p[RHO]
-        else:
-            v = exact_input(p, u - p[OFFSET])
-        step = p[MAX_STEP]
-        v = min(max(v, previous - step), previous + step)
-        v = min(max(v, p[LOW]), p[HIGH])
-    h = preisach_apply(p, v)  # one call site: an inlined copy in each caller of _step
-    if mode == FORWARD:
-        out = h + p[OFFSET]
-    else:
-        if v == p[HIGH] or v == p[LOW]:  # rare: only then can the reference be out of reach
-            _count_clamped(p, s, u, v, h)
-        out = v
-    p[s + ST_LAST] = out
-    return out
-
-
 @step_kernel
 def preisach_step(p, u):
     """One sample through packed system ``p``; updates its state and returns the output.
 
-    The streaming step (a :func:`~hystcomp._kernels._jit.step_kernel`) and the body of the batch
-    :func:`preisach_run`, so the two agree bit for bit.
+    The streaming step (a :func:`~hystcomp._kernels._jit.step_kernel`), which the batch
+    :func:`preisach_run` calls for every sample: the two run the same compiled code and agree
+    bit for bit, and it is compiled once (an inlined copy would be compiled again for each
+    signature of the batch kernel, and cost more than the call saves).
 
     FORWARD maps a voltage to ``x_0 + H(v)``; MULTIPLICATIVE is eq. (10),
     ``v[k] = v[k-1] + (x_ref[k] - x[k-1]) / rho``, i.e. ``(x_ref[k] - Gamma(v[k-1])) / rho``
@@ -449,14 +421,39 @@ def preisach_step(p, u):
     range and ``x_0 + H(v)`` still falls short of ``x_ref`` there by more than
     :data:`~hystcomp._kernels.chain.CLAMP_TOLERANCE` of it.
     """
-    return _step(p, u)
+    s = state_start(p)
+    if u - u != 0.0:  # NaN or +-inf
+        p[s + ST_NONFINITE] += 1.0
+        return p[s + ST_LAST]
+    mode = int(p[MODE])
+    if mode == FORWARD:
+        v = min(max(u, p[V_MIN]), p[V_MAX])  # the plane
+    else:
+        previous = p[s + ST_INPUT]
+        if mode == MULTIPLICATIVE:
+            v = previous + (u - p[OFFSET] - p[s + ST_H]) / p[RHO]
+        else:
+            v = exact_input(p, u - p[OFFSET])
+        step = p[MAX_STEP]
+        if step < np.inf:  # a slew limit (none by default: a shorter path from x_ref to v)
+            v = min(max(v, previous - step), previous + step)
+        v = min(max(v, p[LOW]), p[HIGH])  # the clamp, inside the plane
+    h = preisach_apply(p, v)
+    if mode == FORWARD:
+        out = h + p[OFFSET]
+    else:
+        if v == p[HIGH] or v == p[LOW]:  # rare: only then can the reference be out of reach
+            _count_clamped(p, s, u, v, h)
+        out = v
+    p[s + ST_LAST] = out
+    return out
 
 
 @loop_kernel
 def preisach_run(p, u, out):
     """Run every sample of ``u`` through packed system ``p`` into ``out`` (state kept in ``p``)."""
     for k in range(u.size):
-        out[k] = _step(p, u[k])
+        out[k] = preisach_step(p, u[k])
 
 
 #: The :class:`~hystcomp._kernels._jit.StepKernels` of a packed Preisach system.
