@@ -23,18 +23,6 @@ def kernel(func):
     return numba.njit(cache=True, fastmath=FASTMATH, nogil=True)(func)
 
 
-def loop_kernel(func):
-    """Compile ``func`` as a batch kernel that allocates nothing: :func:`kernel` (cached,
-    :data:`FASTMATH`, the GIL released) without reference counting.
-
-    The kernels inlined into its loop then use the arrays without touching their counts: an
-    inlined kernel that takes the packed array would otherwise increment and decrement its
-    count at every sample, two atomic operations that also hold up the loop's loads and
-    stores. It must not allocate.
-    """
-    return numba.njit(cache=True, fastmath=FASTMATH, nogil=True, _nrt=False)(func)
-
-
 def inline_kernel(func):
     """Compile ``func`` as a kernel inlined into its callers at numba-IR level.
 

@@ -46,7 +46,6 @@ from hystcomp._kernels._jit import (
     inline_kernel,
     inner_kernel,
     kernel,
-    loop_kernel,
     step_kernel,
 )
 from hystcomp._kernels.chain import CLAMP_TOLERANCE
@@ -449,7 +448,7 @@ def preisach_step(p, u):
     return out
 
 
-@loop_kernel
+@kernel
 def preisach_run(p, u, out):
     """Run every sample of ``u`` through packed system ``p`` into ``out`` (state kept in ``p``)."""
     for k in range(u.size):
