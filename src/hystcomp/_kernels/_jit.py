@@ -26,12 +26,25 @@ def kernel(func):
 def inline_kernel(func):
     """Compile ``func`` as a kernel inlined into its callers at numba-IR level.
 
-    The stages of a chain, or the evaluations of an Everett function, then sit in one
-    function that LLVM optimises as a whole (a call per stage and sample would cost more than
-    the stage; LLVM does not inline across numba's separately compiled functions). Only small
-    functions: each inlined copy is compiled again, and the first run's compile time grows.
+    The stages of a chain then sit in one function that LLVM optimises as a whole (a call
+    per stage and sample would cost more than the stage). Only small functions with few call
+    sites: each inlined copy is typed and compiled again, and the first run's compile time
+    grows with every copy. A small :func:`inner_kernel` is often the better choice.
     """
     return numba.njit(cache=True, fastmath=FASTMATH, nogil=True, inline="always")(func)
+
+
+def inner_kernel(func):
+    """Compile ``func`` as a kernel that other kernels call (not Python): :data:`FASTMATH`,
+    cached, without reference counting.
+
+    Compiled once, whatever the number of its call sites; LLVM still inlines it into a
+    caller where it is small (it links the callee's code into each caller's module before
+    optimising it). Without reference counting, a call does not increment and decrement the
+    count of every array it is passed (two atomic operations per call: at a call per sample
+    or per root-finding step, they cost as much as the arithmetic). It must not allocate.
+    """
+    return numba.njit(cache=True, fastmath=FASTMATH, _nrt=False)(func)
 
 
 def step_kernel(func):

@@ -41,7 +41,13 @@ import numpy as np
 from llvmlite import ir  # type: ignore[import-untyped]
 from numba.extending import intrinsic
 
-from hystcomp._kernels._jit import StepKernels, inline_kernel, kernel, step_kernel
+from hystcomp._kernels._jit import (
+    StepKernels,
+    inline_kernel,
+    inner_kernel,
+    kernel,
+    step_kernel,
+)
 from hystcomp._kernels.chain import CLAMP_TOLERANCE
 
 # Modes of a packed system: what a step maps.
@@ -174,20 +180,35 @@ def state_start(p):
     return HEADER + n * n
 
 
-@inline_kernel
+@inner_kernel
 def everett(p, alpha, beta):
-    """``X(alpha, beta)`` of eq. (2) in µm, for voltages inside the plane."""
+    """``X(alpha, beta)`` of eq. (2) in µm, for voltages inside the plane.
+
+    The cubic of eq. (5) is written out here, small enough for LLVM to inline it where it is
+    called (the root search of the exact inverse calls it at every step); any other
+    polynomial and the table are one call of :func:`_everett_any`. Compiled once, not copied
+    into each caller: every copy would be typed and compiled again.
+    """
+    if p[KIND] == POLYNOMIAL and p[N_COEF] == 4:
+        # sum_i b^i (sum_j C[i, j] a^j), Horner in both variables, with fused multiply-adds:
+        # the loop of _everett_any unrolled (its first terms are C[i, 0])
+        a = alpha - p[V_MIN]
+        b = beta - p[V_MIN]
+        c = HEADER
+        acc = _fma(p[c + 12], b, _fma(p[c + 9], a, p[c + 8]))
+        acc = _fma(acc, b, _fma(_fma(p[c + 6], a, p[c + 5]), a, p[c + 4]))
+        inner = _fma(_fma(_fma(p[c + 3], a, p[c + 2]), a, p[c + 1]), a, p[c])
+        return _fma(acc, b, inner)
+    return _everett_any(p, alpha, beta)
+
+
+@inner_kernel
+def _everett_any(p, alpha, beta):
+    """:func:`everett` for any polynomial and for the table."""
     a = alpha - p[V_MIN]
     b = beta - p[V_MIN]
     n = int(p[N_COEF])
     if p[KIND] == POLYNOMIAL:
-        # sum_i b^i (sum_j C[i, j] a^j), Horner in both variables, with fused multiply-adds
-        if n == 4:  # the cubic of eq. (5): the loop below unrolled (its first terms are C[i, 0])
-            c = HEADER
-            acc = _fma(p[c + 12], b, _fma(p[c + 9], a, p[c + 8]))
-            acc = _fma(acc, b, _fma(_fma(p[c + 6], a, p[c + 5]), a, p[c + 4]))
-            inner = _fma(_fma(_fma(p[c + 3], a, p[c + 2]), a, p[c + 1]), a, p[c])
-            return _fma(acc, b, inner)
         acc = 0.0
         for i in range(n - 1, -1, -1):
             row = HEADER + i * n
@@ -221,7 +242,7 @@ def _push(p, e, q, top, value):
     if top + 1 >= int(p[DEPTH]):
         top -= 2  # full: wipe out the innermost stored pair first
     # X(value, e[top]) added on an even top, X(e[top], value) subtracted on an odd one: one
-    # call site of X (each is an inlined copy), the sign exact
+    # call site of X, the sign exact
     if top % 2 == 0:
         alpha, beta, sign = value, p[e + top], 1.0
     else:
@@ -231,14 +252,12 @@ def _push(p, e, q, top, value):
     return top + 1
 
 
-# not an inline kernel: inlined, it made preisach_run take minutes to compile
-@kernel
+@inline_kernel  # one call site, in preisach_step; X is a call (LLVM inlines it), not a copy
 def preisach_apply(p, v):
-    """Apply input ``v`` (clamped to the plane) and return ``H(v)`` without offset, eqs. (3)-(4)."""
+    """Apply input ``v`` (inside the plane) and return ``H(v)`` without offset, eqs. (3)-(4)."""
     s = state_start(p)
     e = s + N_STATE
     q = e + int(p[DEPTH])
-    v = min(max(v, p[V_MIN]), p[V_MAX])
     top = int(p[s + ST_TOP])
     previous = p[s + ST_INPUT]
     if (v < previous) if top % 2 == 0 else (v > previous):
@@ -259,14 +278,15 @@ def preisach_apply(p, v):
 
 
 @inline_kernel
-def _branch(p, base, pivot, rising, v):
-    """A monotone branch: ``base + X(v, pivot)`` rising, ``base - X(pivot, v)`` falling."""
-    alpha, beta, sign = (v, pivot, 1.0) if rising else (pivot, v, -1.0)
-    return base + sign * everett(p, alpha, beta)  # one inlined copy of X; the sign is exact
+def _branch(p, base, pivot, sign, v):
+    """A monotone branch: ``base + X(v, pivot)`` rising (``sign`` 1), ``base - X(pivot, v)``
+    falling (``sign`` -1)."""
+    alpha, beta = (v, pivot) if sign > 0.0 else (pivot, v)
+    return base + sign * everett(p, alpha, beta)  # the sign is exact
 
 
-@kernel
-def _root(p, base, pivot, rising, lo, hi, target, b_lo, b_hi):
+@inner_kernel
+def _root(p, base, pivot, sign, lo, hi, target, b_lo, b_hi):
     """``v`` in ``[lo, hi]`` with branch(v) = target, given branch(lo) < target <= branch(hi).
 
     Illinois (modified regula falsi) with a bisection every fourth step: the bracket
@@ -290,7 +310,7 @@ def _root(p, base, pivot, rising, lo, hi, target, b_lo, b_hi):
             m = (lo * g_hi - hi * g_lo) / (g_hi - g_lo)
             if not (lo < m < hi):
                 m = 0.5 * (lo + hi)
-        g = _branch(p, base, pivot, rising, m) - target
+        g = _branch(p, base, pivot, sign, m) - target
         if abs(g) <= tol_x:
             return m
         if g < 0.0:
@@ -308,73 +328,51 @@ def _root(p, base, pivot, rising, lo, hi, target, b_lo, b_hi):
     return lo if -f_lo < f_hi else hi
 
 
-@kernel
-def _solve_up(p, e, q, top, previous, target):
-    """Smallest rise of the input whose branch output reaches ``target`` (> h)."""
-    if top % 2 == 1:
-        # a reversal: the branch starts at a new minimum beta = previous
-        base = p[q + top] - everett(p, p[e + top], previous)
+@inner_kernel
+def _solve(p, e, q, top, previous, target, sign):
+    """Smallest rise (``sign`` 1) or fall (``sign`` -1) of the input from ``previous`` whose
+    branch output reaches ``target`` (above, or below, the present output).
+
+    The branch runs from the near end ``previous`` to the far end, the next stored extremum
+    in that direction (or the range end); past it, that extremum and its partner are wiped
+    out and the next outer branch goes on. A reversal first starts a branch at ``previous``.
+    """
+    rising = sign > 0.0
+    end = p[V_MAX] if rising else p[V_MIN]
+    if (top % 2 == 1) == rising:
+        # a reversal: the branch starts at a new extremum (a minimum rising, a maximum falling)
+        alpha, beta = (p[e + top], previous) if rising else (previous, p[e + top])
+        base = p[q + top] - sign * everett(p, alpha, beta)
         pivot = previous
-        hi = p[e + top]
+        far = p[e + top]
         k = top - 1
     else:
         base = p[q + top]
         pivot = p[e + top]
-        hi = p[e + top - 1] if top >= 2 else p[V_MAX]
+        far = p[e + top - 1] if top >= 1 else end
         k = top - 2
-    lo = previous
+    near = previous
     first = True
     while True:
-        b_hi = _branch(p, base, pivot, True, hi)
-        if target <= b_hi:
-            b_lo = _branch(p, base, pivot, True, lo)
-            if first and b_lo >= target:
+        b_far = _branch(p, base, pivot, sign, far)
+        if sign * target <= sign * b_far:
+            b_near = _branch(p, base, pivot, sign, near)
+            if first and sign * b_near >= sign * target:
                 return previous  # in the gap a non-zero X(v, v) opens at a reversal: hold
-            return _root(p, base, pivot, True, lo, hi, target, b_lo, b_hi)
+            if rising:
+                return _root(p, base, pivot, sign, near, far, target, b_near, b_far)
+            return _root(p, base, pivot, sign, far, near, target, b_far, b_near)
         if k < 0:
-            return p[V_MAX]
-        first = False
-        lo = hi
+            return end
+        first = False  # past a stored extremum: wiped out, the next outer branch
+        near = far
         base = p[q + k]
         pivot = p[e + k]
-        hi = p[e + k - 1] if k >= 2 else p[V_MAX]
+        far = p[e + k - 1] if k >= 1 else end
         k -= 2
 
 
-@kernel
-def _solve_down(p, e, q, top, previous, target):
-    """Smallest fall of the input whose branch output reaches ``target`` (< h)."""
-    if top % 2 == 0:
-        # a reversal: the branch starts at a new maximum alpha = previous
-        base = p[q + top] + everett(p, previous, p[e + top])
-        pivot = previous
-        lo = p[e + top]
-        k = top - 1
-    else:
-        base = p[q + top]
-        pivot = p[e + top]
-        lo = p[e + top - 1]
-        k = top - 2
-    hi = previous
-    first = True
-    while True:
-        b_lo = _branch(p, base, pivot, False, lo)
-        if target >= b_lo:
-            b_hi = _branch(p, base, pivot, False, hi)
-            if first and b_hi <= target:
-                return previous  # in the gap a non-zero X(v, v) opens at a reversal: hold
-            return _root(p, base, pivot, False, lo, hi, target, b_lo, b_hi)
-        if k < 1:
-            return p[V_MIN]
-        first = False
-        hi = lo
-        base = p[q + k]
-        pivot = p[e + k]
-        lo = p[e + k - 1]
-        k -= 2
-
-
-@kernel
+@inner_kernel
 def exact_input(p, target):
     """The input that makes ``H`` reach ``target`` (µm, no offset) from the current memory.
 
@@ -388,14 +386,12 @@ def exact_input(p, target):
     top = int(p[s + ST_TOP])
     previous = p[s + ST_INPUT]
     h = p[s + ST_H]
-    if target > h:
-        return _solve_up(p, e, q, top, previous, target)
-    if target < h:
-        return _solve_down(p, e, q, top, previous, target)
-    return previous
+    if target == h:
+        return previous
+    return _solve(p, e, q, top, previous, target, 1.0 if target > h else -1.0)
 
 
-@kernel
+@inner_kernel
 def _count_clamped(p, s, u, v, h):
     """Count a compensator's sample as clamped if ``v``, at an end of the range, leaves
     ``x_0 + H(v)`` short of the reference ``u`` (eq. 10 may ask beyond a range end for a
@@ -406,39 +402,14 @@ def _count_clamped(p, s, u, v, h):
         p[s + ST_CLAMPED] += 1.0
 
 
-@inline_kernel
-def _step(p, u):
-    """The body of :func:`preisach_step`, inlined into it and into :func:`preisach_run`."""
-    s = state_start(p)
-    if u - u != 0.0:  # NaN or +-inf
-        p[s + ST_NONFINITE] += 1.0
-        return p[s + ST_LAST]
-    mode = int(p[MODE])
-    if mode == FORWARD:
-        out = preisach_apply(p, u) + p[OFFSET]
-    else:
-        previous = p[s + ST_INPUT]
-        if mode == MULTIPLICATIVE:
-            v = previous + (u - p[OFFSET] - p[s + ST_H]) / p[RHO]
-        else:
-            v = exact_input(p, u - p[OFFSET])
-        step = p[MAX_STEP]
-        v = min(max(v, previous - step), previous + step)
-        v = min(max(v, p[LOW]), p[HIGH])
-        h = preisach_apply(p, v)
-        if v == p[HIGH] or v == p[LOW]:  # rare: only then can the reference be out of reach
-            _count_clamped(p, s, u, v, h)
-        out = v
-    p[s + ST_LAST] = out
-    return out
-
-
 @step_kernel
 def preisach_step(p, u):
     """One sample through packed system ``p``; updates its state and returns the output.
 
-    The streaming step (a :func:`~hystcomp._kernels._jit.step_kernel`) and the body of the batch
-    :func:`preisach_run`, so the two agree bit for bit.
+    The streaming step (a :func:`~hystcomp._kernels._jit.step_kernel`), which the batch
+    :func:`preisach_run` calls for every sample: the two run the same compiled code and agree
+    bit for bit, and it is compiled once (an inlined copy would be compiled again for each
+    signature of the batch kernel, and cost more than the call saves).
 
     FORWARD maps a voltage to ``x_0 + H(v)``; MULTIPLICATIVE is eq. (10),
     ``v[k] = v[k-1] + (x_ref[k] - x[k-1]) / rho``, i.e. ``(x_ref[k] - Gamma(v[k-1])) / rho``
@@ -449,14 +420,39 @@ def preisach_step(p, u):
     range and ``x_0 + H(v)`` still falls short of ``x_ref`` there by more than
     :data:`~hystcomp._kernels.chain.CLAMP_TOLERANCE` of it.
     """
-    return _step(p, u)
+    s = state_start(p)
+    if u - u != 0.0:  # NaN or +-inf
+        p[s + ST_NONFINITE] += 1.0
+        return p[s + ST_LAST]
+    mode = int(p[MODE])
+    if mode == FORWARD:
+        v = min(max(u, p[V_MIN]), p[V_MAX])  # the plane
+    else:
+        previous = p[s + ST_INPUT]
+        if mode == MULTIPLICATIVE:
+            v = previous + (u - p[OFFSET] - p[s + ST_H]) / p[RHO]
+        else:
+            v = exact_input(p, u - p[OFFSET])
+        step = p[MAX_STEP]
+        if step < np.inf:  # a slew limit (none by default: a shorter path from x_ref to v)
+            v = min(max(v, previous - step), previous + step)
+        v = min(max(v, p[LOW]), p[HIGH])  # the clamp, inside the plane
+    h = preisach_apply(p, v)
+    if mode == FORWARD:
+        out = h + p[OFFSET]
+    else:
+        if v == p[HIGH] or v == p[LOW]:  # rare: only then can the reference be out of reach
+            _count_clamped(p, s, u, v, h)
+        out = v
+    p[s + ST_LAST] = out
+    return out
 
 
 @kernel
 def preisach_run(p, u, out):
     """Run every sample of ``u`` through packed system ``p`` into ``out`` (state kept in ``p``)."""
     for k in range(u.size):
-        out[k] = _step(p, u[k])
+        out[k] = preisach_step(p, u[k])
 
 
 #: The :class:`~hystcomp._kernels._jit.StepKernels` of a packed Preisach system.

@@ -6,7 +6,9 @@ input is followed through the stored extrema (where wipe-outs change it) until i
 ``target``, then solved by the Illinois variant of regula falsi with a bisection every
 fourth step. A reference out of reach gives the range ends; a reference inside the step
 that a non-zero ``X(v, v)`` opens at a reversal holds the voltage. The iteration, its
-tolerances and its comparisons are the Python kernel's, in the same order.
+tolerances and its comparisons are the Python kernel's, in the same order (its ``_solve``
+serves both directions with a sign; here ``{p}_solve_up`` and ``{p}_solve_down`` write the
+two out).
 """
 
 from __future__ import annotations
