@@ -11,6 +11,15 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
+#: ``set_title(..., y=TITLE_Y)``: the title just above the axes, where matplotlib's automatic
+#: placement puts it when the tick labels are below them, without that placement (which
+#: measures every y tick label once more).
+TITLE_Y = 1.0
+
+#: PNG encoding for every figure: the fastest zlib level, a few % larger files than the
+#: default level 6 at a third less time.
+PNG_OPTIONS = {"compress_level": 1}
+
 
 def _thin(n: int, points: int = 5000) -> slice:
     """Every k-th sample, so that a line has about ``points`` points (plots only)."""

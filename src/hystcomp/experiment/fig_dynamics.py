@@ -6,7 +6,14 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-from hystcomp.experiment._layout import envelope, fixed_layout, new_figure, pixel_columns
+from hystcomp.experiment._layout import (
+    PNG_OPTIONS,
+    TITLE_Y,
+    envelope,
+    fixed_layout,
+    new_figure,
+    pixel_columns,
+)
 
 
 def plot_bode(model, path, *, measured=None) -> None:
@@ -66,8 +73,8 @@ def plot_step(t, x_ref, runs: dict, path) -> None:
         ax.set_ylabel("tracking error (µm)")
     fast.set_xlabel("time after the step (ms)")
     slow.set_xlabel("time after the step (s)")
-    fast.set_title("the first 10 ms")
-    slow.set_title("creep: 10 ms to the end")
+    fast.set_title("the first 10 ms", y=TITLE_Y)
+    slow.set_title("creep: 10 ms to the end", y=TITLE_Y)
     slow.legend()
     fig.suptitle("Step and hold on the simulated axis with creep")
-    fig.savefig(path)
+    fig.savefig(path, pil_kwargs=PNG_OPTIONS)

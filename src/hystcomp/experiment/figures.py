@@ -16,7 +16,15 @@ from typing import Any
 import numpy as np
 from matplotlib.figure import Figure
 
-from hystcomp.experiment._layout import _thin, envelope, fixed_layout, new_figure, pixel_columns
+from hystcomp.experiment._layout import (
+    PNG_OPTIONS,
+    TITLE_Y,
+    _thin,
+    envelope,
+    fixed_layout,
+    new_figure,
+    pixel_columns,
+)
 from hystcomp.experiment.fig_identification import plot_identification
 from hystcomp.experiment.fig_preisach import plot_preisach_loops
 from hystcomp.experiment.metrics import SATURATION_ZONE
@@ -32,7 +40,7 @@ DPI = 130
 
 def _save(fig: Figure, path: Path) -> None:
     with atomic_path(path) as tmp:
-        fig.savefig(tmp, format="png", dpi=DPI)
+        fig.savefig(tmp, format="png", dpi=DPI, pil_kwargs=PNG_OPTIONS)
 
 
 def figure_9(results: dict, path: Path) -> None:
@@ -65,13 +73,13 @@ def figure_9(results: dict, path: Path) -> None:
     ax.plot([], [], color="k", lw=0.6, ls="--", label="ideal (x = x_ref)")
     inset.set_xlim(zone, top)
     inset.set_ylim(low_y, high_y)
-    inset.set_title("saturation zone", fontsize=8)
+    inset.set_title("saturation zone", fontsize=8, y=TITLE_Y)
     inset.tick_params(labelsize=7)
     ax.indicate_inset_zoom(inset, edgecolor="0.3")
     ax.set_xlabel("reference x_ref (µm)")
     ax.set_ylabel("measured displacement x (µm)")
     frequency = next(iter(results.values())).frequency
-    ax.set_title(f"Hysteresis compensation, {frequency:g} Hz triangle (twin)")
+    ax.set_title(f"Hysteresis compensation, {frequency:g} Hz triangle (twin)", y=TITLE_Y)
     ax.legend(loc="upper left", fontsize=8)
     _save(fig, path)
 
@@ -102,8 +110,8 @@ def figure_10(results: dict, path: Path) -> None:
             row[1].plot(*envelope(t, r.e[w], columns), **style)
         row[0].set_ylabel("displacement (µm)")
         row[1].set_ylabel("tracking error e (µm)")
-        row[0].set_title(f"{f:g} Hz: tracking")
-        row[1].set_title(f"{f:g} Hz: tracking error e = x - x_ref")
+        row[0].set_title(f"{f:g} Hz: tracking", y=TITLE_Y)
+        row[1].set_title(f"{f:g} Hz: tracking error e = x - x_ref", y=TITLE_Y)
         for ax in row:
             ax.set_xlabel("time (s)")
             ax.grid(alpha=0.3)
