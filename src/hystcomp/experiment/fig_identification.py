@@ -64,5 +64,7 @@ def plot_identification(v, x, before, after, path, *, model_name: str = "model")
         ax.legend(loc="upper left")
     axes[0].set_ylabel("displacement x (µm)")
     with atomic_path(path) as tmp:
-        options = {"pil_kwargs": PNG_OPTIONS} if suffix == ".png" else {}
-        fig.savefig(tmp, format=suffix[1:], dpi=150, **options)
+        if suffix == ".png":
+            fig.savefig(tmp, format="png", dpi=150, pil_kwargs=PNG_OPTIONS)
+        else:
+            fig.savefig(tmp, format=suffix[1:], dpi=150)
