@@ -143,12 +143,11 @@ def write_figures(comparison, out_dir: Path) -> dict[str, str | None]:
     notes["fig5_preisach.png"] = None
 
     rec = comparison.record_pi
+    slope, intercept = np.polyfit(rec.v, rec.x, 1)  # "before": the best straight line
+    before = slope * rec.v + intercept
     for kind in ("pi", "mpi"):
         name = f"fig8_{kind}.png"
-        slope, intercept = np.polyfit(rec.v, rec.x, 1)  # "before": the best straight line
         after = comparison.models[kind].simulate(rec.v)
-        plot_identification(
-            rec.v, rec.x, slope * rec.v + intercept, after, out_dir / name, model_name=LABELS[kind]
-        )
+        plot_identification(rec.v, rec.x, before, after, out_dir / name, model_name=LABELS[kind])
         notes[name] = None
     return notes
