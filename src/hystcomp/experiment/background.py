@@ -16,8 +16,12 @@ import multiprocessing
 import signal
 import sys
 import tempfile
+import warnings
 from collections.abc import Callable
 from pathlib import Path
+
+#: The start of Python's warning on a fork in a process with threads (3.12 and later).
+FORK_WARNING = r"This process \(pid=\d+\) is multi-threaded"
 
 #: What a drawing job returns: ``{file name: None if drawn, else why not}`` (as
 #: :func:`~hystcomp.experiment.figures.write_figures`).
@@ -51,7 +55,12 @@ class BackgroundFigures:
             process = context.Process(
                 target=_draw, args=(sender, function, args), daemon=True, name="hystcomp-figures"
             )
-            process.start()
+            with warnings.catch_warnings():
+                # Python >= 3.12 warns of a fork beside threads (BLAS's, here): they may hold
+                # a lock the child needs. The child only draws, with matplotlib and NumPy,
+                # whose BLAS re-creates its threads after a fork.
+                warnings.filterwarnings("ignore", FORK_WARNING, DeprecationWarning)
+                process.start()
         except (OSError, ValueError):  # no fork, no pipe: draw in this process
             return None
         sender.close()
