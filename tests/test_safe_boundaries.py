@@ -135,6 +135,31 @@ def test_text_booleans_and_complex_are_not_numbers(bad):
         as_signal(bad, "v")
 
 
+def test_signals_reach_the_kernels_as_one_array_type():
+    """Read-only, strided or integer samples become a writable C-contiguous float64 array,
+    so that a kernel is compiled once whatever array the caller holds (a Record's samples
+    are read-only; each array type would be a compilation of its own)."""
+    frozen = np.linspace(0.0, 100.0, 9)
+    frozen.setflags(write=False)
+    for given in (frozen, np.linspace(0.0, 100.0, 18)[::2], np.arange(9), [0.0, 1.0]):
+        u = as_signal(given, "v")
+        assert u.dtype == np.float64
+        assert u.flags.c_contiguous
+        assert u.flags.writeable
+    assert not frozen.flags.writeable  # the caller's array is left as it was
+    plain = np.linspace(0.0, 100.0, 9)
+    assert as_signal(plain, "v") is plain  # no copy when none is needed
+
+    from hystcomp._kernels.chain import chain_run
+
+    model = presets.paper_pi()
+    model.simulate(plain)
+    compiled = len(chain_run.signatures)
+    record = Record(np.arange(9) / 20_000.0, plain, plain)
+    np.testing.assert_array_equal(model.simulate(record.v), model.simulate(plain))
+    assert len(chain_run.signatures) == compiled
+
+
 def test_signals_beyond_the_magnitude_bound_name_the_sample():
     model = presets.paper_pi()
     with pytest.raises(InvalidSignalError, match=r"Sample 2 is 1e\+13; check the units"):

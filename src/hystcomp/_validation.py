@@ -143,7 +143,12 @@ def as_path(value, name: str, owner: str) -> Path:
 
 
 def as_signal(value, name: str, *, min_samples: int = 1) -> np.ndarray:
-    """Return a 1-D finite float64 array of samples (a copy if conversion is needed)."""
+    """Return a 1-D finite float64 array of samples, C-contiguous and writable.
+
+    A copy is made if conversion is needed, and of a read-only array (a
+    :class:`~hystcomp.io.records.Record`'s): every kernel then sees one array type and is
+    compiled once, not once more for read-only input. The kernels do not write into it.
+    """
     try:
         arr = _real_array(value, copy=False)
     except (TypeError, ValueError, OverflowError):
@@ -174,7 +179,9 @@ def as_signal(value, name: str, *, min_samples: int = 1) -> np.ndarray:
             f"{name!r} must be finite. Sample {bad} is {value!r}; "
             "remove or interpolate non-finite samples first."
         )
-    return np.ascontiguousarray(arr)
+    if not (arr.flags.c_contiguous and arr.flags.writeable):
+        arr = np.array(arr, order="C")
+    return arr
 
 
 def as_signal_pair(a, b, names: tuple[str, str], owner: str, *, min_samples: int = 1):

@@ -1,6 +1,7 @@
 """The compare pipeline (Section V on the twin): a short run, its files, the command."""
 
 import csv
+import sys
 
 import numpy as np
 import pytest
@@ -10,7 +11,9 @@ from hystcomp import presets
 from hystcomp.cli import main
 from hystcomp.errors import InvalidParameterError
 from hystcomp.experiment import compare as compare_module
+from hystcomp.experiment.background import BackgroundFigures
 from hystcomp.experiment.compare import CompareConfig, run_comparison
+from hystcomp.experiment.figures import write_figures
 from hystcomp.experiment.report import write_outputs
 from hystcomp.paper import METHODS
 
@@ -71,6 +74,26 @@ def test_outputs_are_written(comparison, tmp_path):
     assert f"{first.rms:.3f} | 4.700 |" in report
     assert "datasheet gain" in report
     assert not list(out.glob(".*.tmp"))  # no temporary file left behind
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="fork on Linux only")
+def test_figures_drawn_in_a_forked_process_are_those_drawn_in_place(comparison, tmp_path):
+    here = write_outputs(comparison, tmp_path / "here")
+    there = write_outputs(
+        comparison,
+        tmp_path / "there",
+        figures=BackgroundFigures.start(write_figures, comparison),
+    )
+    assert [p.name for p in there] == [p.name for p in here]
+    for a, b in zip(here, there, strict=True):
+        assert a.read_bytes() == b.read_bytes(), a.name
+    failed = BackgroundFigures.start(_no_figures, comparison)  # drawn in place instead
+    again = write_outputs(comparison, tmp_path / "again", figures=failed)
+    assert [p.read_bytes() for p in again] == [p.read_bytes() for p in here]
+
+
+def _no_figures(comparison, folder):
+    raise RuntimeError("the process fails")
 
 
 def test_output_folder_that_is_a_file_is_refused(comparison, tmp_path):

@@ -40,7 +40,9 @@ def compare(out_dir: Path, seed: int, periods: int | None, quick: bool) -> None:
     compensators in series with their inverse (dynamics.csv, step_creep.png). The axis has
     3 % creep. Units: µm, V, s.
     """
+    from hystcomp.experiment.background import BackgroundFigures
     from hystcomp.experiment.compare import CompareConfig, run_comparison
+    from hystcomp.experiment.figures import write_figures  # matplotlib, for a forked process
     from hystcomp.experiment.report import format_table, prepare_output_dir, write_outputs
 
     start = time.perf_counter()
@@ -53,9 +55,14 @@ def compare(out_dir: Path, seed: int, periods: int | None, quick: bool) -> None:
     def progress(line: str) -> None:
         click.echo(f"hystcomp compare: {line}", err=True)
 
-    comparison = run_comparison(config, progress=progress)
+    figures: dict[str, BackgroundFigures | None] = {}
+
+    def draw_figures(table1) -> None:  # Table I measured: its figures, beside the rest
+        figures["paper"] = BackgroundFigures.start(write_figures, table1)
+
+    comparison = run_comparison(config, progress=progress, table1=draw_figures)
     progress(f"writing tables, figures and report into {out_dir}")
-    files = write_outputs(comparison, out_dir)
+    files = write_outputs(comparison, out_dir, figures=figures.get("paper"))
     click.echo(format_table(comparison))
     seconds = time.perf_counter() - start
     progress(f"done in {seconds:.1f} s; wrote {len(files)} files into {out_dir}")

@@ -202,6 +202,7 @@ def run_comparison(
     *,
     identify: Callable[[Record, Record, CompareConfig], dict] | None = None,
     progress: Callable[[str], None] | None = None,
+    table1: Callable[[Comparison], None] | None = None,
 ) -> Comparison:
     """Run the paper's experiment on the twin.
 
@@ -214,6 +215,10 @@ def run_comparison(
         where each model has ``inverse()``; :func:`identify_models` by default.
     progress : callable, optional
         Called with one line of text at each stage.
+    table1 : callable, optional
+        Called with the comparison as far as Table I (records, models, ``results``,
+        ``datasheet``, ``preisach_exact``; no ``dynamics`` or ``paper_fit`` yet) as soon
+        as it is measured: ``hystcomp compare`` draws the paper's figures meanwhile.
 
     Returns
     -------
@@ -265,6 +270,21 @@ def run_comparison(
             preisach_exact[f] = run_tracking(
                 exact, twin, x_ref, frequency=f, method="preisach (exact inverse)"
             )
+    measured = Comparison(
+        config=config,
+        record_pi=record_pi,
+        record_preisach=record_preisach,
+        record_loops=record_loops,
+        models=models,
+        gain=gain,
+        reference_amplitude=amplitude,
+        results=results,
+        datasheet=datasheet,
+        preisach_exact=preisach_exact,
+        seconds=time.perf_counter() - start,
+    )
+    if table1 is not None:
+        table1(measured)
     dynamics = None
     if config.dynamics:
         from hystcomp.experiment.compare_dynamics import run_dynamics
@@ -286,20 +306,8 @@ def run_comparison(
             paper_fit[kind] = run_tracking(
                 model.inverse(), twin, x_ref, frequency=low, method=f"{kind} (paper's fit)"
             )
-    return Comparison(
-        dynamics=dynamics,
-        config=config,
-        record_pi=record_pi,
-        record_preisach=record_preisach,
-        record_loops=record_loops,
-        models=models,
-        gain=gain,
-        reference_amplitude=amplitude,
-        results=results,
-        datasheet=datasheet,
-        preisach_exact=preisach_exact,
-        seconds=time.perf_counter() - start,
-        paper_fit=paper_fit,
+    return dataclasses.replace(
+        measured, dynamics=dynamics, paper_fit=paper_fit, seconds=time.perf_counter() - start
     )
 
 

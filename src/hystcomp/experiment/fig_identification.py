@@ -10,7 +10,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from hystcomp.errors import InvalidParameterError
-from hystcomp.experiment._layout import _thin, fixed_layout
+from hystcomp.experiment._layout import PNG_OPTIONS, TITLE_Y, _thin, fixed_layout
 from hystcomp.io.atomic import atomic_path
 
 FORMATS = (".png", ".pdf", ".svg")
@@ -58,10 +58,13 @@ def plot_identification(v, x, before, after, path, *, model_name: str = "model")
         ax.plot(v[thin], x[thin], color="0.55", lw=1.6, label="measured")
         label = f"model (rms error {rms:.3g} µm)"
         ax.plot(v[thin], model_x[thin], color="tab:red", lw=0.9, label=label)
-        ax.set_title(title)
+        ax.set_title(title, y=TITLE_Y)
         ax.set_xlabel("voltage v (V)")
         ax.grid(alpha=0.3)
         ax.legend(loc="upper left")
     axes[0].set_ylabel("displacement x (µm)")
     with atomic_path(path) as tmp:
-        fig.savefig(tmp, format=suffix[1:], dpi=150)
+        if suffix == ".png":
+            fig.savefig(tmp, format="png", dpi=150, pil_kwargs=PNG_OPTIONS)
+        else:
+            fig.savefig(tmp, format=suffix[1:], dpi=150)

@@ -9,7 +9,7 @@ from matplotlib.figure import Figure
 
 from hystcomp._validation import as_signal, check_real
 from hystcomp.errors import InvalidParameterError, InvalidSignalError
-from hystcomp.experiment._layout import fixed_layout
+from hystcomp.experiment._layout import PNG_OPTIONS, TITLE_Y, fixed_layout
 from hystcomp.identify.excitation import scaled_amplitudes, sinusoid_sequence
 from hystcomp.io.atomic import atomic_path
 from hystcomp.paper import FIG5_AMPLITUDES
@@ -76,8 +76,8 @@ def plot_preisach_loops(
     # plain text, as in the other figures: mathtext would build its parser (0.4 s) for this
     ax.set_xlabel("Voltage v_px (V)")
     ax.set_ylabel("Displacement x_p (µm)")
-    ax.set_title(f"Preisach model, {frequency:g} Hz sinusoids of growing amplitude")
+    ax.set_title(f"Preisach model, {frequency:g} Hz sinusoids of growing amplitude", y=TITLE_Y)
     ax.grid(True, alpha=0.3)
     ax.legend(loc="upper left")
     with atomic_path(path) as tmp:
-        fig.savefig(tmp, format="png", dpi=120)
+        fig.savefig(tmp, format="png", dpi=120, pil_kwargs=PNG_OPTIONS)

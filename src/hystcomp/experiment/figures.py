@@ -4,7 +4,8 @@ Every figure is drawn on its own :class:`~matplotlib.figure.Figure` (no global p
 state) and saved through :func:`hystcomp.io.atomic.atomic_path`, so a failure never leaves a
 broken image. The margins are fixed in inches (:func:`fixed_layout`) rather than computed by
 matplotlib's constrained layout, which measures every label again and doubled the cost of
-drawing a figure; lines are thinned to a few thousand points (:func:`_thin`).
+drawing a figure; lines are thinned to a few thousand points (:func:`_thin`), time
+series to their envelope per pixel column (:func:`envelope`).
 """
 
 from __future__ import annotations
@@ -15,7 +16,15 @@ from typing import Any
 import numpy as np
 from matplotlib.figure import Figure
 
-from hystcomp.experiment._layout import _thin, fixed_layout, new_figure
+from hystcomp.experiment._layout import (
+    PNG_OPTIONS,
+    TITLE_Y,
+    _thin,
+    envelope,
+    fixed_layout,
+    new_figure,
+    pixel_columns,
+)
 from hystcomp.experiment.fig_identification import plot_identification
 from hystcomp.experiment.fig_preisach import plot_preisach_loops
 from hystcomp.experiment.metrics import SATURATION_ZONE
@@ -25,9 +34,13 @@ from hystcomp.paper import LABELS, METHODS
 COLOURS = {"uncompensated": "0.45", "preisach": "tab:green", "pi": "tab:blue", "mpi": "tab:red"}
 
 
+#: Resolution of the saved figures (dots per inch).
+DPI = 130
+
+
 def _save(fig: Figure, path: Path) -> None:
     with atomic_path(path) as tmp:
-        fig.savefig(tmp, format="png", dpi=130)
+        fig.savefig(tmp, format="png", dpi=DPI, pil_kwargs=PNG_OPTIONS)
 
 
 def figure_9(results: dict, path: Path) -> None:
@@ -60,13 +73,13 @@ def figure_9(results: dict, path: Path) -> None:
     ax.plot([], [], color="k", lw=0.6, ls="--", label="ideal (x = x_ref)")
     inset.set_xlim(zone, top)
     inset.set_ylim(low_y, high_y)
-    inset.set_title("saturation zone", fontsize=8)
+    inset.set_title("saturation zone", fontsize=8, y=TITLE_Y)
     inset.tick_params(labelsize=7)
     ax.indicate_inset_zoom(inset, edgecolor="0.3")
     ax.set_xlabel("reference x_ref (µm)")
     ax.set_ylabel("measured displacement x (µm)")
     frequency = next(iter(results.values())).frequency
-    ax.set_title(f"Hysteresis compensation, {frequency:g} Hz triangle (twin)")
+    ax.set_title(f"Hysteresis compensation, {frequency:g} Hz triangle (twin)", y=TITLE_Y)
     ax.legend(loc="upper left", fontsize=8)
     _save(fig, path)
 
@@ -83,21 +96,22 @@ def figure_10(results: dict, path: Path) -> None:
         rows=len(frequencies), cols=2,
     )  # fmt: skip
     axes = fig.subplots(len(frequencies), 2, squeeze=False)
+    columns = pixel_columns(fig, axes[0, 0], DPI)
     for row, f in zip(axes, frequencies, strict=True):
         first = results[f][METHODS[0]]
         w = first.window
-        thin = _thin(w.stop - w.start)
-        t = first.t[w][thin]
-        row[0].plot(t, first.x_ref[w][thin], color="k", lw=0.8, ls="--", label="reference")
+        t = first.t[w]
+        ref = envelope(t, first.x_ref[w], columns)
+        row[0].plot(*ref, color="k", lw=0.8, ls="--", label="reference")
         for method in METHODS:
             r = results[f][method]
             style = {"color": COLOURS[method], "lw": 0.8, "label": LABELS[method]}
-            row[0].plot(t, r.x[w][thin], **style)
-            row[1].plot(t, r.e[w][thin], **style)
+            row[0].plot(*envelope(t, r.x[w], columns), **style)
+            row[1].plot(*envelope(t, r.e[w], columns), **style)
         row[0].set_ylabel("displacement (µm)")
         row[1].set_ylabel("tracking error e (µm)")
-        row[0].set_title(f"{f:g} Hz: tracking")
-        row[1].set_title(f"{f:g} Hz: tracking error e = x - x_ref")
+        row[0].set_title(f"{f:g} Hz: tracking", y=TITLE_Y)
+        row[1].set_title(f"{f:g} Hz: tracking error e = x - x_ref", y=TITLE_Y)
         for ax in row:
             ax.set_xlabel("time (s)")
             ax.grid(alpha=0.3)
@@ -129,12 +143,11 @@ def write_figures(comparison, out_dir: Path) -> dict[str, str | None]:
     notes["fig5_preisach.png"] = None
 
     rec = comparison.record_pi
+    slope, intercept = np.polyfit(rec.v, rec.x, 1)  # "before": the best straight line
+    before = slope * rec.v + intercept
     for kind in ("pi", "mpi"):
         name = f"fig8_{kind}.png"
-        slope, intercept = np.polyfit(rec.v, rec.x, 1)  # "before": the best straight line
         after = comparison.models[kind].simulate(rec.v)
-        plot_identification(
-            rec.v, rec.x, slope * rec.v + intercept, after, out_dir / name, model_name=LABELS[kind]
-        )
+        plot_identification(rec.v, rec.x, before, after, out_dir / name, model_name=LABELS[kind])
         notes[name] = None
     return notes

@@ -67,6 +67,18 @@ def _write_text(path: Path, text: str) -> None:
         tmp.write_text(text, encoding="utf-8")
 
 
+def _figures(comparison, stage: Path, background) -> dict[str, str | None]:
+    """The paper's figures in ``stage``: from ``background`` if it drew them, else drawn."""
+    drawn = None if background is None else background.collect()
+    if drawn is None:
+        return write_figures(comparison, stage)
+    notes, files = drawn
+    for name, data in files.items():
+        with atomic_path(stage / name) as tmp:
+            tmp.write_bytes(data)
+    return notes
+
+
 def format_table(comparison) -> str:
     """Table I as text for the terminal: our rms/max beside the paper's."""
     lines = [
@@ -106,28 +118,34 @@ def prepare_output_dir(out_dir) -> Path:
     return path
 
 
-def write_outputs(comparison, out_dir) -> list[Path]:
+def write_outputs(comparison, out_dir, *, figures=None) -> list[Path]:
     """Write tables, figures and ``report.md`` into ``out_dir``; return the files written.
 
     Every file is first written into a hidden folder inside ``out_dir``, then all are
     renamed into place together (:func:`hystcomp.io.atomic.replace_all`): a failure or an
     interruption leaves the files of an earlier run as they were, never a mix of two runs.
+
+    ``figures``, if given, is a :class:`~hystcomp.experiment.background.BackgroundFigures`
+    drawing :func:`~hystcomp.experiment.figures.write_figures` for this comparison (from
+    its Table I); its files are written as they came, or the figures are drawn here if it
+    failed.
     """
     out = prepare_output_dir(out_dir)
     with staging_folder(out) as stage:
         _write_text(stage / "table1.csv", _csv_text(table1_rows(comparison)))
         _write_text(stage / "hysteresis.csv", _csv_text(hysteresis_rows(comparison)))
-        notes = write_figures(comparison, stage)
-        text = report_markdown(comparison, notes)
-        names = ["table1.csv", "hysteresis.csv", *(n for n, why in notes.items() if why is None)]
-        if getattr(comparison, "dynamics", None) is not None:  # beyond the paper
+        dc = getattr(comparison, "dynamics", None)
+        if dc is not None:  # beyond the paper; drawn first, while the figures process ends
             from hystcomp.experiment.compare_dynamics import dynamics_markdown, dynamics_rows
             from hystcomp.experiment.fig_dynamics import plot_step
 
-            dc = comparison.dynamics
             _write_text(stage / "dynamics.csv", _csv_text(dynamics_rows(dc)))
             t, x_ref = next(iter(dc.step.values()))[:2]
             plot_step(t, x_ref, {k: run[2] for k, run in dc.step.items()}, stage / "step_creep.png")
+        notes = _figures(comparison, stage, figures)
+        text = report_markdown(comparison, notes)
+        names = ["table1.csv", "hysteresis.csv", *(n for n, why in notes.items() if why is None)]
+        if dc is not None:
             text += "\n" + "\n".join(dynamics_markdown(dc, comparison.results))
             text += "\n![Step and hold](step_creep.png)\n"
             names += ["dynamics.csv", "step_creep.png"]

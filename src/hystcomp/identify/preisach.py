@@ -374,10 +374,10 @@ def identify_preisach(
             f"The 'fit_method' parameter of {owner} must be one of "
             f"{', '.join(map(repr, FIT_METHODS))}. Got {fit_method!r} instead."
         )
+    v = as_signal(v, "v", min_samples=3)  # writable: the kernels compile for one array type
+    x = as_signal(x, "x", min_samples=3)
     curves = find_reversal_curves(v, x, tolerance=tolerance)
     check_response(v, x, owner)  # rising, and more than noise
-    v = np.ascontiguousarray(v, dtype=np.float64).reshape(-1)
-    x = np.ascontiguousarray(x, dtype=np.float64).reshape(-1)
     data_range = (float(v.min()), float(v.max()))
     if voltage_range is None:
         if data_range[0] == data_range[1]:

@@ -128,6 +128,8 @@ class Stepper:
                 "pass one channel at a time (for example u[:, 0])."
             )
         u = np.ascontiguousarray(arr, dtype=np.float64).reshape(-1)
+        if not u.flags.writeable:  # one array type for the kernel (see as_signal)
+            u = u.copy()
         out = np.empty_like(u)
         self._run(self._p, u, out)
         return out
