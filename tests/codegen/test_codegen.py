@@ -479,3 +479,83 @@ def test_preisach_exact_inverse_is_named_in_the_header():
     header, source = generate_c(model.inverse())
     assert "inverse multiplicative structure (paper eqs. 7-10)" in header
     assert "_exact_input" not in source
+
+
+# --- The count of clamped outputs: C's clamped_count against Stepper.clamped_count ---
+
+COUNT_DRIVER = """
+#include "{p}.h"
+
+unsigned long count_clamped(const double *x_ref, double *v, long n)
+{
+    {p}_state s;
+    long k;
+    {p}_init(&s);
+    for (k = 0; k < n; k++) {
+        v[k] = {p}_step(&s, x_ref[k]);
+    }
+    return s.clamped_count;
+}
+"""
+
+
+def _counting_compensators(identified):
+    """Every template's compensator (one with the inverse of the dynamics in front), each
+    beside the model it inverts."""
+    rng = np.random.default_rng(5)
+    mpi = hystcomp.presets.paper_mpi()
+    pi = _bipolar_pi(rng)
+    dynamics = hystcomp.LinearDynamics.from_parameters(
+        sample_rate=20_000.0, resonance_hz=700.0, damping_ratio=0.1
+    )
+    table, quartic = identified["table"], identified["quartic_bipolar"]
+    return {
+        "bipolar_pi": (pi.inverse(), pi),
+        "paper_mpi_slewing": (mpi.inverse(slew_rate=2e5, sample_rate=20_000.0), mpi),
+        "paper_mpi_dynamics": (mpi.inverse(dynamics=dynamics), mpi),
+        "preisach_multiplicative": (table.inverse(method="multiplicative"), table),
+        "preisach_exact_bipolar": (quartic.inverse(method="exact"), quartic),
+        "preisach_exact_dynamics": (table.inverse(method="exact", dynamics=dynamics), table),
+    }
+
+
+@needs_cc
+@pytest.mark.parametrize(
+    "name",
+    [
+        "bipolar_pi",
+        "paper_mpi_slewing",
+        "paper_mpi_dynamics",
+        "preisach_multiplicative",
+        "preisach_exact_bipolar",
+        "preisach_exact_dynamics",
+    ],
+)
+def test_c_counts_clamped_outputs_as_python(name, identified_preisach, tmp_path, rng):
+    comp, model = _counting_compensators(identified_preisach)[name]
+    export_c(comp, tmp_path, prefix="comp")
+    (tmp_path / "driver.c").write_text(COUNT_DRIVER.replace("{p}", "comp"))
+    lib = tmp_path / "libcomp.so"
+    cmd = [CC, *STRICT, "-shared", "-fPIC", "-o", str(lib), "comp.c", "driver.c", "-lm"]
+    build = subprocess.run(cmd, cwd=tmp_path, capture_output=True, text=True, check=False)
+    assert build.returncode == 0, build.stderr
+    count = ctypes.CDLL(str(lib)).count_clamped
+    count.restype = ctypes.c_ulong
+    count.argtypes = [ctypes.c_void_p, ctypes.c_void_p, ctypes.c_long]
+    # a reference that leaves the reachable range at both ends, with a few NaNs
+    low, high = model.reachable_range()
+    span = high - low
+    phase = np.linspace(0.0, 8.0 * np.pi, 12_000)
+    x = 0.5 * (low + high) + 0.6 * span * np.sin(phase) + rng.normal(0.0, 0.01 * span, phase.size)
+    x[rng.choice(x.size, size=8, replace=False)] = np.nan
+    v = np.empty_like(x)
+    clamped_c = count(x.ctypes.data, v.ctypes.data, x.size)
+    stepper = comp.stepper()
+    np.testing.assert_allclose(v, stepper.step_block(x), rtol=0, atol=1e-9)
+    assert comp.voltage_range[0] == v.min()
+    assert v.max() <= comp.voltage_range[1]
+    assert clamped_c == stepper.clamped_count
+    if name == "preisach_exact_dynamics":  # the filter clamps to the reach of H first
+        assert clamped_c == 0
+    else:  # the reference is out of reach often
+        assert 0.05 * x.size < clamped_c < 0.9 * x.size

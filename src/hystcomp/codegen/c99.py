@@ -27,6 +27,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from hystcomp import paper
+from hystcomp._kernels.chain import CLAMP_TOLERANCE
 from hystcomp.errors import InvalidParameterError
 
 # A C identifier that does not start with '_' (reserved at file scope, C99 7.1.3).
@@ -128,8 +129,8 @@ class CTemplate:
     """What a compensator template contributes to the generated files.
 
     Strings are C99 lines in which ``{p}`` stands for the prefix. ``state_fields`` are
-    declarations inside the state struct (``last`` and ``nonfinite_count`` are always
-    there); ``tables`` the ``static const`` tables of NAME.c; ``locals`` the declarations
+    declarations inside the state struct (``last``, ``nonfinite_count`` and
+    ``clamped_count`` are always there); ``tables`` the ``static const`` tables of NAME.c; ``locals`` the declarations
     at the top of ``NAME_step``; ``reset_body`` the statements of ``NAME_reset``.
     ``step_body`` runs for a finite ``x_ref`` and assigns the voltage to ``v``; the common
     part then applies the slew-rate limit (``max_step`` V per sample, if finite) and the
@@ -141,7 +142,12 @@ class CTemplate:
     ``hold_on_overflow`` (the default), a non-finite ``v`` from a finite ``x_ref`` holds
     the last output, as the play chain does; a template whose Python kernel instead takes
     ``v = +-inf`` through the slew-rate limit and the clamp (to the range ends) sets it to
-    False, and its ``step_body`` must then never assign NaN.
+    False, and its ``step_body`` must then never assign NaN. If ``count_clamped`` (the
+    default), an output that the clamp moves by more than
+    :data:`~hystcomp._kernels.chain.CLAMP_TOLERANCE` of the range counts in
+    ``clamped_count``, as the chain kernel counts it; a template with a rule of its own (the
+    Preisach compensators count a reference out of reach) sets it False and counts in its
+    ``after_body``.
     """
 
     kind: str
@@ -158,6 +164,7 @@ class CTemplate:
     after_body: list[str] = field(default_factory=list)
     functions: list[str] = field(default_factory=list)
     hold_on_overflow: bool = True
+    count_clamped: bool = True
 
 
 def check_prefix(prefix: str) -> str:
@@ -234,6 +241,7 @@ def render(
     fields = [
         "double last; /* last output, V (held while x_ref is not finite) */",
         "unsigned long nonfinite_count; /* non-finite x_ref samples since the last reset */",
+        "unsigned long clamped_count; /* outputs the voltage range cut since the last reset */",
         *template.state_fields,
     ]
     header = "\n".join(
@@ -291,6 +299,7 @@ def render(
             *(f"    {line}" for line in template.reset_body),
             f"    s->last = {c_double(template.initial_output)};",
             "    s->nonfinite_count = 0;",
+            "    s->clamped_count = 0;",
             "}",
             "",
             f"void {p}_init({p}_state *s)",
@@ -356,6 +365,13 @@ def _limits(template: CTemplate) -> list[str]:
             "}",
         ]
     lo, hi = c_double(template.low), c_double(template.high)
+    if template.count_clamped:  # the chain kernel's rule (Stepper.clamped_count)
+        tol = CLAMP_TOLERANCE * (template.high - template.low)
+        lines += [
+            f"if (v < {c_double(template.low - tol)} || v > {c_double(template.high + tol)}) {{",
+            "    s->clamped_count++; /* the clamp cuts more than a rounding */",
+            "}",
+        ]
     return [
         *lines,
         "/* the amplifier's range: never drive the piezo outside it */",

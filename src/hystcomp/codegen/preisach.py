@@ -20,6 +20,7 @@ root finder agrees within its tolerance (about 1e-13 V).
 from __future__ import annotations
 
 from hystcomp._kernels import preisach as pk
+from hystcomp._kernels.chain import CLAMP_TOLERANCE
 from hystcomp.codegen.c99 import CTemplate, c_double, c_table
 from hystcomp.codegen.preisach_exact import exact_functions
 
@@ -69,8 +70,19 @@ def preisach_template(compensator) -> CTemplate:
             "s->h = 0.0;",
         ],
         after_body=["{p}_apply(s, v); /* H's memory follows the applied voltage */"],
+        count_clamped=False,  # counted below, as the kernel does: a reference out of reach
     )
     offset = float(p[pk.OFFSET])
+    template.after_body += [
+        f"if (v == {c_double(hi)} || v == {c_double(lo)}) {{ /* only there can x_ref be out of reach */",
+        f"    double target = {_minus('x_ref', offset)};",
+        f"    double miss = {c_double(CLAMP_TOLERANCE)} * (1.0 + fabs(target));",
+        f"    if ((v == {c_double(hi)} && target > s->h + miss) ||",
+        f"        (v == {c_double(lo)} && target < s->h - miss)) {{",
+        "        s->clamped_count++;",
+        "    }",
+        "}",
+    ]
     if exact:
         template.step_body = [
             "/* exact inverse: the input on the current branch of H with x_0 + H(v) = x_ref */",

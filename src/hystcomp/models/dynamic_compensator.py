@@ -274,6 +274,12 @@ class DynamicStepper:
         return self._hyst.nonfinite_count
 
     @property
+    def clamped_count(self) -> int:
+        """Outputs the voltage range clamped since the last reset (the hysteresis stepper's
+        count: the filter's own clamp to the displacement range is not counted)."""
+        return self._hyst.clamped_count
+
+    @property
     def last_output(self) -> float:
         """The last voltage output."""
         return self._hyst.last_output
