@@ -79,7 +79,6 @@ from hystcomp.identify.pi import (
     paper_thresholds,
     play_thresholds,
     prepare_record,
-    thinned,
 )
 
 #: Candidate values of ``regularization`` for a choice: none, then one per decade.
@@ -248,8 +247,7 @@ def fit_mpi_path(
     z = rec.x - x0
     z_span = float(z[rec.start :].max())
     rs = paper_thresholds(m, z_span)  # eq. (17)
-    keep, first = thinned(rec)
-    gram = normal_equations(rec.u[keep], r, y0, z[keep], rs[1:], first)
+    gram = normal_equations(rec.u, r, y0, z, rs[1:], rec.start)
     fits = []
     for penalty in penalties:
         sol = constrained_lsq(
@@ -270,8 +268,8 @@ def fit_mpi_path(
                 inverse_deadzone_weights=np.r_[1.0, sol.coef[n : n + m - 1]],
                 input_offset=input_offset,
                 output_offset=x0,
-                first_sample=rec.start,
-                samples=keep,
+                first_sample=int(rec.samples[rec.start]),
+                samples=rec.samples,
             )
         )
     return fits

@@ -28,7 +28,9 @@ with the thresholds below).
 The physical fit also spreads its thresholds over half the input span, where the plays
 can move (:func:`play_thresholds`). Records longer than
 :data:`~hystcomp.identify.scoring.MAX_SAMPLES` are fitted on every
-turning point and a regular subset of the samples (:func:`thinned`).
+turning point and a regular subset of the samples (:func:`prepare_record`): the play
+outputs there are exact (rate independence), and the cost weights the record as the whole
+does.
 """
 
 from __future__ import annotations
@@ -83,19 +85,31 @@ def play_thresholds(n_operators: int, span: float, constraints: str) -> np.ndarr
 
 @dataclass(frozen=True)
 class PreparedRecord:
-    """A validated identification record, with the play input and the fit's first sample."""
+    """A validated identification record, thinned, with the play input and the fit's start.
+
+    ``v``, ``x`` and ``u`` hold the samples the fit uses (``samples`` of the record: all of
+    them, or for a record longer than :data:`~hystcomp.identify.scoring.MAX_SAMPLES` its
+    turning points and a regular subset, :func:`~hystcomp.identify.scoring.thin`); ``start``
+    indexes them.
+    """
 
     v: np.ndarray
     x: np.ndarray
     input_offset: float  # v_0 = min(v), V
     u: np.ndarray  # v - v_0, V
-    start: int  # first sample in the cost
+    start: int  # first sample in the cost (among the kept samples)
     input_span: float  # max(u), V
     slope: float  # displacement range / input span over the fit samples, µm/V
+    samples: np.ndarray  # indices of the kept samples in the record
 
 
 def prepare_record(v, x, *, n_weights: int, transient, owner: str) -> PreparedRecord:
-    """Validate ``(v, x)`` for identification and find the samples the fit uses."""
+    """Validate ``(v, x)`` for identification, thin it and find the samples the fit uses.
+
+    Every sample is read for validation, for the start-up transient and for the turning
+    points (:func:`~hystcomp.identify.scoring.thin`); every other check runs on the kept
+    samples, which hold the extremes of the input (turning points or end points).
+    """
     v = as_signal(v, "v", min_samples=2)
     x = as_signal(x, "x", min_samples=2)
     if v.size != x.size:
@@ -103,6 +117,11 @@ def prepare_record(v, x, *, n_weights: int, transient, owner: str) -> PreparedRe
             f"{owner}: 'v' and 'x' must have one sample each per instant. Got {v.size} "
             f"voltage samples and {x.size} displacement samples."
         )
+    start = check_transient(transient, v, owner, min_used=2 * n_weights)
+    keep = thin(v, start, scoring.MAX_SAMPLES)
+    if keep.size < v.size:
+        v, x = v[keep], x[keep]
+        start = int(np.searchsorted(keep, start))
     v0 = float(v.min())
     u = v - v0
     span = float(u.max())
@@ -112,7 +131,6 @@ def prepare_record(v, x, *, n_weights: int, transient, owner: str) -> PreparedRe
             "identify. Record the response to an input that sweeps the actuator's range, "
             "such as 'hystcomp excite pi'."
         )
-    start = check_transient(transient, v, owner, min_used=2 * n_weights)
     u_fit, x_fit = u[start:], x[start:]
     if np.ptp(u_fit) <= 0.0:
         raise IdentificationError(
@@ -126,21 +144,7 @@ def prepare_record(v, x, *, n_weights: int, transient, owner: str) -> PreparedRe
             "recorded no motion. Check the displacement column."
         )
     check_response(u_fit, x_fit, owner)  # rising, and more than noise
-    return PreparedRecord(v, x, v0, u, start, span, x_span / span)
-
-
-def thinned(rec: PreparedRecord) -> tuple[np.ndarray, int]:
-    """Samples of a long record that a fit needs (:func:`~hystcomp.identify.scoring.thin`).
-
-        The physical fit also spreads its thresholds over half the input span, where the plays
-    can move (:func:`play_thresholds`). Records longer than
-    :data:`~hystcomp.identify.scoring.MAX_SAMPLES` are fitted on every
-        turning point and a regular subset of the samples: the play outputs there are exact
-        (rate independence), and the cost weights the record as the whole does. Returns the
-        indices kept and the position of the first sample in the cost among them.
-    """
-    keep = thin(rec.u, rec.start, scoring.MAX_SAMPLES)
-    return keep, int(np.searchsorted(keep, rec.start))
+    return PreparedRecord(v, x, v0, u, start, span, x_span / span, keep)
 
 
 @dataclass(frozen=True)
@@ -231,8 +235,7 @@ def fit_pi(
     r = play_thresholds(n, rec.input_span, constraints)
     y0 = np.full(n, rec.u[0])
     x_ref = float(rec.x[rec.start :].min())
-    keep, first = thinned(rec)
-    gram = normal_equations(rec.u[keep], r, y0, rec.x[keep] - x_ref, np.empty(0), first)
+    gram = normal_equations(rec.u, r, y0, rec.x - x_ref, np.empty(0), rec.start)
     sol = constrained_lsq(
         gram,
         blocks=[(0, n, margin * rec.slope)],
@@ -245,6 +248,6 @@ def fit_pi(
         initial_state=y0,
         input_offset=rec.input_offset,
         output_offset=x_ref + float(sol.coef[n]),
-        first_sample=rec.start,
-        samples=keep,
+        first_sample=int(rec.samples[rec.start]),
+        samples=rec.samples,
     )

@@ -153,9 +153,10 @@ class ModifiedPrandtlIshlinskii(PrandtlIshlinskii):
             regularizations=penalties,
             constraints=self.constraints,
         )
-        voltage_range = fit_voltage_range(self.voltage_range, v, owner)
-        # scored on the samples the fit used (a long record is thinned, see fit_mpi_path)
+        # scored on the samples the fit used (a long record is thinned, see fit_mpi_path);
+        # they hold the extremes of the input
         v_k, x_k, first = thinned_record(v, x, fits[0])
+        voltage_range = fit_voltage_range(self.voltage_range, v_k, owner)
         score = tracking_scorer(v_k, x_k, start=first)
         candidates = []
         for penalty, fit in zip(penalties, fits, strict=True):

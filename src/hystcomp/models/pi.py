@@ -150,15 +150,16 @@ class PrandtlIshlinskii(HysteresisModel):
             margin=self.margin,
             constraints=self.constraints,
         )
+        # the samples the fit ran over: they hold the extremes of the input (thin)
+        v_k, x_k, first = thinned_record(v, x, fit)
         fitted = self.from_parameters(
             thresholds=fit.thresholds,
             weights=fit.weights,
             initial_state=fit.initial_state,
-            voltage_range=fit_voltage_range(self.voltage_range, v, owner),
+            voltage_range=fit_voltage_range(self.voltage_range, v_k, owner),
             input_offset=fit.input_offset,
             output_offset=fit.output_offset,
         )
-        v_k, x_k, first = thinned_record(v, x, fit)
         self._adopt_fit(fitted, v_k, x_k, first, compensation_error(fitted, v_k, x_k, start=first))
         return self
 
