@@ -74,12 +74,13 @@ from hystcomp._hyperparameters import (
 )
 from hystcomp._validation import as_vector, check_int, check_real
 from hystcomp.errors import InvalidParameterError
-from hystcomp.identify.lsq import RIDGE, constrained_lsq, normal_equations
+from hystcomp.identify.lsq import RIDGE, constrained_lsq, held_out_fits, normal_equations
 from hystcomp.identify.pi import (
     paper_thresholds,
     play_thresholds,
     prepare_record,
 )
+from hystcomp.identify.scoring import reversal_folds
 
 #: Candidate values of ``regularization`` for a choice: none, then one per decade.
 REGULARIZATION_GRID = (0.0, 1e-4, 1e-3, 1e-2, 1e-1)
@@ -105,6 +106,11 @@ class MPIFit:
         subset (:func:`~hystcomp.identify.scoring.thin`).
     first_sample : int
         First sample of the record in the cost.
+    folds : ndarray or None
+        With ``held_out``: the fold of each of the ``samples`` (-1 before the first).
+    held_out : tuple of MPIFit
+        Fit ``f`` of the same options on every fold but fold ``f`` (:func:`fit_mpi_path`
+        with ``n_folds``), or empty.
     """
 
     thresholds: np.ndarray
@@ -116,6 +122,8 @@ class MPIFit:
     output_offset: float
     first_sample: int
     samples: np.ndarray | None = None
+    folds: np.ndarray | None = None
+    held_out: tuple = ()
 
 
 def absorb_bias(weights, initial_state, input_offset: float, bias: float):
@@ -211,6 +219,7 @@ def fit_mpi_path(
     margin=DEFAULT_MARGIN,
     regularizations=REGULARIZATION_GRID,
     constraints="physical",
+    n_folds=0,
 ) -> list[MPIFit]:
     """:func:`fit_mpi` for several values of ``regularization`` at the cost of about one.
 
@@ -223,6 +232,13 @@ def fit_mpi_path(
         As in :func:`fit_mpi`.
     regularizations : sequence of float, default :data:`REGULARIZATION_GRID`
         The penalties (>= 0), in the order of the fits returned.
+    n_folds : int, default 0
+        With 2 or more, also fit each value on all but one fold of the record's reversal
+        segments (:func:`~hystcomp.identify.scoring.reversal_folds`), for every fold, from
+        the same pass over the record (``MPIFit.held_out``; see
+        :func:`~hystcomp.identify.compensation.tracking_scorer`). Empty if a fold cannot
+        be left out (a record of fewer segments, or one whose other folds do not determine
+        the fit).
 
     Returns
     -------
@@ -240,6 +256,7 @@ def fit_mpi_path(
             f"The 'regularizations' parameter of {owner} must hold at least one value >= 0. "
             "Got an empty sequence instead."
         )
+    n_folds = check_int(n_folds, "n_folds", owner, minimum=0)
     rec = prepare_record(v, x, n_weights=n + m, transient=transient, owner=owner)
     r = play_thresholds(n, rec.input_span, constraints)
     y0 = np.full(n, rec.u[0])
@@ -247,9 +264,11 @@ def fit_mpi_path(
     z = rec.x - x0
     z_span = float(z[rec.start :].max())
     rs = paper_thresholds(m, z_span)  # eq. (17)
-    gram = normal_equations(rec.u, r, y0, z, rs[1:], rec.start)
-    fits = []
-    for penalty in penalties:
+    folds = reversal_folds(rec.u, rec.start, n_folds) if n_folds > 1 else None
+    grams = normal_equations(rec.u, r, y0, z, rs[1:], rec.start, folds, max(n_folds, 1))
+    gram = grams.sum(axis=0) if folds is not None else grams
+
+    def solve(gram, penalty, **extra) -> MPIFit:
         sol = constrained_lsq(
             gram,
             blocks=[(0, n, margin * rec.slope), (n, n + m - 1, margin - 1.0)],
@@ -259,17 +278,21 @@ def fit_mpi_path(
         )
         weights = sol.coef[:n]
         initial_state, input_offset = absorb_bias(weights, y0, rec.input_offset, sol.coef[-1])
-        fits.append(
-            MPIFit(
-                thresholds=r,
-                weights=weights,
-                initial_state=initial_state,
-                inverse_deadzone_thresholds=rs,
-                inverse_deadzone_weights=np.r_[1.0, sol.coef[n : n + m - 1]],
-                input_offset=input_offset,
-                output_offset=x0,
-                first_sample=int(rec.samples[rec.start]),
-                samples=rec.samples,
-            )
+        return MPIFit(
+            thresholds=r,
+            weights=weights,
+            initial_state=initial_state,
+            inverse_deadzone_thresholds=rs,
+            inverse_deadzone_weights=np.r_[1.0, sol.coef[n : n + m - 1]],
+            input_offset=input_offset,
+            output_offset=x0,
+            first_sample=int(rec.samples[rec.start]),
+            samples=rec.samples,
+            **extra,
         )
+
+    fits = []
+    for penalty in penalties:
+        held_out = () if folds is None else held_out_fits(grams, lambda g, p=penalty: solve(g, p))
+        fits.append(solve(gram, penalty, folds=folds if held_out else None, held_out=held_out))
     return fits

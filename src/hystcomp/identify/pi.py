@@ -44,8 +44,8 @@ from hystcomp._hyperparameters import DEFAULT_MARGIN, check_constraints, check_m
 from hystcomp._validation import as_signal, check_int, check_real
 from hystcomp.errors import IdentificationError, InvalidSignalError
 from hystcomp.identify import scoring
-from hystcomp.identify.lsq import constrained_lsq, normal_equations
-from hystcomp.identify.scoring import check_response, check_transient, thin
+from hystcomp.identify.lsq import constrained_lsq, held_out_fits, normal_equations
+from hystcomp.identify.scoring import check_response, check_transient, reversal_folds, thin
 
 
 def paper_thresholds(n_operators: int, span: float) -> np.ndarray:
@@ -170,6 +170,10 @@ class PIFit:
         subset (:func:`~hystcomp.identify.scoring.thin`).
     first_sample : int
         First sample of the record in the cost (after the start-up transient).
+    folds : ndarray or None
+        With ``held_out``: the fold of each of the ``samples`` (-1 before the first).
+    held_out : tuple of PIFit
+        Fit ``f`` on every fold but fold ``f`` (:func:`fit_pi` with ``n_folds``), or empty.
     """
 
     thresholds: np.ndarray
@@ -179,6 +183,8 @@ class PIFit:
     output_offset: float
     first_sample: int
     samples: np.ndarray | None = None
+    folds: np.ndarray | None = None
+    held_out: tuple = ()
 
 
 def fit_pi(
@@ -189,6 +195,7 @@ def fit_pi(
     transient=None,
     margin=DEFAULT_MARGIN,
     constraints="physical",
+    n_folds=0,
 ) -> PIFit:
     """Identify a classical PI model (eq. 12) from a measured record by constrained least squares.
 
@@ -214,6 +221,9 @@ def fit_pi(
     constraints : {"physical", "paper"}, default "physical"
         ``"physical"``: also ``w_i >= 0`` beyond the first weight; ``"paper"``: the
         partial-sum constraints only, eq. (12) as the paper fits it.
+    n_folds : int, default 0
+        With 2 or more, also fit on all but one fold of the record's reversal segments, for
+        every fold (``PIFit.held_out``), as :func:`~hystcomp.identify.mpi.fit_mpi_path`.
 
     Returns
     -------
@@ -231,23 +241,35 @@ def fit_pi(
     n = check_int(n_operators, "n_operators", owner)
     margin = check_margin(margin, owner)
     constraints = check_constraints(constraints, owner)
+    n_folds = check_int(n_folds, "n_folds", owner, minimum=0)
     rec = prepare_record(v, x, n_weights=n + 1, transient=transient, owner=owner)
     r = play_thresholds(n, rec.input_span, constraints)
     y0 = np.full(n, rec.u[0])
     x_ref = float(rec.x[rec.start :].min())
-    gram = normal_equations(rec.u, r, y0, rec.x - x_ref, np.empty(0), rec.start)
-    sol = constrained_lsq(
-        gram,
-        blocks=[(0, n, margin * rec.slope)],
-        floors=[(1, n, 0.0)] if constraints == "physical" else (),
-        scales=np.full(n, rec.input_span),
+    folds = reversal_folds(rec.u, rec.start, n_folds) if n_folds > 1 else None
+    grams = normal_equations(
+        rec.u, r, y0, rec.x - x_ref, np.empty(0), rec.start, folds, max(n_folds, 1)
     )
-    return PIFit(
-        thresholds=r,
-        weights=sol.coef[:n],
-        initial_state=y0,
-        input_offset=rec.input_offset,
-        output_offset=x_ref + float(sol.coef[n]),
-        first_sample=int(rec.samples[rec.start]),
-        samples=rec.samples,
-    )
+
+    def solve(gram, **extra) -> PIFit:
+        sol = constrained_lsq(
+            gram,
+            blocks=[(0, n, margin * rec.slope)],
+            floors=[(1, n, 0.0)] if constraints == "physical" else (),
+            scales=np.full(n, rec.input_span),
+        )
+        return PIFit(
+            thresholds=r,
+            weights=sol.coef[:n],
+            initial_state=y0,
+            input_offset=rec.input_offset,
+            output_offset=x_ref + float(sol.coef[n]),
+            first_sample=int(rec.samples[rec.start]),
+            samples=rec.samples,
+            **extra,
+        )
+
+    if folds is None:
+        return solve(grams)
+    held_out = held_out_fits(grams, solve)
+    return solve(grams.sum(axis=0), folds=folds if held_out else None, held_out=held_out)

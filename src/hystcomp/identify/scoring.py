@@ -118,6 +118,29 @@ def thin(v, start: int = 0, max_samples: int = MAX_SAMPLES) -> np.ndarray:
     return np.flatnonzero(keep)
 
 
+def reversal_folds(v, start: int, n_folds: int) -> np.ndarray:
+    """Folds of a record for cross-validation: its reversal segments dealt out in turn.
+
+    The samples from ``start`` on are cut at the turning points of the input into segments
+    (monotone stretches between reversals), and segment ``i`` goes to fold ``i % n_folds``:
+    every fold holds ascending and descending branches from all over the record, and a
+    model fitted on the other folds must predict whole branches it has not seen. Samples
+    before ``start`` get -1.
+
+    Examples
+    --------
+    >>> reversal_folds(np.array([0.0, 2.0, 4.0, 2.0, 0.0, 3.0, 1.0]), 0, 2).tolist()
+    [0, 0, 0, 1, 1, 0, 1]
+    """
+    v = np.asarray(v, dtype=np.float64)
+    sign = np.sign(np.diff(v[start:]))
+    turns = np.zeros(v.size - start, dtype=np.int64)
+    turns[2:] = sign[1:] != sign[:-1]  # a segment starts just after each turning point
+    folds = np.full(v.size, -1, dtype=np.int64)
+    folds[start:] = np.cumsum(turns) % n_folds
+    return folds
+
+
 #: Least share of the displacement's variance that a straight line in the voltage must
 #: explain for a record to count as a response. Real records explain 0.95 and more; a
 #: loop that turns back (a partial sum of PI weights below 0) still about 0.2; noise
