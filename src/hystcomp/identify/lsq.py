@@ -220,25 +220,22 @@ def constrained_lsq(
     quad = G_c[np.ix_(idx, idx)] * np.outer(scale, scale)
     quad[np.diag_indices_from(quad)] += np.broadcast_to(ridge, (p - 1,))[idx]
     lin = g_c[idx] * scale
-    rows, bounds = [], []
-    for first, stop, bound in blocks:
-        for i in range(first, stop):
-            if varies[i]:  # partial sums at a fixed (zero) coefficient repeat the one before
-                rows.append(np.where((idx >= first) & (idx <= i), scale, 0.0))
-                bounds.append(bound)
-    for first, stop, bound in caps:
-        for i in range(first, stop):
-            if varies[i]:
-                rows.append(np.where((idx >= first) & (idx <= i), -scale, 0.0))
-                bounds.append(-bound)
-    for first, stop, bound in floors:
-        for i in range(first, stop):
-            if varies[i]:
-                rows.append(np.where(idx == i, scale, 0.0))
-                bounds.append(bound)
-    cons = np.array(rows, dtype=np.float64).reshape(len(rows), idx.size)
+    rows, bounds = [np.empty((0, idx.size))], [np.empty(0)]
+    # one row per coefficient that varies (partial sums at a fixed, zero, coefficient
+    # repeat the one before): partial sums from `first` for blocks and caps, itself for floors
+    for group, sign, partial in ((blocks, 1.0, True), (caps, -1.0, True), (floors, 1.0, False)):
+        for first, stop, bound in group:
+            i = np.arange(first, stop)
+            i = i[varies[first:stop]]
+            if partial:
+                mask = (idx[None, :] >= first) & (idx[None, :] <= i[:, None])
+            else:
+                mask = idx[None, :] == i[:, None]
+            rows.append(np.where(mask, sign * scale, 0.0))
+            bounds.append(np.full(i.size, sign * bound))
+    cons = np.vstack(rows)
     try:
-        solution = quadprog.solve_qp(quad, lin, cons.T.copy(), np.array(bounds, dtype=float))[0]
+        solution = quadprog.solve_qp(quad, lin, cons.T.copy(), np.concatenate(bounds))[0]
     except ValueError as exc:
         raise IdentificationError(
             f"The constrained least-squares problem could not be solved ({exc}). Check that "

@@ -47,15 +47,15 @@ model then explains the record with ``H`` first and bends ``S`` only where the d
 it. It biases the fit of a true MPI system (about 0.5 % of the range at 1e-3), so it is chosen
 for compensation, not for fit: ``ModifiedPrandtlIshlinskii(regularization="auto")``, the
 default, fits every value of :data:`REGULARIZATION_GRID` at the cost of about one fit
-(:func:`fit_mpi_path`) and keeps the one whose compensator has the smallest estimated
-tracking error (:func:`hystcomp.identify.compensation.compensation_error`: the inverse run
-on the measured displacement, its voltage error mapped to µm through the record's gain).
-On the panel of ``benchmarks/bench_accuracy.py`` (5 actuators x 4 excitations) the value
-it chooses tracks within 0.025x of the uncompensated error of the best value of the grid in
-every cell (0.008x on average); the smallest fit error, the former criterion, comes within
-0.042x (0.007x on average): once the physical constraints are on, the two criteria agree on
-most records, and the estimate guards against the inverse's failures the fit error cannot
-see (steep slopes, clamping). With a second record of the actuator,
+(:func:`fit_mpi_path`), each also on every fold but one of the record's reversal segments
+(``n_folds``, from the same pass), and keeps the one whose held-out fits predict the
+branches they did not see best, forward and through their inverse
+(:func:`hystcomp.identify.compensation.tracking_scorer`, ``criterion_um``). On the panel
+of ``benchmarks/bench_accuracy.py`` (5 actuators x 4 excitations) the value it chooses
+tracks within 0.015x of the uncompensated error of the best value of the grid in every cell
+(0.005x on average); the smallest fit error, the former criterion, comes within 0.042x,
+and the inverse's estimate on the whole record within 0.025x.
+With a second record of the actuator,
 :func:`hystcomp.identify.validation.choose_regularization` chooses by prediction instead.
 """
 

@@ -48,10 +48,11 @@ class ModifiedPrandtlIshlinskii(PrandtlIshlinskii):
         deviation from the paper for records of actuators that are not exactly MPI systems
         (see :mod:`hystcomp.identify.mpi`). ``"auto"`` fits every value of
         :data:`~hystcomp.identify.mpi.REGULARIZATION_GRID` (0 included) and keeps the model
-        whose compensator has the smallest *estimated tracking error*
-        (:func:`hystcomp.identify.compensation.compensation_error`), not the smallest fit
-        error: a model that reproduces its record best can still have an inverse with steep
-        slopes. With a second record of the actuator, choose it by prediction there with
+        that predicts tracking best by cross-validation over the record's reversal
+        segments (``fit_report_["criterion_um"]``, see
+        :func:`hystcomp.identify.compensation.tracking_scorer`), not the smallest fit
+        error: a model that reproduces its record best can still predict other branches
+        worse, or have an inverse with steep slopes. With a second record of the actuator, choose it by prediction there with
         :func:`hystcomp.identify.validation.choose_regularization`.
     constraints : {"physical", "paper"}, default "physical"
         ``"physical"``: play weights beyond the first are non-negative and ``S`` stays
@@ -72,8 +73,10 @@ class ModifiedPrandtlIshlinskii(PrandtlIshlinskii):
     fit_report_ : dict
         After :meth:`fit`: errors of the model on the record, the ``regularization`` it was
         fitted with (the chosen value if ``"auto"``), ``tracking_rms_um`` (the estimated
-        tracking error of its compensator, µm rms) and ``baseline_tracking_rms_um`` (the same
-        for a straight line ``v = x / k_lin``).
+        tracking error of its compensator, µm rms), ``baseline_tracking_rms_um`` (the same
+        for a straight line ``v = x / k_lin``), and the cross-validated errors
+        ``held_out_rms_um``, ``held_out_tracking_rms_um`` and ``criterion_um``
+        (:func:`hystcomp.identify.compensation.tracking_scorer`).
 
     Examples
     --------
