@@ -25,7 +25,9 @@ regularisation by each (measured ratio of the one it ranks first minus the best)
 Run alone with ``python benchmarks/bench_accuracy.py`` (about two minutes; prints the table).
 ``--paper`` prints the same table for the paper's fits (constraints="paper", regularization 0,
 the Preisach cubic from reversal curves, which only the sinusoids have: ``n/a`` elsewhere);
-``--preisach`` prints the comparison of the Preisach fits; ``--rho`` the rank correlations.
+``--preisach`` prints the comparison of the Preisach fits; ``--rho`` the rank correlations;
+``--limit`` the best MPI tracking of any size and regularisation on the quasi-static
+hysteresis of the twin and the Bouc-Wen stage (:func:`family_limit`).
 """
 
 from __future__ import annotations
@@ -37,7 +39,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from benchmarks.panel import ACTUATORS, EXCITATIONS, Bench
+from benchmarks.panel import ACTUATORS, EXCITATIONS, V_MAX, Bench, excitation
 
 from hystcomp import ModifiedPrandtlIshlinskii, PrandtlIshlinskii, Preisach
 from hystcomp.identify.mpi import REGULARIZATION_GRID
@@ -148,6 +150,40 @@ def criterion_rank_correlation(actuators=ACTUATORS, excitations=EXCITATIONS) -> 
     return out
 
 
+def family_limit(actuators=("twin", "boucwen"), grid=(0.0, 1e-3, 1e-2, 1e-1, 1.0)) -> dict:
+    """Best MPI tracking on an actuator's quasi-static hysteresis, for the MPI family's limit.
+
+    Without creep, resonance or noise (:meth:`benchmarks.panel.Actuator.hysteresis`, the
+    twin's too), from the paper's triangles and from a 0..120 V triangle (the loop that
+    is tracked), the MPI fits of 16 and 32 plays and dead-zones with every
+    ``regularization`` of ``grid``: ``{(actuator, record): (best ratio, operators,
+    regularization)}``, the tracking error of the reference through the same quasi-static
+    hysteresis over the bench's uncompensated error. If the best is above the 0.2 target,
+    no choice of hyperparameters of the family reaches it on that actuator and record.
+    """
+    out = {}
+    for name in actuators:
+        bench = Bench(name)
+        static = bench.act.hysteresis
+        ramp = np.linspace(0.0, V_MAX, 20001)
+        records = {"pi": excitation("pi", bench.act.sample_rate)}
+        records["0..120 V loop"] = np.tile(np.r_[ramp, ramp[::-1][1:-1]], 3)
+        window = slice(bench.period, None)
+        for label, v in records.items():
+            x = static(v)
+            best = (np.inf, 0, 0.0)
+            for n in (16, 32):
+                for value in grid:
+                    model = ModifiedPrandtlIshlinskii(
+                        n_operators=n, n_deadzones=n, regularization=value
+                    ).fit(v, x)
+                    e = static(model.inverse().simulate(bench.x_ref)) - bench.x_ref
+                    ratio = float(np.sqrt(np.mean(e[window] ** 2))) / bench.baseline_rms
+                    best = min(best, (ratio, n, value))
+            out[name, label] = best
+    return out
+
+
 def format_table(table, columns=("PI", "MPI", "Preisach")) -> str:
     """The table as text, one row per cell, ``n/a`` where a fit has no figure."""
     width = max(9, *(len(c) for c in columns))
@@ -230,6 +266,12 @@ if __name__ == "__main__":
     print(format_table(ratio_table(paper="--paper" in sys.argv)))
     if "--preisach" in sys.argv:
         print(format_table(preisach_table(), columns=tuple(PREISACH_FITS)))
+    if "--limit" in sys.argv:
+        for (name, label), (ratio, n, value) in family_limit().items():
+            print(
+                f"{name} quasi-static, from {label}: best MPI {ratio:.3f} ({n} operators, "
+                f"regularization {value:g})"
+            )
     if "--rho" in sys.argv:
         for crit, (rhos, regrets) in criterion_rank_correlation().items():
             print(f"{crit:>9}: rho per cell", " ".join(f"{r:.2f}" for r in rhos))

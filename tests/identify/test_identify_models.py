@@ -20,7 +20,7 @@ from hystcomp.identify.compensation import CV_FOLDS
 from hystcomp.identify.excitation import PI_AMPLITUDES, scaled_amplitudes, triangle_sequence
 from hystcomp.identify.mpi import REGULARIZATION_GRID, absorb_bias, fit_mpi, fit_mpi_path
 from hystcomp.identify.pi import fit_pi
-from hystcomp.identify.scoring import transient_end
+from hystcomp.identify.scoring import reversal_folds, transient_end
 from hystcomp.identify.validation import choose_regularization
 from hystcomp.plant import Twin
 from tests import naive
@@ -375,3 +375,27 @@ def test_regularization_and_validation_arguments_are_checked():
         choose_regularization(hystcomp.ModifiedPrandtlIshlinskii(), v, x, v, x, grid=[])
     with pytest.raises(InvalidSignalError, match=r"one sample each per instant"):
         choose_regularization(hystcomp.ModifiedPrandtlIshlinskii(), v, x, v, x[:-1])
+
+
+def test_held_out_fits_do_not_see_their_fold():
+    """Fit f of the cross-validation is the fit on every fold but f: changing the
+    displacement on fold f's samples (extremes aside) changes the whole fit, not fit f."""
+    _, v = triangle_sequence(sample_rate=1000.0)
+    x = Twin(seed=5).run(np.repeat(v, 20))[::20]
+    start = transient_end(v)
+    folds = reversal_folds(v, start, 3)
+    changed = x.copy()
+    mine = (folds == 1) & (x > x.min() + 0.1) & (x < x.max() - 0.1)
+    changed[mine] += 0.05 * np.sin(np.arange(mine.sum()))  # the extremes stay
+    for fit in (
+        lambda x: fit_pi(v, x, n_folds=3),
+        lambda x: fit_mpi_path(v, x, regularizations=(1e-2,), n_folds=3)[0],
+    ):
+        before, after = fit(x), fit(changed)
+        np.testing.assert_array_equal(before.folds, folds)
+        assert len(before.held_out) == len(after.held_out) == 3
+        np.testing.assert_allclose(
+            after.held_out[1].weights, before.held_out[1].weights, rtol=1e-9, atol=1e-12
+        )
+        assert not np.allclose(after.held_out[0].weights, before.held_out[0].weights)
+        assert not np.allclose(after.weights, before.weights)
