@@ -57,6 +57,17 @@ tracks within 0.015x of the uncompensated error of the best value of the grid in
 and the inverse's estimate on the whole record within 0.025x.
 With a second record of the actuator,
 :func:`hystcomp.identify.validation.choose_regularization` chooses by prediction instead.
+
+Limits of the family. ``S`` bends the loop as a function of the *output* level, so an
+actuator whose loop width depends on the *input* level in another way than its loading
+curve's slope (a Bouc-Wen stage whose hysteretic gain vanishes at 0 V, where every loop
+closes) is beyond any MPI model. On the quasi-static hysteresis of the panel's Bouc-Wen
+stage (no creep, resonance or noise), the best MPI of 16 or 32 plays and dead-zones over
+every regularisation tracks the 1 Hz triangle at 0.48x the uncompensated error from the
+paper's triangles, and still 0.36x when fitted on the tracked 0..120 V loop itself; on the
+twin, 0.22x from the nested triangles but 0.11x from the 0..120 V loop: one set of
+weights cannot match loops of every amplitude (``python benchmarks/bench_accuracy.py
+--limit``).
 """
 
 from __future__ import annotations
