@@ -95,19 +95,23 @@ def normal_equations(
     gram = np.zeros((n_folds if folds is not None else 1, n + m + 2, n + m + 2))
     rows = np.empty((max(_BLOCK, start), n + m + 2))
     _regressor_rows(u, r, y, z, rs, 0, rows[:start])  # the plays' state at `start`
-    # where the fold changes (a fold is a set of whole runs of samples)
+    # where the fold changes (a fold is a set of whole runs of samples), and which blocks
+    # hold a change (most do not: a run is a whole reversal segment)
     changes = np.empty(0, np.int64) if folds is None else np.flatnonzero(np.diff(folds)) + 1
-    for begin in range(start, u.size, _BLOCK):
+    mixed = set(((changes[changes > start] - start - 1) // _BLOCK).tolist())
+    for block, begin in enumerate(range(start, u.size, _BLOCK)):
         part = rows[: min(_BLOCK, u.size - begin)]
         _regressor_rows(u, r, y, z, rs, begin, part)
         if folds is None:
             gram[0] += part.T @ part
-            continue
-        lo, hi = np.searchsorted(changes, (begin, begin + part.shape[0]), side="right")
-        cuts = [0, *(changes[lo:hi] - begin), part.shape[0]]
-        for a, b in itertools.pairwise(cuts):  # runs of one fold each
-            piece = part[a:b]
-            gram[folds[begin + a]] += piece.T @ piece
+        elif block not in mixed:
+            gram[folds[begin]] += part.T @ part
+        else:
+            lo, hi = np.searchsorted(changes, (begin, begin + part.shape[0]), side="right")
+            cuts = [0, *(changes[lo:hi] - begin), part.shape[0]]
+            for a, b in itertools.pairwise(cuts):  # runs of one fold each
+                piece = part[a:b]
+                gram[folds[begin + a]] += piece.T @ piece
     sign = np.r_[np.ones(n), -np.ones(m), 1.0, 1.0]  # the dead-zone regressors are negated
     gram *= np.outer(sign, sign)
     return gram if folds is not None else gram[0]

@@ -279,13 +279,16 @@ def fit_mpi_path(
     grams = normal_equations(rec.u, r, y0, z, rs[1:], rec.start, folds, max(n_folds, 1))
     gram = grams.sum(axis=0) if folds is not None else grams
 
+    scales = np.concatenate([np.full(n, rec.input_span), np.full(m - 1, z_span)])
+    on_deadzones = np.concatenate([np.zeros(n), np.ones(m - 1)])
+
     def solve(gram, penalty, **extra) -> MPIFit:
         sol = constrained_lsq(
             gram,
             blocks=[(0, n, margin * rec.slope), (n, n + m - 1, margin - 1.0)],
             floors=[(1, n, 0.0)] if constraints == "physical" else (),
-            scales=np.r_[np.full(n, rec.input_span), np.full(m - 1, z_span)],
-            ridge=RIDGE + np.r_[np.zeros(n), np.full(m - 1, penalty)],
+            scales=scales,
+            ridge=RIDGE + penalty * on_deadzones,
         )
         weights = sol.coef[:n]
         initial_state, input_offset = absorb_bias(weights, y0, rec.input_offset, sol.coef[-1])
