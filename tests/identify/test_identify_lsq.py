@@ -8,6 +8,7 @@ from hystcomp._kernels import chain
 from hystcomp.identify.excitation import triangle_sequence
 from hystcomp.identify.lsq import constrained_lsq, normal_equations
 from hystcomp.identify.pi import paper_thresholds
+from hystcomp.identify.scoring import reversal_folds
 from tests import naive
 from tests.conftest import random_walk
 
@@ -93,3 +94,24 @@ def test_regressors_that_never_move_are_fixed_at_zero():
     assert sol.varies.tolist() == [True] * 4 + [False] * 4
     np.testing.assert_array_equal(sol.coef[4:8], 0.0)
     np.testing.assert_allclose(sol.coef[:4], [2.0, 1.0, 0.5, 0.3], atol=1e-8)
+
+
+def test_fold_grams_are_each_folds_samples_and_sum_to_the_whole(rng):
+    u = random_walk(rng, 2500, 0.0, 10.0, 0.8)
+    z = 3.0 * u + rng.normal(size=u.size)
+    r, y0, rs = np.array([0.0, 1.0, 2.5]), np.zeros(3), np.array([4.0, 15.0])
+    start = 37
+    folds = reversal_folds(u, start, 3)
+    grams = normal_equations(u, r, y0, z, rs, start, folds, 3)
+    full = np.column_stack([_design(u, r, y0, z, rs), z])
+    for f in range(3):
+        part = full[(folds == f) & (np.arange(u.size) >= start)]
+        np.testing.assert_allclose(grams[f], part.T @ part, rtol=1e-11, atol=1e-6)
+    np.testing.assert_allclose(
+        grams.sum(axis=0), normal_equations(u, r, y0, z, rs, start), rtol=1e-11, atol=1e-6
+    )
+
+
+def test_reversal_folds_deal_whole_segments_in_turn():
+    v = np.array([0.0, 1.0, 3.0, 2.0, 0.0, 1.0, 5.0, 4.0, 4.5])
+    np.testing.assert_array_equal(reversal_folds(v, 1, 2), [-1, 0, 0, 1, 1, 0, 0, 1, 0])

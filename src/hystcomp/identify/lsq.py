@@ -21,6 +21,7 @@ Goldfarb-Idnani dual active-set method, like the paper's Matlab ``quadprog``).
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass
 
 import numba
@@ -54,7 +55,9 @@ def _regressor_rows(u, r, y, z, rs, begin, rows):
         rows[i, n + m + 1] = z[k]
 
 
-def normal_equations(u, thresholds, initial_state, z, deadzone_thresholds, start) -> np.ndarray:
+def normal_equations(
+    u, thresholds, initial_state, z, deadzone_thresholds, start, folds=None, n_folds=1
+) -> np.ndarray:
     """The augmented Gram matrix of the PI/MPI regressors over samples ``start..``.
 
     Parameters
@@ -69,10 +72,16 @@ def normal_equations(u, thresholds, initial_state, z, deadzone_thresholds, start
         Positive thresholds ``r'_1..r'_m`` of the inverse dead-zones in µm (empty for PI).
     start : int
         First sample in the sums (the start-up transient before it is left out).
+    folds : ndarray of int, optional
+        A fold ``0..n_folds - 1`` for every sample (:func:`~hystcomp.identify.scoring.
+        reversal_folds`): then one Gram matrix per fold, each over its own samples, in one
+        pass (their sum is the matrix over every sample).
+    n_folds : int, default 1
+        Number of folds (with ``folds``).
 
     Returns
     -------
-    ndarray, shape (p + 1, p + 1)
+    ndarray, shape (p + 1, p + 1), or (n_folds, p + 1, p + 1) with ``folds``
         ``[Phi | z]^T [Phi | z]`` with ``p = n + m + 1`` regressors (plays, negated
         dead-zones, constant) and the target last.
     """
@@ -83,15 +92,29 @@ def normal_equations(u, thresholds, initial_state, z, deadzone_thresholds, start
     z = np.ascontiguousarray(z, dtype=np.float64)
     rs = np.ascontiguousarray(deadzone_thresholds, dtype=np.float64)
     start = int(start)
-    gram = np.zeros((n + m + 2, n + m + 2))
+    gram = np.zeros((n_folds if folds is not None else 1, n + m + 2, n + m + 2))
     rows = np.empty((max(_BLOCK, start), n + m + 2))
     _regressor_rows(u, r, y, z, rs, 0, rows[:start])  # the plays' state at `start`
-    for begin in range(start, u.size, _BLOCK):
+    # where the fold changes (a fold is a set of whole runs of samples), and which blocks
+    # hold a change (most do not: a run is a whole reversal segment)
+    changes = np.empty(0, np.int64) if folds is None else np.flatnonzero(np.diff(folds)) + 1
+    mixed = set(((changes[changes > start] - start - 1) // _BLOCK).tolist())
+    for block, begin in enumerate(range(start, u.size, _BLOCK)):
         part = rows[: min(_BLOCK, u.size - begin)]
         _regressor_rows(u, r, y, z, rs, begin, part)
-        gram += part.T @ part
+        if folds is None:
+            gram[0] += part.T @ part
+        elif block not in mixed:
+            gram[folds[begin]] += part.T @ part
+        else:
+            lo, hi = np.searchsorted(changes, (begin, begin + part.shape[0]), side="right")
+            cuts = [0, *(changes[lo:hi] - begin), part.shape[0]]
+            for a, b in itertools.pairwise(cuts):  # runs of one fold each
+                piece = part[a:b]
+                gram[folds[begin + a]] += piece.T @ piece
     sign = np.r_[np.ones(n), -np.ones(m), 1.0, 1.0]  # the dead-zone regressors are negated
-    return gram * np.outer(sign, sign)
+    gram *= np.outer(sign, sign)
+    return gram if folds is not None else gram[0]
 
 
 @dataclass(frozen=True)
@@ -201,25 +224,22 @@ def constrained_lsq(
     quad = G_c[np.ix_(idx, idx)] * np.outer(scale, scale)
     quad[np.diag_indices_from(quad)] += np.broadcast_to(ridge, (p - 1,))[idx]
     lin = g_c[idx] * scale
-    rows, bounds = [], []
-    for first, stop, bound in blocks:
-        for i in range(first, stop):
-            if varies[i]:  # partial sums at a fixed (zero) coefficient repeat the one before
-                rows.append(np.where((idx >= first) & (idx <= i), scale, 0.0))
-                bounds.append(bound)
-    for first, stop, bound in caps:
-        for i in range(first, stop):
-            if varies[i]:
-                rows.append(np.where((idx >= first) & (idx <= i), -scale, 0.0))
-                bounds.append(-bound)
-    for first, stop, bound in floors:
-        for i in range(first, stop):
-            if varies[i]:
-                rows.append(np.where(idx == i, scale, 0.0))
-                bounds.append(bound)
-    cons = np.array(rows, dtype=np.float64).reshape(len(rows), idx.size)
+    rows, bounds = [np.empty((0, idx.size))], [np.empty(0)]
+    # one row per coefficient that varies (partial sums at a fixed, zero, coefficient
+    # repeat the one before): partial sums from `first` for blocks and caps, itself for floors
+    for group, sign, partial in ((blocks, 1.0, True), (caps, -1.0, True), (floors, 1.0, False)):
+        for first, stop, bound in group:
+            i = np.arange(first, stop)
+            i = i[varies[first:stop]]
+            if partial:
+                mask = (idx[None, :] >= first) & (idx[None, :] <= i[:, None])
+            else:
+                mask = idx[None, :] == i[:, None]
+            rows.append(np.where(mask, sign * scale, 0.0))
+            bounds.append(np.full(i.size, sign * bound))
+    cons = np.vstack(rows)
     try:
-        solution = quadprog.solve_qp(quad, lin, cons.T.copy(), np.array(bounds, dtype=float))[0]
+        solution = quadprog.solve_qp(quad, lin, cons.T.copy(), np.concatenate(bounds))[0]
     except ValueError as exc:
         raise IdentificationError(
             f"The constrained least-squares problem could not be solved ({exc}). Check that "
@@ -231,6 +251,23 @@ def constrained_lsq(
     coef[-1] = z_mean - mean @ coef[:-1]
     rss = float(zz - 2.0 * g @ coef + coef @ G @ coef)
     return LsqSolution(coef=coef, rss=max(rss, 0.0), varies=varies)
+
+
+def held_out_fits(grams, solve) -> tuple:
+    """``solve(G - G_f)`` for every fold ``f`` of per-fold Gram matrices ``grams``, or ``()``.
+
+    The fits of a cross-validation over the folds of :func:`normal_equations` (with
+    ``folds``), each on every fold but one. Empty if a fold has no sample or if the other
+    folds do not determine a fit (an :class:`~hystcomp.errors.IdentificationError`).
+    """
+    counts = grams[:, -2, -2]  # the constant regressor's square: the samples of each fold
+    if not np.all(counts > 0):
+        return ()
+    total = grams.sum(axis=0)
+    try:
+        return tuple(solve(total - grams[f]) for f in range(grams.shape[0]))
+    except IdentificationError:
+        return ()
 
 
 def solve_inequality_qp(

@@ -28,7 +28,9 @@ with the thresholds below).
 The physical fit also spreads its thresholds over half the input span, where the plays
 can move (:func:`play_thresholds`). Records longer than
 :data:`~hystcomp.identify.scoring.MAX_SAMPLES` are fitted on every
-turning point and a regular subset of the samples (:func:`thinned`).
+turning point and a regular subset of the samples (:func:`prepare_record`): the play
+outputs there are exact (rate independence), and the cost weights the record as the whole
+does.
 """
 
 from __future__ import annotations
@@ -42,8 +44,8 @@ from hystcomp._hyperparameters import DEFAULT_MARGIN, check_constraints, check_m
 from hystcomp._validation import as_signal, check_int, check_real
 from hystcomp.errors import IdentificationError, InvalidSignalError
 from hystcomp.identify import scoring
-from hystcomp.identify.lsq import constrained_lsq, normal_equations
-from hystcomp.identify.scoring import check_response, check_transient, thin
+from hystcomp.identify.lsq import constrained_lsq, held_out_fits, normal_equations
+from hystcomp.identify.scoring import check_response, check_transient, reversal_folds, thin
 
 
 def paper_thresholds(n_operators: int, span: float) -> np.ndarray:
@@ -83,19 +85,31 @@ def play_thresholds(n_operators: int, span: float, constraints: str) -> np.ndarr
 
 @dataclass(frozen=True)
 class PreparedRecord:
-    """A validated identification record, with the play input and the fit's first sample."""
+    """A validated identification record, thinned, with the play input and the fit's start.
+
+    ``v``, ``x`` and ``u`` hold the samples the fit uses (``samples`` of the record: all of
+    them, or for a record longer than :data:`~hystcomp.identify.scoring.MAX_SAMPLES` its
+    turning points and a regular subset, :func:`~hystcomp.identify.scoring.thin`); ``start``
+    indexes them.
+    """
 
     v: np.ndarray
     x: np.ndarray
     input_offset: float  # v_0 = min(v), V
     u: np.ndarray  # v - v_0, V
-    start: int  # first sample in the cost
+    start: int  # first sample in the cost (among the kept samples)
     input_span: float  # max(u), V
     slope: float  # displacement range / input span over the fit samples, µm/V
+    samples: np.ndarray  # indices of the kept samples in the record
 
 
 def prepare_record(v, x, *, n_weights: int, transient, owner: str) -> PreparedRecord:
-    """Validate ``(v, x)`` for identification and find the samples the fit uses."""
+    """Validate ``(v, x)`` for identification, thin it and find the samples the fit uses.
+
+    Every sample is read for validation, for the start-up transient and for the turning
+    points (:func:`~hystcomp.identify.scoring.thin`); every other check runs on the kept
+    samples, which hold the extremes of the input (turning points or end points).
+    """
     v = as_signal(v, "v", min_samples=2)
     x = as_signal(x, "x", min_samples=2)
     if v.size != x.size:
@@ -103,6 +117,11 @@ def prepare_record(v, x, *, n_weights: int, transient, owner: str) -> PreparedRe
             f"{owner}: 'v' and 'x' must have one sample each per instant. Got {v.size} "
             f"voltage samples and {x.size} displacement samples."
         )
+    start = check_transient(transient, v, owner, min_used=2 * n_weights)
+    keep = thin(v, start, scoring.MAX_SAMPLES)
+    if keep.size < v.size:
+        v, x = v[keep], x[keep]
+        start = int(np.searchsorted(keep, start))
     v0 = float(v.min())
     u = v - v0
     span = float(u.max())
@@ -112,7 +131,6 @@ def prepare_record(v, x, *, n_weights: int, transient, owner: str) -> PreparedRe
             "identify. Record the response to an input that sweeps the actuator's range, "
             "such as 'hystcomp excite pi'."
         )
-    start = check_transient(transient, v, owner, min_used=2 * n_weights)
     u_fit, x_fit = u[start:], x[start:]
     if np.ptp(u_fit) <= 0.0:
         raise IdentificationError(
@@ -126,21 +144,7 @@ def prepare_record(v, x, *, n_weights: int, transient, owner: str) -> PreparedRe
             "recorded no motion. Check the displacement column."
         )
     check_response(u_fit, x_fit, owner)  # rising, and more than noise
-    return PreparedRecord(v, x, v0, u, start, span, x_span / span)
-
-
-def thinned(rec: PreparedRecord) -> tuple[np.ndarray, int]:
-    """Samples of a long record that a fit needs (:func:`~hystcomp.identify.scoring.thin`).
-
-        The physical fit also spreads its thresholds over half the input span, where the plays
-    can move (:func:`play_thresholds`). Records longer than
-    :data:`~hystcomp.identify.scoring.MAX_SAMPLES` are fitted on every
-        turning point and a regular subset of the samples: the play outputs there are exact
-        (rate independence), and the cost weights the record as the whole does. Returns the
-        indices kept and the position of the first sample in the cost among them.
-    """
-    keep = thin(rec.u, rec.start, scoring.MAX_SAMPLES)
-    return keep, int(np.searchsorted(keep, rec.start))
+    return PreparedRecord(v, x, v0, u, start, span, x_span / span, keep)
 
 
 @dataclass(frozen=True)
@@ -166,6 +170,10 @@ class PIFit:
         subset (:func:`~hystcomp.identify.scoring.thin`).
     first_sample : int
         First sample of the record in the cost (after the start-up transient).
+    folds : ndarray or None
+        With ``held_out``: the fold of each of the ``samples`` (-1 before the first).
+    held_out : tuple of PIFit
+        Fit ``f`` on every fold but fold ``f`` (:func:`fit_pi` with ``n_folds``), or empty.
     """
 
     thresholds: np.ndarray
@@ -175,6 +183,8 @@ class PIFit:
     output_offset: float
     first_sample: int
     samples: np.ndarray | None = None
+    folds: np.ndarray | None = None
+    held_out: tuple = ()
 
 
 def fit_pi(
@@ -185,6 +195,7 @@ def fit_pi(
     transient=None,
     margin=DEFAULT_MARGIN,
     constraints="physical",
+    n_folds=0,
 ) -> PIFit:
     """Identify a classical PI model (eq. 12) from a measured record by constrained least squares.
 
@@ -210,6 +221,9 @@ def fit_pi(
     constraints : {"physical", "paper"}, default "physical"
         ``"physical"``: also ``w_i >= 0`` beyond the first weight; ``"paper"``: the
         partial-sum constraints only, eq. (12) as the paper fits it.
+    n_folds : int, default 0
+        With 2 or more, also fit on all but one fold of the record's reversal segments, for
+        every fold (``PIFit.held_out``), as :func:`~hystcomp.identify.mpi.fit_mpi_path`.
 
     Returns
     -------
@@ -227,24 +241,35 @@ def fit_pi(
     n = check_int(n_operators, "n_operators", owner)
     margin = check_margin(margin, owner)
     constraints = check_constraints(constraints, owner)
+    n_folds = check_int(n_folds, "n_folds", owner, minimum=0)
     rec = prepare_record(v, x, n_weights=n + 1, transient=transient, owner=owner)
     r = play_thresholds(n, rec.input_span, constraints)
     y0 = np.full(n, rec.u[0])
     x_ref = float(rec.x[rec.start :].min())
-    keep, first = thinned(rec)
-    gram = normal_equations(rec.u[keep], r, y0, rec.x[keep] - x_ref, np.empty(0), first)
-    sol = constrained_lsq(
-        gram,
-        blocks=[(0, n, margin * rec.slope)],
-        floors=[(1, n, 0.0)] if constraints == "physical" else (),
-        scales=np.full(n, rec.input_span),
+    folds = reversal_folds(rec.u, rec.start, n_folds) if n_folds > 1 else None
+    grams = normal_equations(
+        rec.u, r, y0, rec.x - x_ref, np.empty(0), rec.start, folds, max(n_folds, 1)
     )
-    return PIFit(
-        thresholds=r,
-        weights=sol.coef[:n],
-        initial_state=y0,
-        input_offset=rec.input_offset,
-        output_offset=x_ref + float(sol.coef[n]),
-        first_sample=rec.start,
-        samples=keep,
-    )
+
+    def solve(gram, **extra) -> PIFit:
+        sol = constrained_lsq(
+            gram,
+            blocks=[(0, n, margin * rec.slope)],
+            floors=[(1, n, 0.0)] if constraints == "physical" else (),
+            scales=np.full(n, rec.input_span),
+        )
+        return PIFit(
+            thresholds=r,
+            weights=sol.coef[:n],
+            initial_state=y0,
+            input_offset=rec.input_offset,
+            output_offset=x_ref + float(sol.coef[n]),
+            first_sample=int(rec.samples[rec.start]),
+            samples=rec.samples,
+            **extra,
+        )
+
+    if folds is None:
+        return solve(grams)
+    held_out = held_out_fits(grams, solve)
+    return solve(grams.sum(axis=0), folds=folds if held_out else None, held_out=held_out)

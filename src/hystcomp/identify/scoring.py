@@ -46,15 +46,31 @@ def transient_end(v) -> int:
     2
     """
     v = as_signal(v, "v", min_samples=1)
-    lo, hi = v.min(), v.max()
+    return _first_near_an_end(v)
+
+
+#: Samples per block of the block-wise scans of long records (a few hundred kB: the blocks
+#: stay in the cache, and a scan that finds what it seeks early stops there).
+_SCAN_BLOCK = 1 << 16
+
+
+def _first_near_an_end(v: np.ndarray) -> int:
+    """:func:`transient_end` of a validated signal: two passes for the range, then a scan
+    block by block that stops at the first block holding a sample near an end."""
+    lo, hi = float(v.min()), float(v.max())
     tol = END_TOLERANCE * (hi - lo)
-    return int(np.argmax((v <= lo + tol) | (v >= hi - tol)))
+    for begin in range(0, v.size, _SCAN_BLOCK):
+        part = v[begin : begin + _SCAN_BLOCK]
+        near = (part <= lo + tol) | (part >= hi - tol)
+        if near.any():
+            return begin + int(np.argmax(near))
+    return 0  # not reached: the extremes are samples
 
 
 def check_transient(transient, v: np.ndarray, owner: str, *, min_used: int) -> int:
     """The first sample of the fit: ``transient`` validated, or :func:`transient_end`."""
     start = (
-        transient_end(v)
+        _first_near_an_end(v)
         if transient is None
         else check_int(transient, "transient", owner, minimum=0)
     )
@@ -91,11 +107,38 @@ def thin(v, start: int = 0, max_samples: int = MAX_SAMPLES) -> np.ndarray:
     if n <= max_samples:
         return np.arange(n)
     keep = np.zeros(n, dtype=bool)
-    sign = np.sign(np.diff(v))
-    keep[1:-1] = sign[1:] != sign[:-1]
+    # sample i (1 <= i <= n - 2) turns where the sign of v[i+1] - v[i] differs from the one
+    # before; block by block, so that the differences and signs stay in the cache
+    for begin in range(1, n - 1, _SCAN_BLOCK):
+        stop = min(begin + _SCAN_BLOCK, n - 1)
+        sign = np.sign(np.diff(v[begin - 1 : stop + 1]))
+        keep[begin:stop] = sign[1:] != sign[:-1]
     keep[start :: max(1, (n - start) // max_samples)] = True
     keep[0] = keep[-1] = True
     return np.flatnonzero(keep)
+
+
+def reversal_folds(v, start: int, n_folds: int) -> np.ndarray:
+    """Folds of a record for cross-validation: its reversal segments dealt out in turn.
+
+    The samples from ``start`` on are cut at the turning points of the input into segments
+    (monotone stretches between reversals), and segment ``i`` goes to fold ``i % n_folds``:
+    every fold holds ascending and descending branches from all over the record, and a
+    model fitted on the other folds must predict whole branches it has not seen. Samples
+    before ``start`` get -1.
+
+    Examples
+    --------
+    >>> reversal_folds(np.array([0.0, 2.0, 4.0, 2.0, 0.0, 3.0, 1.0]), 0, 2).tolist()
+    [0, 0, 0, 1, 1, 0, 1]
+    """
+    v = np.asarray(v, dtype=np.float64)
+    sign = np.sign(np.diff(v[start:]))
+    turns = np.zeros(v.size - start, dtype=np.int64)
+    turns[2:] = sign[1:] != sign[:-1]  # a segment starts just after each turning point
+    folds = np.full(v.size, -1, dtype=np.int64)
+    folds[start:] = np.cumsum(turns) % n_folds
+    return folds
 
 
 #: Least share of the displacement's variance that a straight line in the voltage must

@@ -13,7 +13,7 @@ import numpy as np
 from hystcomp import paper
 from hystcomp._hyperparameters import check_regularization_option
 from hystcomp._validation import as_vector, check_int, check_thresholds
-from hystcomp.identify.compensation import tracking_scorer
+from hystcomp.identify.compensation import CV_FOLDS, tracking_scorer
 from hystcomp.identify.mpi import REGULARIZATION_GRID, fit_mpi_path
 from hystcomp.models.base import DEFAULT_VOLTAGE_RANGE, fit_voltage_range
 from hystcomp.models.compensator import Compensator
@@ -48,10 +48,11 @@ class ModifiedPrandtlIshlinskii(PrandtlIshlinskii):
         deviation from the paper for records of actuators that are not exactly MPI systems
         (see :mod:`hystcomp.identify.mpi`). ``"auto"`` fits every value of
         :data:`~hystcomp.identify.mpi.REGULARIZATION_GRID` (0 included) and keeps the model
-        whose compensator has the smallest *estimated tracking error*
-        (:func:`hystcomp.identify.compensation.compensation_error`), not the smallest fit
-        error: a model that reproduces its record best can still have an inverse with steep
-        slopes. With a second record of the actuator, choose it by prediction there with
+        that predicts tracking best by cross-validation over the record's reversal
+        segments (``fit_report_["criterion_um"]``, see
+        :func:`hystcomp.identify.compensation.tracking_scorer`), not the smallest fit
+        error: a model that reproduces its record best can still predict other branches
+        worse, or have an inverse with steep slopes. With a second record of the actuator, choose it by prediction there with
         :func:`hystcomp.identify.validation.choose_regularization`.
     constraints : {"physical", "paper"}, default "physical"
         ``"physical"``: play weights beyond the first are non-negative and ``S`` stays
@@ -72,8 +73,10 @@ class ModifiedPrandtlIshlinskii(PrandtlIshlinskii):
     fit_report_ : dict
         After :meth:`fit`: errors of the model on the record, the ``regularization`` it was
         fitted with (the chosen value if ``"auto"``), ``tracking_rms_um`` (the estimated
-        tracking error of its compensator, µm rms) and ``baseline_tracking_rms_um`` (the same
-        for a straight line ``v = x / k_lin``).
+        tracking error of its compensator, µm rms), ``baseline_tracking_rms_um`` (the same
+        for a straight line ``v = x / k_lin``), and the cross-validated errors
+        ``held_out_rms_um``, ``held_out_tracking_rms_um`` and ``criterion_um``
+        (:func:`hystcomp.identify.compensation.tracking_scorer`).
 
     Examples
     --------
@@ -152,31 +155,39 @@ class ModifiedPrandtlIshlinskii(PrandtlIshlinskii):
             margin=self.margin,
             regularizations=penalties,
             constraints=self.constraints,
+            n_folds=CV_FOLDS,
         )
-        voltage_range = fit_voltage_range(self.voltage_range, v, owner)
-        # scored on the samples the fit used (a long record is thinned, see fit_mpi_path)
+        # scored on the samples the fit used (a long record is thinned, see fit_mpi_path);
+        # they hold the extremes of the input
         v_k, x_k, first = thinned_record(v, x, fits[0])
-        score = tracking_scorer(v_k, x_k, start=first)
+        voltage_range = fit_voltage_range(self.voltage_range, v_k, owner)
+        score = tracking_scorer(v_k, x_k, start=first, folds=fits[0].folds)
         candidates = []
         for penalty, fit in zip(penalties, fits, strict=True):
-            rs, ws = self.forward_deadzones(
-                fit.inverse_deadzone_thresholds, fit.inverse_deadzone_weights
-            )
-            candidate = self.from_parameters(
-                thresholds=fit.thresholds,
-                weights=fit.weights,
-                initial_state=fit.initial_state,
-                deadzone_thresholds=rs,
-                deadzone_weights=ws,
-                voltage_range=voltage_range,
-                input_offset=fit.input_offset,
-                output_offset=fit.output_offset,
-            )
-            candidates.append((candidate, penalty, score(candidate)))
-        # the smallest estimated tracking error (the first of equals)
-        model, penalty, est = min(candidates, key=lambda c: c[2]["tracking_rms_um"])
+            candidate = self._from_fit(fit, voltage_range)
+            held_out = tuple(self._from_fit(part, voltage_range) for part in fit.held_out)
+            candidates.append((candidate, penalty, score(candidate, held_out)))
+        # the smallest criterion (the first of equals)
+        model, penalty, est = min(candidates, key=lambda c: c[2]["criterion_um"])
         self._adopt_fit(model, v_k, x_k, first, est, regularization=penalty)
         return self
+
+    def _from_fit(self, fit, voltage_range) -> Self:
+        """The model of an :class:`~hystcomp.identify.mpi.MPIFit` (forward dead-zones from
+        the identified inverse ones, eqs. 24-25)."""
+        rs, ws = self.forward_deadzones(
+            fit.inverse_deadzone_thresholds, fit.inverse_deadzone_weights
+        )
+        return self.from_parameters(
+            thresholds=fit.thresholds,
+            weights=fit.weights,
+            initial_state=fit.initial_state,
+            deadzone_thresholds=rs,
+            deadzone_weights=ws,
+            voltage_range=voltage_range,
+            input_offset=fit.input_offset,
+            output_offset=fit.output_offset,
+        )
 
     def _penalties(self, owner: str) -> tuple[float, ...]:
         """The regularisation values to fit: the grid for ``"auto"``, else the one given."""

@@ -16,7 +16,7 @@ from hystcomp import paper
 from hystcomp._hyperparameters import check_constraints, check_margin
 from hystcomp._kernels import chain
 from hystcomp._validation import as_vector, check_int, check_range, check_real, check_thresholds
-from hystcomp.identify.compensation import compensation_error
+from hystcomp.identify.compensation import CV_FOLDS, tracking_scorer
 from hystcomp.identify.pi import fit_pi, paper_thresholds
 from hystcomp.identify.scoring import error_report
 from hystcomp.models.base import (
@@ -150,18 +150,27 @@ class PrandtlIshlinskii(HysteresisModel):
             transient=self.transient,
             margin=self.margin,
             constraints=self.constraints,
+            n_folds=CV_FOLDS,
         )
-        fitted = self.from_parameters(
+        # the samples the fit ran over: they hold the extremes of the input (thin)
+        v_k, x_k, first = thinned_record(v, x, fit)
+        voltage_range = fit_voltage_range(self.voltage_range, v_k, owner)
+        fitted = self._from_fit(fit, voltage_range)
+        score = tracking_scorer(v_k, x_k, start=first, folds=fit.folds)
+        held_out = tuple(self._from_fit(part, voltage_range) for part in fit.held_out)
+        self._adopt_fit(fitted, v_k, x_k, first, score(fitted, held_out))
+        return self
+
+    def _from_fit(self, fit, voltage_range) -> Self:
+        """The model of a :class:`~hystcomp.identify.pi.PIFit`."""
+        return self.from_parameters(
             thresholds=fit.thresholds,
             weights=fit.weights,
             initial_state=fit.initial_state,
-            voltage_range=fit_voltage_range(self.voltage_range, v, owner),
+            voltage_range=voltage_range,
             input_offset=fit.input_offset,
             output_offset=fit.output_offset,
         )
-        v_k, x_k, first = thinned_record(v, x, fit)
-        self._adopt_fit(fitted, v_k, x_k, first, compensation_error(fitted, v_k, x_k, start=first))
-        return self
 
     def _adopt_fit(self, fitted: Self, v_k, x_k, first: int, est: dict, **extra) -> None:
         """Take ``fitted``'s parameters, with its fit report on the thinned record: the
@@ -171,6 +180,10 @@ class PrandtlIshlinskii(HysteresisModel):
         report.update(extra)
         report["tracking_rms_um"] = est["tracking_rms_um"]
         report["baseline_tracking_rms_um"] = est["baseline_rms_um"]
+        for key in ("held_out_rms_um", "held_out_tracking_rms_um"):
+            if key in est:
+                report[key] = est[key]
+        report["criterion_um"] = est["criterion_um"]
         self._adopt(fitted, report)
 
     @classmethod
