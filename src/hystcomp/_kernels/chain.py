@@ -142,6 +142,28 @@ def deadzone_values(z, r, out):
         out[j] = max(z - r[j], 0.0) if r[j] > 0.0 else z
 
 
+@kernel
+def regressor_rows(u, r, y, z, rs, begin, rows):
+    """Regressor rows ``[plays | dead-zones (positive) | 1 | z]`` of eqs. (12) and (19).
+
+    Fills ``rows[i]`` for sample ``begin + i`` (as many as ``rows`` has), advancing the
+    play states ``y`` over those samples in place. No matrix product here: the Gram update
+    is NumPy's (BLAS) in :func:`hystcomp.identify.lsq.normal_equations`, so that this
+    kernel compiles without numba's linear algebra (which took most of a first run's
+    compile time).
+    """
+    n = r.size
+    m = rs.size
+    for i in range(rows.shape[0]):
+        k = begin + i
+        play_update(u[k], r, y)
+        for j in range(n):  # a loop, not row[:n] = y: slice assignment compiles slowly
+            rows[i, j] = y[j]
+        deadzone_values(z[k], rs, rows[i, n : n + m])  # negated after the sums
+        rows[i, n + m] = 1.0
+        rows[i, n + m + 1] = z[k]
+
+
 @inline_kernel
 def chain_state_start(p):
     """Index of the first state slot of packed chain ``p``."""

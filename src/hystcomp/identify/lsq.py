@@ -24,7 +24,6 @@ from __future__ import annotations
 import itertools
 from dataclasses import dataclass
 
-import numba
 import numpy as np
 import quadprog
 
@@ -32,27 +31,6 @@ from hystcomp._kernels import chain
 from hystcomp.errors import IdentificationError
 
 _BLOCK = 256  # rows per BLAS update of the Gram matrix (larger blocks gain nothing)
-
-
-@numba.njit(cache=True, nogil=True)
-def _regressor_rows(u, r, y, z, rs, begin, rows):
-    """Regressor rows ``[plays | dead-zones (positive) | 1 | z]`` of samples ``begin..``.
-
-    Fills ``rows[i]`` for sample ``begin + i`` (as many as ``rows`` has), advancing the
-    play states ``y`` over those samples in place. No matrix product here: the Gram update
-    is NumPy's (BLAS) in :func:`normal_equations`, so that this kernel compiles without
-    numba's linear algebra (which took most of a first run's compile time).
-    """
-    n = r.size
-    m = rs.size
-    for i in range(rows.shape[0]):
-        k = begin + i
-        chain.play_update(u[k], r, y)
-        for j in range(n):  # a loop, not row[:n] = y: slice assignment compiles slowly
-            rows[i, j] = y[j]
-        chain.deadzone_values(z[k], rs, rows[i, n : n + m])  # negated after the sums
-        rows[i, n + m] = 1.0
-        rows[i, n + m + 1] = z[k]
 
 
 def normal_equations(
@@ -94,14 +72,14 @@ def normal_equations(
     start = int(start)
     gram = np.zeros((n_folds if folds is not None else 1, n + m + 2, n + m + 2))
     rows = np.empty((max(_BLOCK, start), n + m + 2))
-    _regressor_rows(u, r, y, z, rs, 0, rows[:start])  # the plays' state at `start`
+    chain.regressor_rows(u, r, y, z, rs, 0, rows[:start])  # the plays' state at `start`
     # where the fold changes (a fold is a set of whole runs of samples), and which blocks
     # hold a change (most do not: a run is a whole reversal segment)
     changes = np.empty(0, np.int64) if folds is None else np.flatnonzero(np.diff(folds)) + 1
     mixed = set(((changes[changes > start] - start - 1) // _BLOCK).tolist())
     for block, begin in enumerate(range(start, u.size, _BLOCK)):
         part = rows[: min(_BLOCK, u.size - begin)]
-        _regressor_rows(u, r, y, z, rs, begin, part)
+        chain.regressor_rows(u, r, y, z, rs, begin, part)
         if folds is None:
             gram[0] += part.T @ part
         elif block not in mixed:
