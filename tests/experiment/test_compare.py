@@ -1,6 +1,7 @@
 """The compare pipeline (Section V on the twin): a short run, its files, the command."""
 
 import csv
+import functools
 import sys
 
 import numpy as np
@@ -13,7 +14,7 @@ from hystcomp.errors import InvalidParameterError
 from hystcomp.experiment import compare as compare_module
 from hystcomp.experiment.background import BackgroundFigures
 from hystcomp.experiment.compare import CompareConfig, run_comparison
-from hystcomp.experiment.figures import write_figures
+from hystcomp.experiment.figures import BACKGROUND_FIGURES, write_figures
 from hystcomp.experiment.report import write_outputs
 from hystcomp.paper import METHODS
 
@@ -82,7 +83,9 @@ def test_figures_drawn_in_a_forked_process_are_those_drawn_in_place(comparison, 
     there = write_outputs(
         comparison,
         tmp_path / "there",
-        figures=BackgroundFigures.start(write_figures, comparison),
+        figures=BackgroundFigures.start(
+            functools.partial(write_figures, names=BACKGROUND_FIGURES), comparison
+        ),
     )
     assert [p.name for p in there] == [p.name for p in here]
     for a, b in zip(here, there, strict=True):

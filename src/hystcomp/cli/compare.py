@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import time
 from pathlib import Path
 from typing import Any
@@ -42,7 +43,10 @@ def compare(out_dir: Path, seed: int, periods: int | None, quick: bool) -> None:
     """
     from hystcomp.experiment.background import BackgroundFigures
     from hystcomp.experiment.compare import CompareConfig, run_comparison
-    from hystcomp.experiment.figures import write_figures  # matplotlib, for a forked process
+    from hystcomp.experiment.figures import (  # matplotlib, for a forked process
+        BACKGROUND_FIGURES,
+        write_figures,
+    )
     from hystcomp.experiment.report import format_table, prepare_output_dir, write_outputs
 
     start = time.perf_counter()
@@ -58,7 +62,9 @@ def compare(out_dir: Path, seed: int, periods: int | None, quick: bool) -> None:
     figures: dict[str, BackgroundFigures | None] = {}
 
     def draw_figures(table1) -> None:  # Table I measured: its figures, beside the rest
-        figures["paper"] = BackgroundFigures.start(write_figures, table1)
+        figures["paper"] = BackgroundFigures.start(
+            functools.partial(write_figures, names=BACKGROUND_FIGURES), table1
+        )
 
     comparison = run_comparison(config, progress=progress, table1=draw_figures)
     progress(f"writing tables, figures and report into {out_dir}")

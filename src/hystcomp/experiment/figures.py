@@ -120,34 +120,57 @@ def figure_10(results: dict, path: Path) -> None:
     _save(fig, path)
 
 
-def write_figures(comparison, out_dir: Path) -> dict[str, str | None]:
-    """Draw every figure into ``out_dir``; returns ``{file name: None if drawn, else why not}``.
+def _fig9(comparison, path: Path) -> None:
+    figure_9(comparison.results[min(comparison.results)], path)
+
+
+def _fig10(comparison, path: Path) -> None:
+    figure_10(comparison.results, path)
+
+
+def _fig5(comparison, path: Path) -> None:
+    rec = comparison.record_loops
+    plot_preisach_loops(comparison.models["preisach"], path, measured=(rec.v, rec.x))
+
+
+def _fig8(kind: str):
+    def draw(comparison, path: Path) -> None:
+        rec = comparison.record_pi
+        slope, intercept = np.polyfit(rec.v, rec.x, 1)  # "before": the best straight line
+        after = comparison.models[kind].simulate(rec.v)
+        plot_identification(
+            rec.v, rec.x, slope * rec.v + intercept, after, path, model_name=LABELS[kind]
+        )
+
+    return draw
+
+
+#: Every figure of the paper's experiment: file name -> ``draw(comparison, path)``.
+FIGURES = {
+    "fig9_compensation.png": _fig9,
+    "fig10_tracking.png": _fig10,
+    "fig5_preisach.png": _fig5,
+    "fig8_pi.png": _fig8("pi"),
+    "fig8_mpi.png": _fig8("mpi"),
+}
+
+#: The figures ``hystcomp compare`` draws in a second process, while the first goes on with
+#: the dynamics part and then draws the others: about as much drawing each.
+BACKGROUND_FIGURES = ("fig10_tracking.png", "fig5_preisach.png", "fig8_pi.png", "fig8_mpi.png")
+
+
+def write_figures(comparison, out_dir: Path, names=None) -> dict[str, str | None]:
+    """Draw the figures ``names`` (default every one) into ``out_dir``; returns
+    ``{file name: None if drawn, else why not}``.
 
     Figs. 9 and 10 (:func:`figure_9`, :func:`figure_10`), Fig. 5
     (:func:`~hystcomp.experiment.fig_preisach.plot_preisach_loops`) and Fig. 8 for PI and
-    MPI (:func:`~hystcomp.experiment.fig_identification.plot_identification`); every one is
-    drawn, so every value is None.
+    MPI (:func:`~hystcomp.experiment.fig_identification.plot_identification`), in the order
+    of :data:`FIGURES`; every one is drawn, so every value is None.
     """
     notes: dict[str, str | None] = {}
-    frequencies = sorted(comparison.results)
-    first = frequencies[0]
-    figure_9(comparison.results[first], out_dir / "fig9_compensation.png")
-    notes["fig9_compensation.png"] = None
-    figure_10(comparison.results, out_dir / "fig10_tracking.png")
-    notes["fig10_tracking.png"] = None
-
-    rec = comparison.record_loops
-    plot_preisach_loops(
-        comparison.models["preisach"], out_dir / "fig5_preisach.png", measured=(rec.v, rec.x)
-    )
-    notes["fig5_preisach.png"] = None
-
-    rec = comparison.record_pi
-    slope, intercept = np.polyfit(rec.v, rec.x, 1)  # "before": the best straight line
-    before = slope * rec.v + intercept
-    for kind in ("pi", "mpi"):
-        name = f"fig8_{kind}.png"
-        after = comparison.models[kind].simulate(rec.v)
-        plot_identification(rec.v, rec.x, before, after, out_dir / name, model_name=LABELS[kind])
-        notes[name] = None
+    for name, draw in FIGURES.items():
+        if names is None or name in names:
+            draw(comparison, out_dir / name)
+            notes[name] = None
     return notes

@@ -19,7 +19,7 @@ from pathlib import Path
 
 from hystcomp import paper
 from hystcomp.errors import InvalidParameterError
-from hystcomp.experiment.figures import write_figures
+from hystcomp.experiment.figures import BACKGROUND_FIGURES, FIGURES, write_figures
 from hystcomp.experiment.metrics import SATURATION_ZONE
 from hystcomp.io.atomic import (
     atomic_path,
@@ -68,15 +68,21 @@ def _write_text(path: Path, text: str) -> None:
 
 
 def _figures(comparison, stage: Path, background) -> dict[str, str | None]:
-    """The paper's figures in ``stage``: from ``background`` if it drew them, else drawn."""
-    drawn = None if background is None else background.collect()
-    if drawn is None:
+    """The paper's figures in ``stage``: those of :data:`~hystcomp.experiment.figures.
+    BACKGROUND_FIGURES` from ``background`` if it drew them, the others (or all) drawn here."""
+    if background is None:
         return write_figures(comparison, stage)
-    notes, files = drawn
-    for name, data in files.items():
-        with atomic_path(stage / name) as tmp:
-            tmp.write_bytes(data)
-    return notes
+    notes = write_figures(comparison, stage, [n for n in FIGURES if n not in BACKGROUND_FIGURES])
+    drawn = background.collect()
+    if drawn is None:
+        notes.update(write_figures(comparison, stage, BACKGROUND_FIGURES))
+    else:
+        more, files = drawn
+        for name, data in files.items():
+            with atomic_path(stage / name) as tmp:
+                tmp.write_bytes(data)
+        notes.update(more)
+    return {name: notes[name] for name in FIGURES if name in notes}
 
 
 def format_table(comparison) -> str:
@@ -126,9 +132,10 @@ def write_outputs(comparison, out_dir, *, figures=None) -> list[Path]:
     interruption leaves the files of an earlier run as they were, never a mix of two runs.
 
     ``figures``, if given, is a :class:`~hystcomp.experiment.background.BackgroundFigures`
-    drawing :func:`~hystcomp.experiment.figures.write_figures` for this comparison (from
-    its Table I); its files are written as they came, or the figures are drawn here if it
-    failed.
+    drawing :data:`~hystcomp.experiment.figures.BACKGROUND_FIGURES` with
+    :func:`~hystcomp.experiment.figures.write_figures` for this comparison (from its Table
+    I) while the others are drawn here; its files are written as they came, or its figures
+    are drawn here too if it failed.
     """
     out = prepare_output_dir(out_dir)
     with staging_folder(out) as stage:
