@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import functools
+import importlib
+import threading
 import time
 from pathlib import Path
 from typing import Any
@@ -10,6 +12,9 @@ from typing import Any
 import click
 
 from hystcomp.cli import main
+
+#: What draws the figures and writes the report: imported beside the experiment.
+_DRAWING = "hystcomp.experiment.report"
 
 
 @main.command("compare")
@@ -41,16 +46,15 @@ def compare(out_dir: Path, seed: int, periods: int | None, quick: bool) -> None:
     compensators in series with their inverse (dynamics.csv, step_creep.png). The axis has
     3 % creep. Units: µm, V, s.
     """
-    from hystcomp.experiment.background import BackgroundFigures
     from hystcomp.experiment.compare import CompareConfig, run_comparison
-    from hystcomp.experiment.figures import (  # matplotlib, for a forked process
-        BACKGROUND_FIGURES,
-        write_figures,
-    )
-    from hystcomp.experiment.report import format_table, prepare_output_dir, write_outputs
+    from hystcomp.io.atomic import prepare_output_dir
 
-    start = time.perf_counter()
     prepare_output_dir(out_dir)  # refuse a bad --out before the work
+    # matplotlib and the report load in a thread while the experiment's kernels run (they
+    # release the GIL); they are needed from Table I on, and before the fork that draws
+    drawing = threading.Thread(target=importlib.import_module, args=(_DRAWING,), daemon=True)
+    drawing.start()
+    start = time.perf_counter()
     changes: dict[str, Any] = (
         {"seed": seed} if periods is None else {"seed": seed, "periods": periods}
     )
@@ -59,14 +63,21 @@ def compare(out_dir: Path, seed: int, periods: int | None, quick: bool) -> None:
     def progress(line: str) -> None:
         click.echo(f"hystcomp compare: {line}", err=True)
 
-    figures: dict[str, BackgroundFigures | None] = {}
+    figures: dict[str, Any] = {}
 
     def draw_figures(table1) -> None:  # Table I measured: its figures, beside the rest
+        drawing.join()  # never fork while a thread imports
+        from hystcomp.experiment.background import BackgroundFigures
+        from hystcomp.experiment.figures import BACKGROUND_FIGURES, write_figures
+
         figures["paper"] = BackgroundFigures.start(
             functools.partial(write_figures, names=BACKGROUND_FIGURES), table1
         )
 
     comparison = run_comparison(config, progress=progress, table1=draw_figures)
+    drawing.join()
+    from hystcomp.experiment.report import format_table, write_outputs
+
     progress(f"writing tables, figures and report into {out_dir}")
     files = write_outputs(comparison, out_dir, figures=figures.get("paper"))
     click.echo(format_table(comparison))
