@@ -3,8 +3,6 @@
 from __future__ import annotations
 
 import functools
-import importlib
-import threading
 import time
 from pathlib import Path
 from typing import Any
@@ -12,9 +10,6 @@ from typing import Any
 import click
 
 from hystcomp.cli import main
-
-#: What draws the figures and writes the report: imported beside the experiment.
-_DRAWING = "hystcomp.experiment.report"
 
 
 @main.command("compare")
@@ -46,15 +41,16 @@ def compare(out_dir: Path, seed: int, periods: int | None, quick: bool) -> None:
     compensators in series with their inverse (dynamics.csv, step_creep.png). The axis has
     3 % creep. Units: µm, V, s.
     """
+    from hystcomp.experiment.background import BackgroundFigures
     from hystcomp.experiment.compare import CompareConfig, run_comparison
-    from hystcomp.io.atomic import prepare_output_dir
+    from hystcomp.experiment.figures import (  # matplotlib, for a forked process
+        BACKGROUND_FIGURES,
+        write_figures,
+    )
+    from hystcomp.experiment.report import format_table, prepare_output_dir, write_outputs
 
-    prepare_output_dir(out_dir)  # refuse a bad --out before the work
-    # matplotlib and the report load in a thread while the experiment's kernels run (they
-    # release the GIL); they are needed from Table I on, and before the fork that draws
-    drawing = threading.Thread(target=importlib.import_module, args=(_DRAWING,), daemon=True)
-    drawing.start()
     start = time.perf_counter()
+    prepare_output_dir(out_dir)  # refuse a bad --out before the work
     changes: dict[str, Any] = (
         {"seed": seed} if periods is None else {"seed": seed, "periods": periods}
     )
@@ -63,21 +59,14 @@ def compare(out_dir: Path, seed: int, periods: int | None, quick: bool) -> None:
     def progress(line: str) -> None:
         click.echo(f"hystcomp compare: {line}", err=True)
 
-    figures: dict[str, Any] = {}
+    figures: dict[str, BackgroundFigures | None] = {}
 
     def draw_figures(table1) -> None:  # Table I measured: its figures, beside the rest
-        drawing.join()  # never fork while a thread imports
-        from hystcomp.experiment.background import BackgroundFigures
-        from hystcomp.experiment.figures import BACKGROUND_FIGURES, write_figures
-
         figures["paper"] = BackgroundFigures.start(
             functools.partial(write_figures, names=BACKGROUND_FIGURES), table1
         )
 
     comparison = run_comparison(config, progress=progress, table1=draw_figures)
-    drawing.join()
-    from hystcomp.experiment.report import format_table, write_outputs
-
     progress(f"writing tables, figures and report into {out_dir}")
     files = write_outputs(comparison, out_dir, figures=figures.get("paper"))
     click.echo(format_table(comparison))

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import csv
 import io
+import os
 from pathlib import Path
 
 from hystcomp import paper
@@ -23,7 +24,6 @@ from hystcomp.experiment.metrics import SATURATION_ZONE
 from hystcomp.io.atomic import (
     atomic_path,
     check_output_path,
-    prepare_output_dir,
     replace_all,
     staging_folder,
     write_target,
@@ -105,6 +105,23 @@ def format_table(comparison) -> str:
                 label = LABELS[base] + (f" + {extra}" if extra else "")
                 lines.append(f"{f:>7g}  {label:<20}{r.rms:>10.3f}{'-':>9}{r.max:>11.3f}{'-':>9}")
     return "\n".join(lines)
+
+
+def prepare_output_dir(out_dir) -> Path:
+    """Create ``out_dir`` if needed; refuse a path that exists and is not a folder."""
+    path = Path(os.fspath(out_dir))
+    if path.exists() and not path.is_dir():
+        raise InvalidParameterError(
+            f"The output folder {str(path)!r} exists and is a file, not a folder. "
+            "Choose another --out path or remove the file."
+        )
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise InvalidParameterError(
+            f"Cannot create the output folder {str(path)!r}: {exc.strerror}. Choose another path."
+        ) from None
+    return path
 
 
 def write_outputs(comparison, out_dir, *, figures=None) -> list[Path]:

@@ -239,20 +239,3 @@ def atomic_path(path: str | os.PathLike):
     """
     with atomic_paths(path) as (tmp,):
         yield tmp
-
-
-def prepare_output_dir(out_dir) -> Path:
-    """Create ``out_dir`` if needed; refuse a path that exists and is not a folder."""
-    path = Path(os.fspath(out_dir))
-    if path.exists() and not path.is_dir():
-        raise InvalidParameterError(
-            f"The output folder {str(path)!r} exists and is a file, not a folder. "
-            "Choose another --out path or remove the file."
-        )
-    try:
-        path.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise InvalidParameterError(
-            f"Cannot create the output folder {str(path)!r}: {exc.strerror}. Choose another path."
-        ) from None
-    return path
