@@ -1,12 +1,13 @@
 """Figures drawn in a second process while the experiment goes on (``hystcomp compare``).
 
-Drawing the paper's figures costs about as much CPU as the dynamics part of the
-experiment, and they need only Table I's runs: :func:`hystcomp.experiment.compare.run_comparison`
-hands Table I over as soon as it is measured, a forked process draws its figures while
-the experiment goes on, and :func:`~hystcomp.experiment.report.write_outputs` takes the
-image files from it and writes them with the tables and the report, all at once. Where
-``fork`` is not available, or if the process fails in any way, the figures are drawn in
-the calling process instead, as before: the files are the same either way.
+The paper's figures need only Table I's runs: :func:`hystcomp.experiment.compare.run_comparison`
+hands Table I over as soon as it is measured, and a forked process draws
+:data:`~hystcomp.experiment.figures.BACKGROUND_FIGURES` while the calling process goes on
+with the dynamics part and then draws the others (about as much drawing each);
+:func:`~hystcomp.experiment.report.write_outputs` takes the image files from it and writes
+them with the tables and the report, all at once. Where ``fork`` is not available, or if
+the process fails in any way, those figures are drawn in the calling process instead: the
+files are the same either way.
 """
 
 from __future__ import annotations
