@@ -1,5 +1,5 @@
 """``python -m hystcomp``: the ``hystcomp`` command."""
 
-from hystcomp.cli import main
+from hystcomp.cli import run
 
-main(prog_name="hystcomp")
+run()

@@ -280,3 +280,22 @@ def test_mpi_regularization_reaches_the_fit_and_the_model_file(tmp_path):
     assert auto.get_params()["regularization"] == "auto"
     assert f"regularization: {chosen:g} (auto" in result.output
     assert auto.fit_report_["rms_error_um"] <= plain.fit_report_["rms_error_um"]
+
+
+@pytest.mark.parametrize(
+    ("argv", "status"),
+    [(["--version"], 0), (["excite", "nope"], 2), (["excite", "pi", "-o", "{tmp}/e.csv"], 0)],
+)
+def test_the_program_flushes_then_ends_with_the_commands_status(
+    monkeypatch, tmp_path, capsys, argv, status
+):
+    from hystcomp import cli
+
+    ended = []
+    monkeypatch.setattr(cli.os, "_exit", ended.append)  # the real one would end pytest
+    monkeypatch.setattr(sys, "argv", ["hystcomp", *(a.format(tmp=tmp_path) for a in argv)])
+    cli.run()
+    assert ended == [status]
+    err = capsys.readouterr().err
+    assert err.startswith("hystcomp: error:") if status else "Traceback" not in err
+    assert (tmp_path / "e.csv").exists() == ("pi" in argv)

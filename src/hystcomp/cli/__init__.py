@@ -191,6 +191,32 @@ class _Group(click.Group):
             sys.exit(EXIT_INTERNAL)
 
 
+def run() -> None:
+    """The ``hystcomp`` program: :data:`main`, then the process ends without tearing down.
+
+    The console script and ``python -m hystcomp`` call this, never a test (which calls
+    :data:`main`). Once a command has returned, its outputs are written, closed and renamed
+    into place, and standard output and error are flushed here; what is left is the
+    interpreter's teardown, which deallocates every module and compiled kernel one by one:
+    0.4 to 0.6 s of a 4 s ``hystcomp compare``, measured in alternated runs. So the
+    process ends with :func:`os._exit` and the command's exit status. If a flush fails
+    (standard output closed early), the normal exit path runs and reports it.
+    """
+    try:
+        result = main(prog_name="hystcomp")  # --help and --version return 0
+        code = result if isinstance(result, int) else 0
+    except SystemExit as exc:
+        code = exc.code
+    if code is not None and not isinstance(code, int):
+        sys.exit(code)  # a message: printed and exit status 1, as Python does
+    try:
+        sys.stdout.flush()
+        sys.stderr.flush()
+    except (OSError, ValueError):
+        sys.exit(code)
+    os._exit(code or 0)
+
+
 @click.group(cls=_Group, context_settings={"help_option_names": ["-h", "--help"]})
 @click.version_option(package_name="hystcomp")
 def main() -> None:

@@ -1,5 +1,5 @@
 """``python -m hystcomp.cli``: the ``hystcomp`` command."""
 
-from hystcomp.cli import main
+from hystcomp.cli import run
 
-main()
+run()

@@ -21,8 +21,6 @@ from dataclasses import dataclass
 from typing import NamedTuple
 
 import numpy as np
-import scipy.sparse
-import scipy.sparse.linalg
 
 from hystcomp._hyperparameters import check_options
 from hystcomp._kernels import preisach as pk
@@ -257,6 +255,9 @@ def fit_everett_table(alpha, beta, value, *, grid_size: int, voltage_range) -> n
     the antisymmetric extension). A light second-difference penalty inside the triangle fills
     nodes that no curve reaches. Returns the full ``(grid_size, grid_size)`` table.
     """
+    import scipy.sparse  # here: 0.2 s to import, and only the table fit needs it
+    import scipy.sparse.linalg
+
     lo, hi = voltage_range
     n = grid_size
     h = (hi - lo) / (n - 1)
