@@ -33,20 +33,20 @@ def check_invertible(weights: np.ndarray, what: str) -> None:
     hystcomp.errors.NotInvertibleError: the model is not invertible: ...(index 1)...
     """
     partial = np.cumsum(weights)
-    bad = np.flatnonzero(~(partial > 0))
-    if bad.size:
-        i = int(bad[0])
+    if not partial.min() > 0:  # also NaN; the index is looked for only on a refusal
+        i = int(np.flatnonzero(~(partial > 0))[0])
         raise NotInvertibleError(
             f"{what} is not invertible: the partial sum of weights w_0 + ... + w_{i} = "
             f"{partial[i]:.6g} is not positive (index {i}). Eqs. 24-26 need every partial sum "
             f"> 0: identify the model with the invertibility constraint, or change weights[{i}].",
             index=i,
         )
-    with np.errstate(over="ignore", divide="ignore"):
-        gains = np.abs(np.r_[1.0 / partial[0], weights[1:] / (partial[1:] * partial[:-1])])
-    bad = np.flatnonzero(~(gains <= MAX_INVERSE_WEIGHT))
-    if bad.size:
-        i = int(bad[0])
+    # |w'_i| of eq. 25: 1 / w_0, then w_i / (p_i p_{i-1}) (p_0 = w_0 makes the first term so)
+    before = np.concatenate((partial[:1], partial[:-1]))
+    with np.errstate(all="ignore"):  # an overflow or a NaN is judged below
+        gains = np.abs(weights / (partial * before))
+    if not gains.max() <= MAX_INVERSE_WEIGHT:
+        i = int(np.flatnonzero(~(gains <= MAX_INVERSE_WEIGHT))[0])
         raise NotInvertibleError(
             f"{what} is not invertible in floating point: the partial sum of weights "
             f"w_0 + ... + w_{i} = {partial[i]:.6g} is so close to 0 that the inverse weight "
