@@ -202,6 +202,7 @@ def run() -> None:
     process ends with :func:`os._exit` and the command's exit status. If a flush fails
     (standard output closed early), the normal exit path runs and reports it.
     """
+    code: int | str | None
     try:
         result = main(prog_name="hystcomp")  # --help and --version return 0
         code = result if isinstance(result, int) else 0

@@ -1,0 +1,93 @@
+"""Kernels compiled on the second core while ``hystcomp compare`` starts (a first run).
+
+numba compiles a kernel at its first call and keeps the result in its on-disk cache; a
+later first call, in any process, loads it from there in milliseconds. On a first run
+(an empty cache) ``compare`` spends about 11 s of CPU compiling, one kernel after the
+other on one core, while the second core idles until the figures are drawn. So
+``hystcomp compare`` forks a process first (:func:`start`) that compiles, into the same
+cache, the kernels the experiment needs later: the play chain's (PI and MPI fits and
+their inverses) and the linear dynamics' (:func:`compile_later_kernels`). Meanwhile the
+first process compiles the twin's and the Preisach model's kernels, which it needs first;
+when it reaches the others, it loads them. Once the cache is filled, the second process
+only loads them and ends, on a core that is idle then.
+
+Nothing the experiment computes depends on which process compiled a kernel: the cache
+holds the same machine code.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import multiprocessing
+import signal
+import sys
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+from hystcomp._kernels import chain
+from hystcomp.experiment.background import FORK_WARNING
+
+
+def compile_later_kernels() -> None:
+    """Call the kernels that ``compare`` needs after the Preisach model, on small inputs.
+
+    Through the public calls that ``compare`` makes (a PI and an MPI fit with their
+    defaults, their compensators, an MPI compensator with an inverse of the dynamics, the
+    twin), so that every kernel is compiled for the argument types it meets there.
+    """
+    from hystcomp import presets
+    from hystcomp.identify.dynamics import dynamics_excitation
+    from hystcomp.identify.excitation import triangle_sequence
+    from hystcomp.models.dynamics import LinearDynamics
+    from hystcomp.models.mpi import ModifiedPrandtlIshlinskii
+    from hystcomp.models.pi import PrandtlIshlinskii
+    from hystcomp.plant.twin import Twin
+
+    _, v = triangle_sequence(sample_rate=400.0)
+    x = presets.paper_mpi().simulate(v)
+    models = [PrandtlIshlinskii(), ModifiedPrandtlIshlinskii()]
+    for model in models:
+        model.fit(v, x).inverse().simulate(x)
+    # the twin last: the first process compiles it first, so that here it is loaded
+    twin = Twin(seed=0)
+    fs = twin.sample_rate
+    _, u = dynamics_excitation(sample_rate=fs, voltage_range=twin.voltage_range)
+    dynamics = LinearDynamics().fit(u, twin.run(u), fs)
+    models[1].inverse(dynamics=dynamics).simulate(np.linspace(0.0, float(x.max()), 100))
+
+
+def start(job=compile_later_kernels):
+    """Fork a daemon process that runs ``job`` (and ends), or None if there is no need.
+
+    Nothing is started if the cache already holds the play chain's batch kernel (a run
+    after the first: loading the kernels would cost the second process as much as the
+    first, about 0.5 s of CPU for numba's start, on a core that the figures need). Linux only, as :class:`~hystcomp.experiment.background.BackgroundFigures`. The process
+    is not waited for: its only output is the kernel cache, and a kernel that it has not
+    compiled yet when this process needs it is compiled here as it would be without it.
+    """
+    if not sys.platform.startswith("linux") or _in_cache(chain.chain_run):
+        return None
+    try:
+        context = multiprocessing.get_context("fork")
+        process = context.Process(target=_run, args=(job,), daemon=True, name="hystcomp-warmup")
+        with warnings.catch_warnings():
+            warnings.filterwarnings("ignore", FORK_WARNING, DeprecationWarning)
+            process.start()
+    except (OSError, ValueError):
+        return None
+    return process
+
+
+def _in_cache(kernel) -> bool:
+    """Whether numba's on-disk cache holds compiled code of ``kernel`` (a data file named
+    after it, as numba names them: ``<module>.<name>-<line>.py<version>.<n>.nbc``)."""
+    folder = Path(kernel.stats.cache_path)
+    return any(folder.glob(f"*.{kernel.py_func.__name__}-*.nbc"))
+
+
+def _run(job) -> None:
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the caller's to answer
+    with contextlib.suppress(Exception):  # a failure here only costs the caller time
+        job()

@@ -1,0 +1,55 @@
+"""The warm-up process of a first ``compare``: it compiles what the experiment then loads."""
+
+import json
+import os
+import subprocess
+import sys
+
+import pytest
+
+from hystcomp import presets
+from hystcomp._kernels import chain
+from hystcomp.experiment import warmup
+
+pytestmark = pytest.mark.skipif(not sys.platform.startswith("linux"), reason="fork on Linux")
+
+_COMPARE = """
+import json
+from hystcomp._kernels import chain, dynamics
+from hystcomp.experiment.compare import CompareConfig, run_comparison
+run_comparison(CompareConfig.quick())
+kernels = [getattr(m, n) for m in (chain, dynamics) for n in dir(m)]
+print(json.dumps({
+    k.py_func.__name__: [len(k.stats.cache_hits), len(k.stats.cache_misses)]
+    for k in kernels if hasattr(k, "stats") and (k.stats.cache_hits or k.stats.cache_misses)
+}))
+"""
+
+
+def _python(code, cache):
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(cache))
+    done = subprocess.run(
+        [sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True
+    )
+    return done.stdout
+
+
+@pytest.mark.slow
+def test_compare_loads_every_chain_and_dynamics_kernel_the_warmup_compiled(tmp_path):
+    _python("from hystcomp.experiment.warmup import compile_later_kernels as f; f()", tmp_path)
+    counts = json.loads(_python(_COMPARE, tmp_path).splitlines()[-1])
+    assert {"chain_run", "regressor_rows", "inverse_run"} <= set(counts)
+    missed = {name: c for name, c in counts.items() if c[1]}
+    assert not missed  # compiled by compare itself: the warm-up called it differently
+
+
+def test_no_process_once_the_cache_holds_the_kernels(monkeypatch):
+    ran = []
+    presets.paper_mpi().simulate([0.0, 1.0])  # chain_run: compiled or loaded, now cached
+    assert warmup._in_cache(chain.chain_run)
+    assert warmup.start(lambda: ran.append(1)) is None
+    monkeypatch.setattr(warmup, "_in_cache", lambda kernel: False)
+    process = warmup.start(lambda: None)
+    assert process is not None
+    process.join(timeout=30)
+    assert process.exitcode == 0
