@@ -5,10 +5,10 @@ later first call, in any process, loads it from there in milliseconds. On a firs
 (an empty cache) ``compare`` spends about 11 s of CPU compiling, one kernel after the
 other on one core, while the second core idles until the figures are drawn. So
 ``hystcomp compare`` forks a process first (:func:`start`) that compiles, into the same
-cache, the kernels the experiment needs later: the play chain's (PI and MPI fits and
-their inverses) and the linear dynamics' (:func:`compile_later_kernels`). Meanwhile the
-first process compiles the twin's and the Preisach model's kernels, which it needs first;
-when it reaches the others, it loads them. Once the cache is filled, the second process
+cache, the kernels the experiment needs later: the Everett function's, the play chain's
+(PI and MPI fits and their inverses) and the linear dynamics' (:func:`compile_later_kernels`).
+Meanwhile the first process compiles the twin's and the Preisach model's run, which it
+needs first; when it reaches the others, it loads them. Once the cache is filled, the second process
 only loads them and ends, on a core that is idle then.
 
 Nothing the experiment computes depends on which process compiled a kernel: the cache
@@ -31,7 +31,7 @@ from hystcomp.experiment.background import FORK_WARNING
 
 
 def compile_later_kernels() -> None:
-    """Call the kernels that ``compare`` needs after the Preisach model, on small inputs.
+    """Call the kernels that ``compare`` needs after the twin's, on small inputs.
 
     Through the public calls that ``compare`` makes (a PI and an MPI fit with their
     defaults, their compensators, an MPI compensator with an inverse of the dynamics, the
@@ -45,6 +45,9 @@ def compile_later_kernels() -> None:
     from hystcomp.models.pi import PrandtlIshlinskii
     from hystcomp.plant.twin import Twin
 
+    # first the Everett function's kernel, which the first process needs soon after the
+    # twin's (to fit the Preisach model), then the play chain's and the dynamics' kernels
+    presets.paper_preisach().everett_function([1.0], [0.0])
     _, v = triangle_sequence(sample_rate=400.0)
     x = presets.paper_mpi().simulate(v)
     models = [PrandtlIshlinskii(), ModifiedPrandtlIshlinskii()]
