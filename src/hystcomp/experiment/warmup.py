@@ -8,8 +8,8 @@ other on one core, while the second core idles until the figures are drawn. So
 cache, the kernels the experiment needs later: the Everett function's, the play chain's
 (PI and MPI fits and their inverses) and the linear dynamics' (:func:`compile_later_kernels`).
 Meanwhile the first process compiles the twin's and the Preisach model's run, which it
-needs first; when it reaches the others, it loads them. Once the cache is filled, the second process
-only loads them and ends, on a core that is idle then.
+needs first; when it reaches the others, it loads them. Once the cache holds them, no
+second process is started.
 
 Nothing the experiment computes depends on which process compiled a kernel: the cache
 holds the same machine code.
