@@ -66,9 +66,11 @@ def start(job=compile_later_kernels):
 
     Nothing is started if the cache already holds the play chain's batch kernel (a run
     after the first: loading the kernels would cost the second process as much as the
-    first, about 0.5 s of CPU for numba's start, on a core that the figures need). Linux only, as :class:`~hystcomp.experiment.background.BackgroundFigures`. The process
-    is not waited for: its only output is the kernel cache, and a kernel that it has not
-    compiled yet when this process needs it is compiled here as it would be without it.
+    first, about 0.5 s of CPU for numba's start, on a core that the figures need), nor
+    where the platform does not fork (Linux only, as
+    :class:`~hystcomp.experiment.background.BackgroundFigures`). The process is not
+    waited for: its only output is the kernel cache, and a kernel that it has not compiled
+    yet when this process needs it is compiled here as it would be without it.
     """
     if not sys.platform.startswith("linux") or _in_cache(chain.chain_run):
         return None
@@ -91,6 +93,9 @@ def _in_cache(kernel) -> bool:
 
 
 def _run(job) -> None:
-    signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the caller's to answer
+    # Ctrl-C or SIGTERM end it at once and silently (not the caller's handlers, which it
+    # inherits): numba writes each cache file whole, under a temporary name first
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
     with contextlib.suppress(Exception):  # a failure here only costs the caller time
         job()
