@@ -200,8 +200,11 @@ def _real_array(value, *, copy: bool) -> np.ndarray:
     """``value`` as a float64 array; anything but real numbers raises TypeError.
 
     Text, booleans, dates and complex numbers are refused rather than converted (``"1.5"``
-    or ``True`` are not samples), and so is any conversion that warns.
+    or ``True`` are not samples), and so is any conversion that warns. A float64 array,
+    the common case, needs no conversion and no warning filter.
     """
+    if type(value) is np.ndarray and value.dtype == np.float64:  # not a subclass
+        return value.copy() if copy else value
     with warnings.catch_warnings():
         warnings.simplefilter("error")  # e.g. a ComplexWarning from an object array
         try:
