@@ -6,10 +6,10 @@ later first call, in any process, loads it from there in milliseconds. On a firs
 other on one core, while the second core idles until the figures are drawn. So
 ``hystcomp compare`` forks a process first (:func:`start`) that compiles, into the same
 cache, the kernels the experiment needs later: the Everett function's, the play chain's
-(PI and MPI fits and their inverses) and the linear dynamics' (:func:`compile_later_kernels`).
-Meanwhile the first process compiles the twin's and the Preisach model's run, which it
-needs first; when it reaches the others, it loads them. Once the cache holds them, no
-second process is started.
+(PI and MPI fits and their inverses) and the linear dynamics'
+(:func:`compile_later_kernels`). Meanwhile the first process compiles the twin's and the
+Preisach model's run, which it needs first; when it reaches the others, it loads them.
+Once the cache holds them, no second process is started.
 
 Nothing the experiment computes depends on which process compiled a kernel: the cache
 holds the same machine code.
