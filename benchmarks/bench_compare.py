@@ -4,7 +4,9 @@ Two runs, each a fresh process as a user would start it, writing into a temporar
 
 * cold: an empty numba kernel cache, in a new temporary folder (``NUMBA_CACHE_DIR``), so
   every kernel the command needs is compiled (a first run after installing);
-* warm: the same command again, the kernels loaded from the cache the first run filled.
+* warm: the same command again, the kernels loaded from the cache the first run filled;
+  the median of :data:`WARM_RUNS` runs (a shared machine's load moves one run by up to
+  1.5x), with the slowest beside it.
 
 Targets: under 8 s cold and 3 s warm. The machine's load counts in these wall-clock
 figures, so the process's own CPU time is given beside each.
@@ -24,6 +26,7 @@ from pathlib import Path
 
 TARGET_WARM_S = 3.0
 TARGET_COLD_S = 8.0
+WARM_RUNS = 3
 
 
 def _run_compare(cache: Path) -> tuple[float, float]:
@@ -59,7 +62,8 @@ def run() -> list[dict]:
     """Measure and return one row per figure: name, value, unit, target, ok."""
     with tempfile.TemporaryDirectory() as cache:
         cold, cold_cpu = _run_compare(Path(cache))
-        warm, warm_cpu = _run_compare(Path(cache))
+        warm_runs = sorted(_run_compare(Path(cache)) for _ in range(WARM_RUNS))
+    warm, warm_cpu = warm_runs[len(warm_runs) // 2]
     return [
         _row(
             "hystcomp compare, empty kernel cache (fresh temporary folder)",
@@ -68,8 +72,11 @@ def run() -> list[dict]:
             TARGET_COLD_S,
         ),
         _row("  its CPU time (user + system)", cold_cpu, "s"),
-        _row("hystcomp compare, warm kernel cache", warm, "s", TARGET_WARM_S),
+        _row(
+            f"hystcomp compare, warm kernel cache, median of {WARM_RUNS}", warm, "s", TARGET_WARM_S
+        ),
         _row("  its CPU time (user + system)", warm_cpu, "s"),
+        _row("  the slowest warm run", warm_runs[-1][0], "s"),
     ]
 
 
