@@ -124,6 +124,13 @@ def test_npz_columns_of_different_lengths(tmp_path):
         read_record(path)
 
 
+def test_a_single_npy_array_named_npz_is_told_as_such(tmp_path):
+    np.save(tmp_path / "array.npy", np.arange(3.0))
+    path = (tmp_path / "array.npy").rename(tmp_path / "array.npz")
+    with pytest.raises(DataFileError, match=r"single \.npy array, not named arrays"):
+        read_record(path)
+
+
 def test_read_table_for_inputs_and_references(tmp_path):
     path = _csv(tmp_path, "t,x\n0,1\n0.001,2\n")
     table = read_table(path, ("x",))

@@ -74,6 +74,7 @@ def _check_npz_headers(path: Path, file, limit: int) -> None:
     try:
         archive = zipfile.ZipFile(file)
     except (zipfile.BadZipFile, OSError, ValueError, EOFError):
+        file.seek(0)  # the search for a zip directory moved it: np.load reads from the start
         return  # not a zip: np.load says what it is
     with archive:
         for info in archive.infolist():
