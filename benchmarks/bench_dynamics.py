@@ -17,7 +17,8 @@ the rows are ratios measured in the same run:
 * the extra time of the dynamics part of ``compare`` (identification, 1..200 Hz runs, the
   step) as a fraction of the rest of the run (information: ``compare`` must stay fast).
 
-Run alone with ``python benchmarks/bench_dynamics.py``.
+Run alone with ``python benchmarks/bench_dynamics.py``; ``--heights`` prints the step's
+ratio at several heights instead (:func:`step_heights`).
 """
 
 from __future__ import annotations
@@ -61,6 +62,30 @@ def _exact_step_ratio(c, params) -> float:
         )
     ]
     return err[0] / err[1]
+
+
+#: Step heights (fractions of the reference's peak) of :func:`step_heights`.
+HEIGHTS = (0.2, 0.35, 0.5, 0.65, 0.8)
+
+
+def step_heights(c, params, method) -> dict:
+    """``{height: (ratio, error with)}``: a step from rest to ``height`` of the peak, held
+    :data:`STEP_HOLD` s, mean |error| from :data:`STEP_FROM` s with over without the
+    dynamics, and the error with them (µm); as ``compare``'s step, at other heights."""
+    twin = Twin(params, seed=c.config.seed)
+    fs = twin.sample_rate
+    n0 = round(0.1 * fs)
+    window = slice(n0 + round(STEP_FROM * fs), None)
+    model = c.models[method]
+    out = {}
+    for height in HEIGHTS:
+        x_ref = np.r_[np.zeros(n0), np.full(round(STEP_HOLD * fs), height * c.reference_amplitude)]
+        with_, without = (
+            float(np.mean(np.abs(twin.run(comp.simulate(x_ref)) - x_ref)[window]))
+            for comp in (model.inverse(dynamics=c.dynamics.dynamics), model.inverse())
+        )
+        out[height] = (with_ / without, with_)
+    return out
 
 
 def _lifted_ratio(c, params, method) -> float:
@@ -137,5 +162,17 @@ def run() -> list[dict]:
 
 
 if __name__ == "__main__":
+    import sys
+
+    if "--heights" in sys.argv:  # the step at several heights (docs/dynamics.md)
+        for stage, params in STAGES.items():
+            c = run_comparison(CompareConfig(twin=params))
+            for method in ("mpi", "preisach"):
+                cells = step_heights(c, params, method)
+                print(
+                    f"{stage}: {method}, step with / without dynamics (error with, µm): "
+                    + ", ".join(f"{h:g}: {r:.2f} ({e:.3f})" for h, (r, e) in cells.items())
+                )
+        sys.exit()
     for row in run():
         print(f"{row['name']}: {row['value']:.4g} {row['unit']} (target {row['target']})")

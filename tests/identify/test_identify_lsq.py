@@ -2,13 +2,20 @@
 
 import numpy as np
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 
 from hystcomp import presets
 from hystcomp._kernels import chain
 from hystcomp.identify.excitation import triangle_sequence
 from hystcomp.identify.lsq import constrained_lsq, normal_equations
 from hystcomp.identify.pi import paper_thresholds
-from hystcomp.identify.scoring import reversal_folds
+from hystcomp.identify.scoring import (
+    RANGE_BINS,
+    RANGE_WEIGHT_CAP,
+    range_weights,
+    reversal_folds,
+)
 from tests import naive
 from tests.conftest import random_walk
 
@@ -39,6 +46,46 @@ def test_normal_equations_equal_the_explicit_design(rng):
     gram = normal_equations(u, r, y0, z, rs, start)
     full = np.column_stack([_design(u, r, y0, z, rs), z])[start:]
     np.testing.assert_allclose(gram, full.T @ full, rtol=1e-11, atol=1e-6)
+
+
+def test_weighted_normal_equations_equal_the_explicit_weighted_design(rng):
+    u = random_walk(rng, 2500, 0.0, 10.0, 0.8)
+    z = 3.0 * u + rng.normal(size=u.size)
+    r, y0 = np.array([0.0, 1.0, 2.5, 6.0]), np.array([0.0, 0.5, 2.0, 5.0])
+    rs = np.array([4.0, 15.0])
+    c = rng.uniform(0.2, 3.0, u.size)
+    gram = normal_equations(u, r, y0, z, rs, 37, weights=c)
+    full = np.column_stack([_design(u, r, y0, z, rs), z])[37:]
+    np.testing.assert_allclose(gram, full.T @ (c[37:, None] * full), rtol=1e-11, atol=1e-6)
+
+
+@given(st.lists(st.integers(0, RANGE_BINS - 1), min_size=1, max_size=200), st.integers(0, 5))
+def test_range_weights_match_a_count_per_part(parts, start):
+    # after `start` samples left out: the span's two ends, 0 and 24, and samples at the
+    # middle of its parts 0..23
+    u = np.r_[np.zeros(start), 0.0, np.array(parts) + 0.5, float(RANGE_BINS)]
+    w = range_weights(u, start)
+    fitted = u[start:]
+    part = np.minimum(np.floor(u), RANGE_BINS - 1).astype(int)
+    counts = np.array([np.sum(part[start:] == p) for p in range(RANGE_BINS)])
+    raw = np.minimum(fitted.size / RANGE_BINS / counts[part], RANGE_WEIGHT_CAP)
+    np.testing.assert_allclose(w, raw / raw[start:].mean(), rtol=1e-12)
+    assert w[start:].mean() == pytest.approx(1.0)
+
+
+def test_range_weights_of_a_constant_input_are_one():
+    np.testing.assert_array_equal(range_weights(np.full(5, 3.0)), 1.0)
+
+
+def test_range_weights_favour_the_rarely_visited_top_up_to_the_cap():
+    # ten passes through the lowest quarter for one through the rest, as nested triangles
+    ramp = np.linspace(0.0, 120.0, 2401)
+    u = np.r_[np.tile(ramp[ramp < 30.0], 9), ramp]
+    w = range_weights(u)
+    # a count of 10 passes below 30 V and 1 above; 3.25 on average: the top's weight
+    # 3.25 / 1 is capped at 3, the bottom's is 3.25 / 10
+    ratio = w[u >= 30.0].mean() / w[u < 30.0].mean()
+    assert ratio == pytest.approx(RANGE_WEIGHT_CAP / 0.325, rel=0.02)
 
 
 def test_constrained_lsq_matches_a_bounded_solver_when_constraints_bind(rng):

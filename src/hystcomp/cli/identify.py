@@ -129,8 +129,9 @@ def _regularization(ctx, param, value):
     default=None,
     help="pi, mpi: 'physical' [default]: play weights beyond the first are non-negative, so "
     "the loops widen with amplitude and the inverse has no steep slopes, and the play "
-    "thresholds span half the input range, where plays can move; 'paper': eq. 16's "
-    "thresholds and only the partial-sum constraints of eq. 12 / eq. 19 as printed.",
+    "thresholds span half the input range, where plays can move (pi: and every part of the "
+    "input range weighs the same in the fit); 'paper': eq. 16's thresholds and only the "
+    "partial-sum constraints of eq. 12 / eq. 19 as printed.",
 )
 @columns_option
 @fs_option

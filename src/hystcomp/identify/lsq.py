@@ -34,7 +34,8 @@ _BLOCK = 2048  # rows per BLAS update of the Gram matrix: 0.5 MB, in L2 cache (2
 
 
 def normal_equations(
-    u, thresholds, initial_state, z, deadzone_thresholds, start, folds=None, n_folds=1
+    u, thresholds, initial_state, z, deadzone_thresholds, start, folds=None, n_folds=1,
+    weights=None,
 ) -> np.ndarray:
     """The augmented Gram matrix of the PI/MPI regressors over samples ``start..``.
 
@@ -56,6 +57,10 @@ def normal_equations(
         pass (their sum is the matrix over every sample).
     n_folds : int, default 1
         Number of folds (with ``folds``).
+    weights : ndarray, optional
+        A weight ``c_k >= 0`` for every sample (:func:`~hystcomp.identify.scoring.
+        range_weights`): the sums are then ``[Phi | z]^T C [Phi | z]``, the normal equations
+        of the weighted cost ``sum_k c_k e_k^2``. None: every sample weighs 1.
 
     Returns
     -------
@@ -69,6 +74,7 @@ def normal_equations(
     y = np.array(initial_state, dtype=np.float64)  # the play states, advanced block by block
     z = np.ascontiguousarray(z, dtype=np.float64)
     rs = np.ascontiguousarray(deadzone_thresholds, dtype=np.float64)
+    root = None if weights is None else np.sqrt(np.asarray(weights, dtype=np.float64))
     start = int(start)
     gram = np.zeros((n_folds if folds is not None else 1, n + m + 2, n + m + 2))
     rows = np.empty((max(_BLOCK, start), n + m + 2))
@@ -80,6 +86,8 @@ def normal_equations(
     for block, begin in enumerate(range(start, u.size, _BLOCK)):
         part = rows[: min(_BLOCK, u.size - begin)]
         chain.regressor_rows(u, r, y, z, rs, begin, part)
+        if root is not None:
+            part *= root[begin : begin + part.shape[0], None]
         if folds is None:
             gram[0] += part.T @ part
         elif block not in mixed:

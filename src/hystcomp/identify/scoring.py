@@ -118,6 +118,51 @@ def thin(v, start: int = 0, max_samples: int = MAX_SAMPLES) -> np.ndarray:
     return np.flatnonzero(keep)
 
 
+#: Parts of the input range that :func:`range_weights` weighs equally.
+RANGE_BINS = 24
+#: The largest weight :func:`range_weights` gives a sample, relative to the average sample.
+RANGE_WEIGHT_CAP = 3.0
+
+
+def range_weights(u, start: int = 0) -> np.ndarray:
+    """Sample weights under which every part of the input range counts the same in a fit.
+
+    A record lingers where its signal does: the paper's nested triangles and sinusoids,
+    which all start from ``v_min``, hold 8 to 9 times as many samples in the lowest quarter
+    of the range as in the highest. An unweighted least-squares fit then buys its accuracy
+    at the bottom of the stroke with errors at the top, while a compensator is judged over
+    the whole stroke. So the span of ``u[start:]`` is cut into :data:`RANGE_BINS` equal
+    parts, and each sample is weighted by the mean count of samples per part over the count
+    of its own part, at most :data:`RANGE_WEIGHT_CAP` (a part that the record barely visits
+    must not let a few noisy samples steer the fit); the weights average 1 over
+    ``u[start:]``. Samples before ``start`` get the weight of their part (they are out of
+    the cost anyway).
+
+    The PI fit with physical constraints uses it (:func:`hystcomp.identify.pi.fit_pi`); on
+    the panel of ``benchmarks/bench_accuracy.py`` (5 actuators of none of the families, 4
+    excitations) it brings the worst 1 Hz tracking of a PI compensator from 0.62x to 0.48x
+    the uncompensated error. With a cap of 10 the worst cell is 0.49x, with 12 or 48 parts
+    0.50x and 0.49x, with the square root of the weights 0.55x, with their 1.5th power
+    0.56x.
+
+    Examples
+    --------
+    >>> w = range_weights(np.r_[np.zeros(30), np.linspace(0.0, 1.0, 24)])
+    >>> bool(w[0] < w[-1]), round(float(w.mean()), 12)
+    (True, 1.0)
+    """
+    u = np.asarray(u, dtype=np.float64)
+    fitted = u[start:]
+    low, span = float(fitted.min()), float(np.ptp(fitted))
+    if span <= 0.0:
+        return np.ones(u.size)
+    part = np.clip(((u - low) * (RANGE_BINS / span)).astype(np.int64), 0, RANGE_BINS - 1)
+    counts = np.bincount(part[start:], minlength=RANGE_BINS).astype(np.float64)
+    # a part holding a sample has a count of at least 1, so no division by zero below
+    weights = np.minimum(counts.mean() / np.maximum(counts[part], 1.0), RANGE_WEIGHT_CAP)
+    return weights / weights[start:].mean()
+
+
 def reversal_folds(v, start: int, n_folds: int) -> np.ndarray:
     """Folds of a record for cross-validation: its reversal segments dealt out in turn.
 

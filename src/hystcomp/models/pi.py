@@ -60,9 +60,10 @@ class PrandtlIshlinskii(HysteresisModel):
         ``margin`` times the record's mean slope (see :func:`hystcomp.identify.pi.fit_pi`).
     constraints : {"physical", "paper"}, default "physical"
         ``"physical"``: the weights beyond the first are also non-negative, so the loops
-        widen with amplitude and the inverse has no steep slopes (a deviation from the
-        paper, see :mod:`hystcomp.identify.pi`); ``"paper"``: the partial-sum constraints
-        of eq. (12) only.
+        widen with amplitude and the inverse has no steep slopes, and every part of the
+        input range weighs the same in the fit (deviations from the paper, see
+        :mod:`hystcomp.identify.pi`); ``"paper"``: the partial-sum constraints of eq. (12)
+        only, over every sample alike.
 
     Attributes
     ----------
