@@ -34,8 +34,7 @@ _BLOCK = 2048  # rows per BLAS update of the Gram matrix: 0.5 MB, in L2 cache (2
 
 
 def normal_equations(
-    u, thresholds, initial_state, z, deadzone_thresholds, start, folds=None, n_folds=1,
-    weights=None,
+    u, thresholds, initial_state, z, deadzone_thresholds, start, folds=None, n_folds=1, weights=None
 ) -> np.ndarray:
     """The augmented Gram matrix of the PI/MPI regressors over samples ``start..``.
 
