@@ -6,9 +6,6 @@ the rows are ratios measured in the same run:
 
 * rms of the 100 Hz (200 Hz) triangle over the 1 Hz rms of the same compensator, with the
   inverse of the dynamics (targets <= 1.5 and <= 2.5) and without it (for information);
-* the same 100 Hz / 1 Hz ratio for a triangle whose bottom is lifted by :data:`LIFT` µm
-  (information: what is left of the 100 Hz excess away from the bottom of the stroke, where
-  the hysteresis models are least accurate; see docs/dynamics.md);
 * mean |error| from 20 ms to 3 s after a step, with over without the dynamics (target
   < 0.3), and how far the error drifts over that time (the creep left), with over without;
 * the same step ratio for the exact Preisach inverse (information: the default inverse of
@@ -29,17 +26,12 @@ import numpy as np
 
 from hystcomp.experiment.compare import CompareConfig, run_comparison
 from hystcomp.experiment.compare_dynamics import STEP_FROM, STEP_HOLD
-from hystcomp.experiment.references import triangle_reference
-from hystcomp.experiment.tracking import run_tracking
 from hystcomp.plant import Twin, creep_twin
 
 STAGES = {
     "compare twin (630 Hz, zeta 0.1, 3 % creep)": creep_twin(),
     "stage 780 Hz, zeta 0.05, 3 % creep": creep_twin(resonance_hz=780.0, damping_ratio=0.05),
 }
-
-#: How far (µm) the bottom of the lifted triangles is above the rest position.
-LIFT = 1.5
 
 
 def _row(name, value, unit="x", target=None, ok=None):
@@ -88,23 +80,6 @@ def step_heights(c, params, method) -> dict:
     return out
 
 
-def _lifted_ratio(c, params, method) -> float:
-    """100 Hz rms over 1 Hz rms with the dynamics, triangles from LIFT µm to the usual peak."""
-    twin = Twin(params, seed=c.config.seed)
-    comp = c.models[method].inverse(dynamics=c.dynamics.dynamics)
-    rms = {}
-    for f, periods in ((1.0, c.config.periods), (100.0, 10 * c.config.periods)):
-        _, x_ref = triangle_reference(
-            c.reference_amplitude - LIFT,
-            f,
-            periods=periods,
-            sample_rate=twin.sample_rate,
-            offset=LIFT,
-        )
-        rms[f] = run_tracking(comp, twin, x_ref, frequency=f).rms
-    return rms[100.0] / rms[1.0]
-
-
 def run() -> list[dict]:
     """Measure and return one row per figure: name, value, unit, target, ok."""
     rows = []
@@ -127,12 +102,6 @@ def run() -> list[dict]:
                 )
                 plain = dc.results[f][method].rms / c.results[1.0][method].rms
                 rows.append(_row(f"{stage}: {method} alone, rms {f:g} Hz / 1 Hz", plain))
-            rows.append(
-                _row(
-                    f"{stage}: {label}, rms 100 Hz / 1 Hz, triangle lifted {LIFT:g} µm",
-                    _lifted_ratio(c, params, method),
-                )
-            )
             step = dc.step_error[label] / dc.step_error[method]
             rows.append(
                 _row(

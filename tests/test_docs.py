@@ -70,9 +70,10 @@ def test_closed_loop_example_quick(tmp_path, capsys):
     module = runpy.run_path(str(ROOT / "examples" / "closed_loop_feedforward.py"))
     results = module["main"](tmp_path, quick=True)
     rows = results[50.0]
-    # the feedforward removes most of the loop's error at 50 Hz, and the loop adds to it
+    # at 50 Hz, the loop's crossover, the feedforward removes most of the loop's error;
+    # the loop's own lag there adds a little to the feedforward's (0.66 against 0.57 µm)
+    assert rows["feedforward"][0] < 0.15 * rows["feedback"][0]
     assert rows["both"][0] < 0.3 * rows["feedback"][0]
-    assert rows["both"][0] < rows["feedforward"][0]
     assert (tmp_path / "closed_loop_feedforward.png").stat().st_size > 10_000
     assert "feedforward cuts the loop's rms error" in capsys.readouterr().out
 

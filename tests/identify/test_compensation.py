@@ -89,13 +89,14 @@ def test_rich_excitation_covers_the_range_from_rest():
 
 @pytest.mark.parametrize(
     ("name", "pi_target", "mpi_target"),
-    [("twin", 0.5, 0.3), ("kp", 0.5, 0.2), ("preisach", 0.5, 0.2)],
+    [("twin", 0.5, 0.2), ("kp", 0.5, 0.2), ("preisach", 0.5, 0.2)],
 )
 def test_panel_subset_tracks_within_targets_from_the_paper_triangles(name, pi_target, mpi_target):
     """1 Hz triangle tracking / uncompensated on actuators of none of the families
-    (benchmarks/bench_accuracy.py has the whole panel). Measured at 5 kHz: twin 0.33/0.24,
-    kp 0.44/0.03, preisach 0.46/0.17; the paper's fits give 0.55/0.99 on the twin. kp's PI
-    needs the range weights of its fit (0.52 without them)."""
+    (benchmarks/bench_accuracy.py has the whole panel). Measured at 5 kHz: twin 0.33/0.08,
+    kp 0.44/0.03, preisach 0.46/0.14; the paper's fits give 0.55/0.99 on the twin. kp's PI
+    needs the range weights of its fit (0.52 without them), the twin's MPI the descended
+    start (0.24 from eq. 18's virgin one)."""
     bench = Bench(name, sample_rate=5000.0)
     v, x = bench.record("pi")
     pi = bench.ratio(hystcomp.PrandtlIshlinskii().fit(v, x))
@@ -122,14 +123,13 @@ def test_panel_subset_preisach_default_tracks_within_target(name, excitation):
 def test_whole_panel_within_targets():
     """Every cell of benchmarks/bench_accuracy.py (about 30 s). Preisach and PI meet their
     targets (< 0.25x, worst 0.16x; < 0.5x, worst 0.48x); MPI is held where it is, so that
-    no cell regresses: it misses its target (0.2x) on the twin from the paper's signals
-    and on the Bouc-Wen stage (worst 0.49x)."""
+    no cell regresses: it meets its target (0.2x) but on the Bouc-Wen stage (worst 0.33x)."""
     from benchmarks.bench_accuracy import ratio_table
 
     for (name, exc), cells in ratio_table().items():
         assert cells["Preisach"] < 0.25, (name, exc, cells)
         assert cells["PI"] < 0.5, (name, exc, cells)
-        assert cells["MPI"] < 0.55, (name, exc, cells)
+        assert cells["MPI"] < (0.35 if name == "boucwen" else 0.2), (name, exc, cells)
 
 
 def test_real_record_holdout_stays_well_below_the_straight_line():

@@ -261,7 +261,9 @@ def report_markdown(comparison, figure_notes: dict[str, str | None]) -> str:
             (
                 "The default fit keeps the play weights beyond the first non-negative (the loop "
                 "widens with amplitude, as on a piezo), spreads the play thresholds over half the "
-                "input span (where plays can move) and chooses the MPI regularisation by the "
+                "input span (where plays can move), weighs every part of the input range the "
+                "same (PI), and chooses the MPI regularisation and the plays' initial memory "
+                "(eq. 18's virgin start, or descended, so that loops close at 0 V) by the "
                 'predicted tracking error; the paper\'s fit (constraints="paper", '
                 "regularization=0) only keeps every partial sum positive, so on an actuator of "
                 "none of the model families its weights may alternate in sign and its inverse "
@@ -397,13 +399,22 @@ def _baseline_reading(c, common) -> list[str]:
 
 def _mpi_note(model) -> str:
     """How the MPI regularisation was chosen, if the model was fitted."""
-    value = getattr(model, "fit_report_", {}).get("regularization")
+    report = getattr(model, "fit_report_", {})
+    value = report.get("regularization")
     if value is None:
         return "MPI model: given, not identified in this run."
+    memory = report.get("initial_memory", "virgin")
     return (
         f"MPI identification: eq. 19 with non-negative play weights beyond the first and a "
-        f"penalty on the inverse dead-zone weights (regularization {value:g}), the value of "
-        "0, 1e-4 .. 1e-1 whose compensator is predicted to track best "
+        f"penalty on the inverse dead-zone weights (regularization {value:g}), the plays "
+        f"starting {memory} ({_MEMORY[memory]}); of 0, 1e-4 .. 1e-1 and of both initial "
+        "memories, those whose compensator is predicted to track best "
         "(hystcomp.identify.compensation). Eq. 19 as printed overfits a twin that is not an "
         "MPI system (see the section on the paper's fit below)."
     )
+
+
+_MEMORY = {
+    "virgin": "eq. 18's zero states",
+    "descended": "as after a descent from the top, so that every loop closes at 0 V",
+}

@@ -75,6 +75,10 @@ def tracking_scorer(v, x, *, start: int = 0, max_samples=MAX_SCORED_SAMPLES, fol
     estimates: the held-out forward error (the size of the model's error away from its
     record) and the inverse's error on the record (which sees the steep slopes of an
     inverse the forward error cannot). Without held-out fits it is the latter alone.
+
+    ``score(model, held_out, estimate=False)`` leaves out the inverse's run over the whole
+    record: the score then holds the held-out figures and ``criterion_um`` only, enough to
+    rank candidates at a fraction of the cost.
     """
     owner = "compensation_error"
     v, x = as_signal_pair(v, x, ("v", "x"), owner, min_samples=2)
@@ -109,18 +113,20 @@ def tracking_scorer(v, x, *, start: int = 0, max_samples=MAX_SCORED_SAMPLES, fol
         v_cv, x_cv = v_k[cv_keep], np.ascontiguousarray(x_k[cv_keep])
         folds_k = folds[keep][cv_keep]
 
-    def score(model, held_out=()) -> dict:
-        v_hat = np.asarray(model.inverse().simulate(x_k), dtype=np.float64)
-        err = a * (v_hat[scored] - v_s)
-        model_rms = float(np.sqrt(np.mean(err**2)))
-        out = {
-            "tracking_rms_um": model_rms,
-            "baseline_rms_um": line_rms,
-            "ratio": model_rms / line_rms if line_rms > 0 else float("inf"),
-            "gain_um_per_v": a,
-            "n_scored": int(v_s.size),
-            "criterion_um": model_rms,
-        }
+    def score(model, held_out=(), *, estimate=True) -> dict:
+        out: dict = {}
+        if estimate or not (held_out and folds_k is not None):
+            v_hat = np.asarray(model.inverse().simulate(x_k), dtype=np.float64)
+            err = a * (v_hat[scored] - v_s)
+            model_rms = float(np.sqrt(np.mean(err**2)))
+            out = {
+                "tracking_rms_um": model_rms,
+                "baseline_rms_um": line_rms,
+                "ratio": model_rms / line_rms if line_rms > 0 else float("inf"),
+                "gain_um_per_v": a,
+                "n_scored": int(v_s.size),
+                "criterion_um": model_rms,
+            }
         if held_out and folds_k is not None:
             forward, inverse, count = 0.0, 0.0, 0
             for fold, fitted in enumerate(held_out):

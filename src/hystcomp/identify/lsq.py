@@ -193,6 +193,27 @@ def constrained_lsq(
         If the constrained problem has no solution (it always has one when the first
         regressor of each block varies; the message says what to check otherwise).
     """
+    (solution,) = constrained_lsq_path(
+        gram,
+        (ridge,),
+        blocks=blocks,
+        scales=scales,
+        floors=floors,
+        caps=caps,
+        flat_tol=flat_tol,
+    )
+    return solution
+
+
+def constrained_lsq_path(
+    gram, ridges, *, blocks, scales, floors=(), caps=(), flat_tol=1e-6
+) -> list[LsqSolution]:
+    """:func:`constrained_lsq` for each ridge of ``ridges`` on the same Gram matrix.
+
+    The problem (centring, scaling, constraint rows) is set up once and only the ridge
+    changes from one quadratic programme to the next, which is most of the cost of one
+    (a path of penalties, :func:`~hystcomp.identify.mpi.fit_mpi_path`).
+    """
     p = gram.shape[0] - 1
     G, g, zz, count, mean, z_mean, G_c, g_c = _centred(gram)
     spread = np.sqrt(np.maximum(np.diag(G_c), 0.0) / count)
@@ -207,7 +228,6 @@ def constrained_lsq(
     idx = np.flatnonzero(varies)
     scale = 1.0 / np.sqrt(np.diag(G_c)[idx])
     quad = G_c[np.ix_(idx, idx)] * np.outer(scale, scale)
-    quad[np.diag_indices_from(quad)] += np.broadcast_to(ridge, (p - 1,))[idx]
     lin = g_c[idx] * scale
     rows, bounds = [np.empty((0, idx.size))], [np.empty(0)]
     # one row per coefficient that varies (partial sums at a fixed, zero, coefficient
@@ -222,20 +242,27 @@ def constrained_lsq(
                 mask = idx[None, :] == i[:, None]
             rows.append(np.where(mask, sign * scale, 0.0))
             bounds.append(np.full(i.size, sign * bound))
-    cons = np.vstack(rows)
-    try:
-        solution = quadprog.solve_qp(quad, lin, cons.T.copy(), np.concatenate(bounds))[0]
-    except ValueError as exc:
-        raise IdentificationError(
-            f"The constrained least-squares problem could not be solved ({exc}). Check that "
-            "the record is one experiment (input and displacement of the same samples) and "
-            "try fewer operators."
-        ) from None
-    coef = np.zeros(p)
-    coef[idx] = solution * scale
-    coef[-1] = z_mean - mean @ coef[:-1]
-    rss = float(zz - 2.0 * g @ coef + coef @ G @ coef)
-    return LsqSolution(coef=coef, rss=max(rss, 0.0), varies=varies)
+    cons_t = np.vstack(rows).T.copy()
+    bound = np.concatenate(bounds)
+    diagonal = np.diag_indices_from(quad)
+    solutions = []
+    for ridge in ridges:
+        ridged = quad.copy()
+        ridged[diagonal] += np.broadcast_to(ridge, (p - 1,))[idx]
+        try:
+            solution = quadprog.solve_qp(ridged, lin, cons_t, bound)[0]
+        except ValueError as exc:
+            raise IdentificationError(
+                f"The constrained least-squares problem could not be solved ({exc}). Check "
+                "that the record is one experiment (input and displacement of the same "
+                "samples) and try fewer operators."
+            ) from None
+        coef = np.zeros(p)
+        coef[idx] = solution * scale
+        coef[-1] = z_mean - mean @ coef[:-1]
+        rss = float(zz - 2.0 * g @ coef + coef @ G @ coef)
+        solutions.append(LsqSolution(coef=coef, rss=max(rss, 0.0), varies=varies))
+    return solutions
 
 
 def held_out_fits(grams, solve) -> tuple:

@@ -59,30 +59,40 @@ With a second record of the actuator,
 :func:`hystcomp.identify.validation.choose_regularization` chooses by prediction instead.
 
 Samples weigh alike. The PI fit weights them so that every part of the input range counts
-the same (:func:`~hystcomp.identify.scoring.range_weights`); for MPI that trade is not a
-clear gain, so eq. (19)'s unweighted sum stays. Weighted, the 1 Hz tracking of the panel
-improves (the twin from the paper's triangles 0.24x to 0.18x, from its sinusoids 0.27x to
-0.15x, the Bouc-Wen stage 0.49x to 0.45x) and so does Table I's MPI row in ``hystcomp
-compare`` (0.41 to 0.32 µm at 1 Hz). But the weights take accuracy from the bottom of the
-initial loading curve, which every move from rest follows: on the compare twin a step from
-rest, held 3 s with the inverse of the dynamics, leaves a mean error of 0.130 µm instead
-of 0.078 µm (average over steps to 0.2 .. 0.8 of the stroke; 0.135 against 0.017 µm for
-``compare``'s step to half the stroke, above the creep it removes).
+the same (:func:`~hystcomp.identify.scoring.range_weights`); for MPI that is no gain, so
+eq. (19)'s unweighted sum stays: weighted, the worst cell of the panel of
+``benchmarks/bench_accuracy.py`` goes from 0.33x to 0.38x (the Bouc-Wen stage from the
+paper's triangles, 0.26x to 0.38x), the twin from 0.075x to 0.10x.
+
+Initial memory (a deviation from eq. 18 with the physical constraints). Eq. (18) starts
+every play at zero, the *virgin* state of a demagnetised actuator: a loop from ``v_min``
+back to ``v_min`` then ends above its start by ``sum_i w_i r_i``. A piezo that has been
+driven before (by its own identification run, for one) rests at ``v_min`` in the state
+that the last descent left, and most stages close their loops there. The physical fit
+therefore also fits the *descended* start, every play at the top of its band as after a
+descent from above (:func:`initial_play_states`; for the plays, the state of a Preisach
+model with every relay off, where :class:`~hystcomp.Preisach` starts), and
+``ModifiedPrandtlIshlinskii`` keeps the one whose compensator is predicted to track best
+(the same criterion as the regularisation). On the panel it keeps the better of the two in
+all 20 cells: the twin from the paper's triangles goes from 0.24x to 0.075x the
+uncompensated error, the Bouc-Wen stage from 0.49x to 0.26x, and the Coleman-Hodgdon
+stage, which keeps 3.4 µm at 0 V after a loop, stays virgin. Table I's MPI row in
+``hystcomp compare`` goes from 0.41 to 0.16 µm at 1 Hz.
 
 Limits of the family. ``S`` bends the loop as a function of the *output* level, so an
 actuator whose loop width depends on the *input* level in another way than its loading
-curve's slope (a Bouc-Wen stage whose hysteretic gain vanishes at 0 V, where every loop
-closes) is beyond any MPI model. On the quasi-static hysteresis of the panel's Bouc-Wen
-stage (no creep, resonance or noise), the best MPI of 16 or 32 plays and dead-zones over
-every regularisation tracks the 1 Hz triangle at 0.48x the uncompensated error from the
-paper's triangles, and still 0.36x when fitted on the tracked 0..120 V loop itself; on the
-twin, 0.22x from the nested triangles but 0.11x from the 0..120 V loop: one set of
-weights cannot match loops of every amplitude (``python benchmarks/bench_accuracy.py
---limit``).
+curve's slope (a Bouc-Wen stage whose hysteretic gain grows from nothing at 0 V) is beyond
+any MPI model. On the quasi-static hysteresis of the panel's Bouc-Wen stage (no creep,
+resonance or noise), the best MPI of 16 or 32 plays and dead-zones over every
+regularisation tracks the 1 Hz triangle at 0.25x the uncompensated error from the paper's
+triangles, and 0.33x when fitted on the tracked 0..120 V loop itself (on the twin, 0.07x
+and 0.08x; ``python benchmarks/bench_accuracy.py --limit``).
 """
 
 from __future__ import annotations
 
+import dataclasses
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -96,7 +106,7 @@ from hystcomp._hyperparameters import (
 )
 from hystcomp._validation import as_vector, check_int, check_real
 from hystcomp.errors import InvalidParameterError
-from hystcomp.identify.lsq import RIDGE, constrained_lsq, held_out_fits, normal_equations
+from hystcomp.identify.lsq import RIDGE, constrained_lsq_path, held_out_fits, normal_equations
 from hystcomp.identify.pi import (
     paper_thresholds,
     play_thresholds,
@@ -128,6 +138,10 @@ class MPIFit:
         subset (:func:`~hystcomp.identify.scoring.thin`).
     first_sample : int
         First sample of the record in the cost.
+    regularization : float
+        The penalty it was fitted with.
+    initial_memory : {"virgin", "descended"}
+        The plays' initial memory it was fitted with (:func:`initial_play_states`).
     folds : ndarray or None
         With ``held_out``: the fold of each of the ``samples`` (-1 before the first).
     held_out : tuple of MPIFit
@@ -144,6 +158,8 @@ class MPIFit:
     output_offset: float
     first_sample: int
     samples: np.ndarray | None = None
+    regularization: float = 0.0
+    initial_memory: str = "virgin"
     folds: np.ndarray | None = None
     held_out: tuple = ()
 
@@ -169,13 +185,51 @@ def absorb_bias(weights, initial_state, input_offset: float, bias: float):
     initial_state = as_vector(initial_state, "initial_state", "absorb_bias", length=weights.size)
     input_offset = check_real(input_offset, "input_offset", "absorb_bias")
     bias = check_real(bias, "bias", "absorb_bias")
-    total = float(np.sum(weights))
-    if total == 0.0:
+    if float(np.sum(weights)) == 0.0:
         raise InvalidParameterError(
             "absorb_bias: the weights sum to 0, so a bias cannot be absorbed."
         )
-    shift = bias / total
+    return _absorb_bias(weights, initial_state, input_offset, bias)
+
+
+def _absorb_bias(weights, initial_state, input_offset: float, bias: float):
+    """:func:`absorb_bias` for a fit's own values (finite; ``sum(w) > 0`` by its constraints)."""
+    shift = bias / float(np.sum(weights))
     return initial_state + shift, input_offset - shift
+
+
+#: The initial memories of a play superposition that a fit can start from.
+INITIAL_MEMORIES = ("virgin", "descended")
+
+
+def check_initial_memory(initial_memory) -> str:
+    """The ``initial_memory`` option: one of :data:`INITIAL_MEMORIES`."""
+    if initial_memory not in INITIAL_MEMORIES:
+        raise InvalidParameterError(
+            f"The 'initial_memory' parameter must be one of {INITIAL_MEMORIES}. "
+            f"Got {initial_memory!r} instead."
+        )
+    return initial_memory
+
+
+def initial_play_states(u0: float, thresholds, initial_memory: str) -> np.ndarray:
+    """The states of plays of ``thresholds`` at a first input ``u0``, for an initial memory.
+
+    ``"virgin"``: every play at the input, ``y_i = u0`` (eq. 18's zero states for a record
+    that starts at ``v_min``): the loading curve from there is the initial one, and a loop
+    back to ``u0`` ends above its start by ``sum_i w_i r_i``. ``"descended"``: every play at
+    the top of its band, ``y_i = u0 + r_i``, as after a descent from far above (for the
+    plays, the state of a Preisach model whose every relay is off, the start of
+    :class:`~hystcomp.Preisach`): every loop from ``u0`` closes there again.
+
+    Examples
+    --------
+    >>> initial_play_states(0.0, np.array([0.0, 10.0]), "descended").tolist()
+    [0.0, 10.0]
+    """
+    initial_memory = check_initial_memory(initial_memory)
+    r = np.asarray(thresholds, dtype=np.float64)
+    return np.full(r.size, float(u0)) + (r if initial_memory == "descended" else 0.0)
 
 
 def fit_mpi(
@@ -188,6 +242,7 @@ def fit_mpi(
     margin=DEFAULT_MARGIN,
     regularization=0.0,
     constraints="physical",
+    initial_memory="virgin",
 ) -> MPIFit:
     """Identify an MPI model (eq. 15) from a measured record, by eq. (19) with constraints.
 
@@ -211,6 +266,9 @@ def fit_mpi(
     constraints : {"physical", "paper"}, default "physical"
         ``"physical"``: also ``w_i >= 0`` for the plays beyond the first; ``"paper"``:
         the partial-sum constraints of eq. (19) only.
+    initial_memory : {"virgin", "descended"}, default "virgin"
+        The plays' state at the first sample (:func:`initial_play_states`): eq. (18)'s
+        ``"virgin"`` state, or ``"descended"``, as after a descent from above.
 
     Returns
     -------
@@ -227,6 +285,7 @@ def fit_mpi(
         margin=margin,
         regularizations=(regularization,),
         constraints=constraints,
+        initial_memories=(initial_memory,),
     )
     return fit
 
@@ -242,11 +301,13 @@ def fit_mpi_path(
     regularizations=REGULARIZATION_GRID,
     constraints="physical",
     n_folds=0,
+    initial_memories=("virgin",),
 ) -> list[MPIFit]:
     """:func:`fit_mpi` for several values of ``regularization`` at the cost of about one.
 
     The normal equations of eq. (19) do not depend on the penalty, so they are accumulated
-    once over the record; each value costs one small quadratic programme.
+    once over the record for each initial memory; each value costs one small quadratic
+    programme.
 
     Parameters
     ----------
@@ -254,6 +315,9 @@ def fit_mpi_path(
         As in :func:`fit_mpi`.
     regularizations : sequence of float, default :data:`REGULARIZATION_GRID`
         The penalties (>= 0), in the order of the fits returned.
+    initial_memories : sequence of {"virgin", "descended"}, default ("virgin",)
+        The plays' initial memories to fit (:func:`initial_play_states`), each with every
+        penalty, in this order.
     n_folds : int, default 0
         With 2 or more, also fit each value on all but one fold of the record's reversal
         segments (:func:`~hystcomp.identify.scoring.reversal_folds`), for every fold, from
@@ -265,7 +329,7 @@ def fit_mpi_path(
     Returns
     -------
     list of MPIFit
-        One fit per value of ``regularizations``.
+        One fit per initial memory and value of ``regularizations``, memory by memory.
     """
     owner = "fit_mpi"
     n = check_int(n_operators, "n_operators", owner)
@@ -279,45 +343,58 @@ def fit_mpi_path(
             "Got an empty sequence instead."
         )
     n_folds = check_int(n_folds, "n_folds", owner, minimum=0)
+    memories = [check_initial_memory(memory) for memory in initial_memories]
     rec = prepare_record(v, x, n_weights=n + m, transient=transient, owner=owner)
     r = play_thresholds(n, rec.input_span, constraints)
-    y0 = np.full(n, rec.u[0])
     x0 = float(rec.x[rec.start :].min())
     z = rec.x - x0
     z_span = float(z[rec.start :].max())
     rs = paper_thresholds(m, z_span)  # eq. (17)
     folds = reversal_folds(rec.u, rec.start, n_folds) if n_folds > 1 else None
-    grams = normal_equations(rec.u, r, y0, z, rs[1:], rec.start, folds, max(n_folds, 1))
-    gram = grams.sum(axis=0) if folds is not None else grams
-
     scales = np.concatenate([np.full(n, rec.input_span), np.full(m - 1, z_span)])
     on_deadzones = np.concatenate([np.zeros(n), np.ones(m - 1)])
 
-    def solve(gram, penalty, **extra) -> MPIFit:
-        sol = constrained_lsq(
+    ridges = [RIDGE + penalty * on_deadzones for penalty in penalties]
+
+    def solve(gram, y0, memory) -> list[MPIFit]:
+        """The fits of every penalty on ``gram``, plays starting at ``y0``."""
+        solutions = constrained_lsq_path(
             gram,
+            ridges,
             blocks=[(0, n, margin * rec.slope), (n, n + m - 1, margin - 1.0)],
             floors=[(1, n, 0.0)] if constraints == "physical" else (),
             scales=scales,
-            ridge=RIDGE + penalty * on_deadzones,
         )
-        weights = sol.coef[:n]
-        initial_state, input_offset = absorb_bias(weights, y0, rec.input_offset, sol.coef[-1])
-        return MPIFit(
-            thresholds=r,
-            weights=weights,
-            initial_state=initial_state,
-            inverse_deadzone_thresholds=rs,
-            inverse_deadzone_weights=np.r_[1.0, sol.coef[n : n + m - 1]],
-            input_offset=input_offset,
-            output_offset=x0,
-            first_sample=int(rec.samples[rec.start]),
-            samples=rec.samples,
-            **extra,
-        )
+        fits = []
+        for penalty, sol in zip(penalties, solutions, strict=True):
+            weights = sol.coef[:n]
+            initial_state, input_offset = _absorb_bias(weights, y0, rec.input_offset, sol.coef[-1])
+            fits.append(
+                MPIFit(
+                    thresholds=r,
+                    weights=weights,
+                    initial_state=initial_state,
+                    inverse_deadzone_thresholds=rs,
+                    inverse_deadzone_weights=np.r_[1.0, sol.coef[n : n + m - 1]],
+                    input_offset=input_offset,
+                    output_offset=x0,
+                    first_sample=int(rec.samples[rec.start]),
+                    samples=rec.samples,
+                    regularization=penalty,
+                    initial_memory=memory,
+                )
+            )
+        return fits
 
     fits = []
-    for penalty in penalties:
-        held_out = () if folds is None else held_out_fits(grams, lambda g, p=penalty: solve(g, p))
-        fits.append(solve(gram, penalty, folds=folds if held_out else None, held_out=held_out))
+    for memory in memories:
+        y0 = initial_play_states(rec.u[0], r, memory)
+        grams = normal_equations(rec.u, r, y0, z, rs[1:], rec.start, folds, max(n_folds, 1))
+        gram = grams.sum(axis=0) if folds is not None else grams
+        # per fold left out, the fits of every penalty
+        solve_fold = functools.partial(solve, y0=y0, memory=memory)
+        held_out = () if folds is None else held_out_fits(grams, solve_fold)
+        for k, fit in enumerate(solve(gram, y0, memory)):
+            parts = tuple(by_penalty[k] for by_penalty in held_out)
+            fits.append(dataclasses.replace(fit, folds=folds if parts else None, held_out=parts))
     return fits

@@ -420,6 +420,12 @@ def identify_record(
         lines.append(
             f"  regularization: {chosen:g} (auto: the best predicted tracking of 0, 1e-4 .. 1e-1)"
         )
+    memory = getattr(model, "fit_report_", {}).get("initial_memory")
+    if memory is not None and model.get_params().get("constraints") == "physical":
+        lines.append(
+            f"  initial memory: {memory} (the better predicted tracking of 'virgin', eq. 18, "
+            "and 'descended')"
+        )
     if kind == "preisach":
         lines.append(f"  Everett fit: {_preisach_fit_line(model)}")
     lines.append(

@@ -14,7 +14,7 @@ from hystcomp import paper
 from hystcomp._hyperparameters import check_regularization_option
 from hystcomp._validation import as_vector, check_int, check_thresholds
 from hystcomp.identify.compensation import CV_FOLDS, tracking_scorer
-from hystcomp.identify.mpi import REGULARIZATION_GRID, fit_mpi_path
+from hystcomp.identify.mpi import INITIAL_MEMORIES, REGULARIZATION_GRID, fit_mpi_path
 from hystcomp.models.base import DEFAULT_VOLTAGE_RANGE, fit_voltage_range
 from hystcomp.models.compensator import Compensator
 from hystcomp.models.dynamic_compensator import DynamicCompensator
@@ -52,13 +52,15 @@ class ModifiedPrandtlIshlinskii(PrandtlIshlinskii):
         segments (``fit_report_["criterion_um"]``, see
         :func:`hystcomp.identify.compensation.tracking_scorer`), not the smallest fit
         error: a model that reproduces its record best can still predict other branches
-        worse, or have an inverse with steep slopes. With a second record of the actuator, choose it by prediction there with
+        worse, or have an inverse with steep slopes. With a second record of the actuator,
+        choose it by prediction there with
         :func:`hystcomp.identify.validation.choose_regularization`.
     constraints : {"physical", "paper"}, default "physical"
-        ``"physical"``: play weights beyond the first are non-negative and ``S`` stays
-        monotone (see :mod:`hystcomp.identify.mpi`); ``"paper"``: the partial-sum
-        constraints of eq. (19) only. ``constraints="paper", regularization=0`` is the
-        paper's fit exactly.
+        ``"physical"``: play weights beyond the first are non-negative, ``S`` stays
+        monotone, and the plays start virgin (eq. 18) or descended, whichever is predicted
+        to track best, as the regularisation (see :mod:`hystcomp.identify.mpi`);
+        ``"paper"``: the partial-sum constraints of eq. (19) only, from eq. (18)'s virgin
+        start. ``constraints="paper", regularization=0`` is the paper's fit exactly.
 
     Attributes
     ----------
@@ -72,7 +74,8 @@ class ModifiedPrandtlIshlinskii(PrandtlIshlinskii):
         As in :class:`~hystcomp.models.pi.PrandtlIshlinskii`.
     fit_report_ : dict
         After :meth:`fit`: errors of the model on the record, the ``regularization`` it was
-        fitted with (the chosen value if ``"auto"``), ``tracking_rms_um`` (the estimated
+        fitted with (the chosen value if ``"auto"``), the ``initial_memory`` of its plays
+        (``"virgin"`` or ``"descended"``), ``tracking_rms_um`` (the estimated
         tracking error of its compensator, µm rms), ``baseline_tracking_rms_um`` (the same
         for a straight line ``v = x / k_lin``), and the cross-validated errors
         ``held_out_rms_um``, ``held_out_tracking_rms_um`` and ``criterion_um``
@@ -146,6 +149,7 @@ class ModifiedPrandtlIshlinskii(PrandtlIshlinskii):
         n = check_int(self.n_operators, "n_operators", owner)
         m = check_int(self.n_deadzones, "n_deadzones", owner)
         penalties = self._penalties(owner)
+        # eq. 18's virgin plays, and with the physical constraints the descended ones too
         fits = fit_mpi_path(
             v,
             x,
@@ -156,6 +160,7 @@ class ModifiedPrandtlIshlinskii(PrandtlIshlinskii):
             regularizations=penalties,
             constraints=self.constraints,
             n_folds=CV_FOLDS,
+            initial_memories=INITIAL_MEMORIES if self.constraints == "physical" else ("virgin",),
         )
         # scored on the samples the fit used (a long record is thinned, see fit_mpi_path);
         # they hold the extremes of the input
@@ -163,31 +168,31 @@ class ModifiedPrandtlIshlinskii(PrandtlIshlinskii):
         voltage_range = fit_voltage_range(self.voltage_range, v_k, owner)
         score = tracking_scorer(v_k, x_k, start=first, folds=fits[0].folds)
         candidates = []
-        for penalty, fit in zip(penalties, fits, strict=True):
+        for fit in fits:
             candidate = self._from_fit(fit, voltage_range)
             held_out = tuple(self._from_fit(part, voltage_range) for part in fit.held_out)
-            candidates.append((candidate, penalty, score(candidate, held_out)))
-        # the smallest criterion (the first of equals)
-        model, penalty, est = min(candidates, key=lambda c: c[2]["criterion_um"])
-        self._adopt_fit(model, v_k, x_k, first, est, regularization=penalty)
+            candidates.append((candidate, fit, score(candidate, held_out, estimate=False)))
+        # the smallest criterion (the first of equals), then its estimate on the record
+        model, fit, cv = min(candidates, key=lambda c: c[2]["criterion_um"])
+        est = {**score(model), **cv}
+        self._adopt_fit(
+            model,
+            v_k,
+            x_k,
+            first,
+            est,
+            regularization=fit.regularization,
+            initial_memory=fit.initial_memory,
+        )
         return self
 
     def _from_fit(self, fit, voltage_range) -> Self:
-        """The model of an :class:`~hystcomp.identify.mpi.MPIFit` (forward dead-zones from
-        the identified inverse ones, eqs. 24-25)."""
-        rs, ws = self.forward_deadzones(
-            fit.inverse_deadzone_thresholds, fit.inverse_deadzone_weights
-        )
-        return self.from_parameters(
-            thresholds=fit.thresholds,
-            weights=fit.weights,
-            initial_state=fit.initial_state,
-            deadzone_thresholds=rs,
-            deadzone_weights=ws,
-            voltage_range=voltage_range,
-            input_offset=fit.input_offset,
-            output_offset=fit.output_offset,
-        )
+        """The model of an :class:`~hystcomp.identify.mpi.MPIFit`, its forward dead-zones
+        from the identified inverse ones (eqs. 24-25; see :meth:`_set_fitted`)."""
+        rs, ws = invert_superposition(fit.inverse_deadzone_thresholds, fit.inverse_deadzone_weights)
+        model = type(self)(n_operators=fit.thresholds.size, n_deadzones=rs.size, voltage_range=None)
+        model._set_fitted(fit, voltage_range, deadzone_thresholds_=rs, deadzone_weights_=ws)
+        return model
 
     def _penalties(self, owner: str) -> tuple[float, ...]:
         """The regularisation values to fit: the grid for ``"auto"``, else the one given."""

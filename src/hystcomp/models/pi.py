@@ -163,15 +163,31 @@ class PrandtlIshlinskii(HysteresisModel):
         return self
 
     def _from_fit(self, fit, voltage_range) -> Self:
-        """The model of a :class:`~hystcomp.identify.pi.PIFit`."""
-        return self.from_parameters(
-            thresholds=fit.thresholds,
-            weights=fit.weights,
-            initial_state=fit.initial_state,
-            voltage_range=voltage_range,
-            input_offset=fit.input_offset,
-            output_offset=fit.output_offset,
-        )
+        """The model of a :class:`~hystcomp.identify.pi.PIFit` (see :meth:`_set_fitted`)."""
+        model = type(self)(n_operators=fit.thresholds.size, voltage_range=None)
+        model._set_fitted(fit, voltage_range)
+        return model
+
+    def _set_fitted(self, fit, voltage_range, **arrays) -> None:
+        """Set the learned attributes from an identification's ``fit`` (and ``arrays``).
+
+        They are not validated again, as :meth:`from_parameters` does: the fit computed them
+        under its constraints (finite, every partial sum above the margin) and
+        ``voltage_range`` was checked, while a fit builds dozens of candidate models.
+        """
+        fields = {
+            "thresholds_": fit.thresholds,
+            "weights_": fit.weights,
+            "initial_state_": fit.initial_state,
+            **arrays,
+        }
+        for name, value in fields.items():
+            value = np.array(value, dtype=np.float64)  # the model's own, read-only
+            value.setflags(write=False)
+            setattr(self, name, value)
+        self.voltage_range_ = voltage_range
+        self.input_offset_ = float(fit.input_offset)
+        self.output_offset_ = float(fit.output_offset)
 
     def _adopt_fit(self, fitted: Self, v_k, x_k, first: int, est: dict, **extra) -> None:
         """Take ``fitted``'s parameters, with its fit report on the thinned record: the
