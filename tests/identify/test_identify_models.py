@@ -18,14 +18,8 @@ from hystcomp.errors import (
 from hystcomp.experiment.references import triangle_reference
 from hystcomp.identify.compensation import CV_FOLDS
 from hystcomp.identify.excitation import PI_AMPLITUDES, scaled_amplitudes, triangle_sequence
-from hystcomp.identify.mpi import (
-    REGULARIZATION_GRID,
-    absorb_bias,
-    fit_mpi,
-    fit_mpi_path,
-    initial_play_states,
-)
-from hystcomp.identify.pi import fit_pi, play_thresholds
+from hystcomp.identify.mpi import REGULARIZATION_GRID, absorb_bias, fit_mpi, fit_mpi_path
+from hystcomp.identify.pi import fit_pi, initial_play_states, play_thresholds
 from hystcomp.identify.scoring import reversal_folds, transient_end
 from hystcomp.identify.validation import choose_regularization
 from hystcomp.plant import Twin

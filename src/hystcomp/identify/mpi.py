@@ -70,7 +70,7 @@ back to ``v_min`` then ends above its start by ``sum_i w_i r_i``. A piezo that h
 driven before (by its own identification run, for one) rests at ``v_min`` in the state
 that the last descent left, and most stages close their loops there. The physical fit
 therefore also fits the *descended* start, every play at the top of its band as after a
-descent from above (:func:`initial_play_states`; for the plays, the state of a Preisach
+descent from above (:func:`~hystcomp.identify.pi.initial_play_states`; for the plays, the state of a Preisach
 model with every relay off, where :class:`~hystcomp.Preisach` starts), and
 ``ModifiedPrandtlIshlinskii`` keeps the one whose compensator is predicted to track best
 (the same criterion as the regularisation). On the panel it keeps the better of the two in
@@ -108,6 +108,8 @@ from hystcomp._validation import as_vector, check_int, check_real
 from hystcomp.errors import InvalidParameterError
 from hystcomp.identify.lsq import RIDGE, constrained_lsq_path, held_out_fits, normal_equations
 from hystcomp.identify.pi import (
+    check_initial_memory,
+    initial_play_states,
     paper_thresholds,
     play_thresholds,
     prepare_record,
@@ -141,7 +143,7 @@ class MPIFit:
     regularization : float
         The penalty it was fitted with.
     initial_memory : {"virgin", "descended"}
-        The plays' initial memory it was fitted with (:func:`initial_play_states`).
+        The plays' initial memory it was fitted with (:func:`~hystcomp.identify.pi.initial_play_states`).
     folds : ndarray or None
         With ``held_out``: the fold of each of the ``samples`` (-1 before the first).
     held_out : tuple of MPIFit
@@ -198,40 +200,6 @@ def _absorb_bias(weights, initial_state, input_offset: float, bias: float):
     return initial_state + shift, input_offset - shift
 
 
-#: The initial memories of a play superposition that a fit can start from.
-INITIAL_MEMORIES = ("virgin", "descended")
-
-
-def check_initial_memory(initial_memory) -> str:
-    """The ``initial_memory`` option: one of :data:`INITIAL_MEMORIES`."""
-    if initial_memory not in INITIAL_MEMORIES:
-        raise InvalidParameterError(
-            f"The 'initial_memory' parameter must be one of {INITIAL_MEMORIES}. "
-            f"Got {initial_memory!r} instead."
-        )
-    return initial_memory
-
-
-def initial_play_states(u0: float, thresholds, initial_memory: str) -> np.ndarray:
-    """The states of plays of ``thresholds`` at a first input ``u0``, for an initial memory.
-
-    ``"virgin"``: every play at the input, ``y_i = u0`` (eq. 18's zero states for a record
-    that starts at ``v_min``): the loading curve from there is the initial one, and a loop
-    back to ``u0`` ends above its start by ``sum_i w_i r_i``. ``"descended"``: every play at
-    the top of its band, ``y_i = u0 + r_i``, as after a descent from far above (for the
-    plays, the state of a Preisach model whose every relay is off, the start of
-    :class:`~hystcomp.Preisach`): every loop from ``u0`` closes there again.
-
-    Examples
-    --------
-    >>> initial_play_states(0.0, np.array([0.0, 10.0]), "descended").tolist()
-    [0.0, 10.0]
-    """
-    initial_memory = check_initial_memory(initial_memory)
-    r = np.asarray(thresholds, dtype=np.float64)
-    return np.full(r.size, float(u0)) + (r if initial_memory == "descended" else 0.0)
-
-
 def fit_mpi(
     v,
     x,
@@ -267,7 +235,7 @@ def fit_mpi(
         ``"physical"``: also ``w_i >= 0`` for the plays beyond the first; ``"paper"``:
         the partial-sum constraints of eq. (19) only.
     initial_memory : {"virgin", "descended"}, default "virgin"
-        The plays' state at the first sample (:func:`initial_play_states`): eq. (18)'s
+        The plays' state at the first sample (:func:`~hystcomp.identify.pi.initial_play_states`): eq. (18)'s
         ``"virgin"`` state, or ``"descended"``, as after a descent from above.
 
     Returns
@@ -316,7 +284,7 @@ def fit_mpi_path(
     regularizations : sequence of float, default :data:`REGULARIZATION_GRID`
         The penalties (>= 0), in the order of the fits returned.
     initial_memories : sequence of {"virgin", "descended"}, default ("virgin",)
-        The plays' initial memories to fit (:func:`initial_play_states`), each with every
+        The plays' initial memories to fit (:func:`~hystcomp.identify.pi.initial_play_states`), each with every
         penalty, in this order.
     n_folds : int, default 0
         With 2 or more, also fit each value on all but one fold of the record's reversal

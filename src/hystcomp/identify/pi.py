@@ -33,6 +33,13 @@ stroke away for it. The weighting took the panel's worst cell from 0.62x to 0.48
 paper's sinusoids on a Krasnosel'skii-Pokrovskii stage; the twin from the paper's
 triangles: 0.37x to 0.33x).
 
+The plays start as eq. (18) has them (:func:`initial_play_states`, ``"virgin"``). The MPI
+fit also tries the descended start and keeps the one predicted to track best
+(:mod:`hystcomp.identify.mpi`); for PI the same choice would take the twin's cells from
+0.33x to 0.17x, but it picks the worse memory in 5 of the panel's 20 cells, two of which
+then go over the 0.5x target (the Bouc-Wen stage from the paper's triangles 0.43x to 0.51x,
+the Krasnosel'skii-Pokrovskii stage from the sinusoids 0.48x to 0.50x), so PI keeps eq. 18.
+
 Records longer than :data:`~hystcomp.identify.scoring.MAX_SAMPLES` are fitted on every
 turning point and a regular subset of the samples (:func:`prepare_record`): the play
 outputs there are exact (rate independence), and the cost weights the record as the whole
@@ -48,7 +55,7 @@ import numpy as np
 from hystcomp import paper
 from hystcomp._hyperparameters import DEFAULT_MARGIN, check_constraints, check_margin
 from hystcomp._validation import as_signal, check_int, check_real
-from hystcomp.errors import IdentificationError, InvalidSignalError
+from hystcomp.errors import IdentificationError, InvalidParameterError, InvalidSignalError
 from hystcomp.identify import scoring
 from hystcomp.identify.lsq import constrained_lsq, held_out_fits, normal_equations
 from hystcomp.identify.scoring import (
@@ -93,6 +100,40 @@ def play_thresholds(n_operators: int, span: float, constraints: str) -> np.ndarr
     [0.0, 15.0, 30.0, 45.0]
     """
     return paper_thresholds(n_operators, span if constraints == "paper" else 0.5 * span)
+
+
+#: The initial memories of a play superposition that a fit can start from.
+INITIAL_MEMORIES = ("virgin", "descended")
+
+
+def check_initial_memory(initial_memory) -> str:
+    """The ``initial_memory`` option: one of :data:`INITIAL_MEMORIES`."""
+    if initial_memory not in INITIAL_MEMORIES:
+        raise InvalidParameterError(
+            f"The 'initial_memory' parameter must be one of {INITIAL_MEMORIES}. "
+            f"Got {initial_memory!r} instead."
+        )
+    return initial_memory
+
+
+def initial_play_states(u0: float, thresholds, initial_memory: str) -> np.ndarray:
+    """The states of plays of ``thresholds`` at a first input ``u0``, for an initial memory.
+
+    ``"virgin"``: every play at the input, ``y_i = u0`` (eq. 18's zero states for a record
+    that starts at ``v_min``): the loading curve from there is the initial one, and a loop
+    back to ``u0`` ends above its start by ``sum_i w_i r_i``. ``"descended"``: every play at
+    the top of its band, ``y_i = u0 + r_i``, as after a descent from far above (for the
+    plays, the state of a Preisach model whose every relay is off, the start of
+    :class:`~hystcomp.Preisach`): every loop from ``u0`` closes there again.
+
+    Examples
+    --------
+    >>> initial_play_states(0.0, np.array([0.0, 10.0]), "descended").tolist()
+    [0.0, 10.0]
+    """
+    initial_memory = check_initial_memory(initial_memory)
+    r = np.asarray(thresholds, dtype=np.float64)
+    return np.full(r.size, float(u0)) + (r if initial_memory == "descended" else 0.0)
 
 
 @dataclass(frozen=True)
@@ -269,7 +310,7 @@ def fit_pi(
         v, x, n_weights=n + 1, transient=transient, owner=owner, weighted=constraints == "physical"
     )
     r = play_thresholds(n, rec.input_span, constraints)
-    y0 = np.full(n, rec.u[0])
+    y0 = initial_play_states(rec.u[0], r, "virgin")  # eq. 18 (module docstring)
     x_ref = float(rec.x[rec.start :].min())
     folds = reversal_folds(rec.u, rec.start, n_folds) if n_folds > 1 else None
     grams = normal_equations(

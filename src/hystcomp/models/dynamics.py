@@ -354,7 +354,7 @@ def with_dynamics(
     gain there, ``D^-1 |D(1 Hz)|``: it adds only what the hysteresis model lacks, the creep
     slower than 1 Hz (after a step) and the fast dynamics. Creep scales the displacement
     from rest, so the scaling is about rest for a PI or MPI model whose loops close there
-    (one that starts descended, :func:`hystcomp.identify.mpi.initial_play_states`): on
+    (one that starts descended, :func:`hystcomp.identify.pi.initial_play_states`): on
     the creep stages of ``benchmarks/bench_dynamics.py`` steps to 0.2 .. 0.8 of the stroke
     then keep a mean error of 0.03 µm (0.19 µm scaled about mid-range). Other models
     (virgin plays, whose loops stay open at rest; the Preisach model) are scaled about the

@@ -14,7 +14,8 @@ from hystcomp import paper
 from hystcomp._hyperparameters import check_regularization_option
 from hystcomp._validation import as_vector, check_int, check_thresholds
 from hystcomp.identify.compensation import CV_FOLDS, tracking_scorer
-from hystcomp.identify.mpi import INITIAL_MEMORIES, REGULARIZATION_GRID, fit_mpi_path
+from hystcomp.identify.mpi import REGULARIZATION_GRID, fit_mpi_path
+from hystcomp.identify.pi import INITIAL_MEMORIES
 from hystcomp.models.base import DEFAULT_VOLTAGE_RANGE, fit_voltage_range
 from hystcomp.models.compensator import Compensator
 from hystcomp.models.dynamic_compensator import DynamicCompensator
