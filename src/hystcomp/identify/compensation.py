@@ -29,11 +29,12 @@ other folds) rates each candidate by ``criterion_um``: the geometric mean of the
 forward error and the held-out inverse error above, on the branches each fit did not see.
 On the panel of ``benchmarks/bench_accuracy.py`` (5 actuators of none of the model
 families, 4 excitations) it ranks the candidate PI and MPI fits of a record as their
-measured 1 Hz tracking does with a median Spearman rank correlation of 0.93 (mean 0.84,
-worst cell 0.29), where the fit error reaches 0.89 (0.76, -0.07) and the inverse's estimate
-on the whole record 0.86 (0.71, -0.57); the MPI regularisation it chooses tracks within
-0.015x of the uncompensated error of the best of the grid in every cell (fit error 0.042x,
-the estimate alone 0.025x). The estimate alone is weakest on a Preisach actuator with
+measured 1 Hz tracking does with a median Spearman rank correlation of 0.96 (mean 0.88,
+worst cell 0.29), where the fit error reaches 0.93 (0.86, 0.29) and the inverse's estimate
+on the whole record 0.91 (0.81, 0.25); the MPI regularisation it chooses tracks within
+0.002x of the uncompensated error of the best of the grid in every cell (fit error 0.002x,
+the estimate alone 0.012x; before the MPI fit chose its plays' initial memory too, 0.015x,
+0.042x and 0.025x). The estimate alone is weakest on a Preisach actuator with
 output saturation, where a voltage error at the saturated top counts more than the
 tracking error it causes; the held-out forward error is not.
 """

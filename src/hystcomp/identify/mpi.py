@@ -52,9 +52,11 @@ default, fits every value of :data:`REGULARIZATION_GRID` at the cost of about on
 branches they did not see best, forward and through their inverse
 (:func:`hystcomp.identify.compensation.tracking_scorer`, ``criterion_um``). On the panel
 of ``benchmarks/bench_accuracy.py`` (5 actuators x 4 excitations) the value it chooses
-tracks within 0.015x of the uncompensated error of the best value of the grid in every cell
-(0.005x on average); the smallest fit error, the former criterion, comes within 0.042x,
-and the inverse's estimate on the whole record within 0.025x.
+tracks within 0.002x of the uncompensated error of the best value of the grid in every cell
+(0.0004x on average; the smallest fit error, the former criterion, also 0.002x, and the
+inverse's estimate on the whole record 0.012x). With eq. (18)'s virgin plays only, where
+the fits are further from the actuators, the criterion came within 0.015x, the fit error
+within 0.042x: ``python benchmarks/bench_accuracy.py --rho``.
 With a second record of the actuator,
 :func:`hystcomp.identify.validation.choose_regularization` chooses by prediction instead.
 
