@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import itertools
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 import quadprog
@@ -126,21 +127,41 @@ class LsqSolution:
 RIDGE = 1e-10
 
 
-def _centred(gram: np.ndarray):
-    """The parts of an augmented Gram matrix ``[X 1 z]^T [X 1 z]``, and its centred block.
+class _Centred(NamedTuple):
+    """The parts of an augmented Gram matrix ``[X 1 z]^T [X 1 z]`` and its centred block:
+    ``G, g, zz`` are the blocks ``[X 1]^T [X 1]``, ``[X 1]^T z`` and ``z^T z``; ``G_c, g_c``
+    the centred ``X^T X`` and ``X^T z`` (the intercept eliminated)."""
 
-    Returns ``G, g, zz`` (the blocks ``[X 1]^T [X 1]``, ``[X 1]^T z`` and ``z^T z``), the
-    sample count, the regressor means and the mean of ``z``, and the centred ``X^T X`` and
-    ``X^T z`` (the intercept eliminated).
-    """
+    G: np.ndarray
+    g: np.ndarray
+    zz: float
+    samples: float  # the constant regressor's square: the sample count
+    mean: np.ndarray  # of the regressors
+    z_mean: float
+    G_c: np.ndarray
+    g_c: np.ndarray
+
+
+def _centred(gram: np.ndarray) -> _Centred:
+    """The blocks of ``gram`` and its centred normal equations (:class:`_Centred`)."""
     p = gram.shape[0] - 1
-    G, g, zz = gram[:p, :p], gram[:p, p], gram[p, p]
-    count = G[-1, -1]
+    G, g, zz = gram[:p, :p], gram[:p, p], float(gram[p, p])
+    count = float(G[-1, -1])
     mean = G[-1, :-1] / count
-    z_mean = g[-1] / count
+    z_mean = float(g[-1] / count)
     G_c = G[:-1, :-1] - count * np.outer(mean, mean)
     g_c = g[:-1] - count * mean * z_mean
-    return G, g, zz, count, mean, z_mean, G_c, g_c
+    return _Centred(G, g, zz, count, mean, z_mean, G_c, g_c)
+
+
+def _unscaled(c: _Centred, solution, idx, scale) -> tuple[np.ndarray, float]:
+    """The coefficients of a solution for the unit-scaled columns ``idx`` (the others 0), with
+    the constant that the centring eliminated, and the residual sum of squares."""
+    coef = np.zeros(c.G.shape[0])
+    coef[idx] = solution * scale
+    coef[-1] = c.z_mean - c.mean @ coef[:-1]
+    rss = float(c.zz - 2.0 * c.g @ coef + coef @ c.G @ coef)
+    return coef, max(rss, 0.0)
 
 
 def constrained_lsq(
@@ -215,8 +236,8 @@ def constrained_lsq_path(
     (a path of penalties, :func:`~hystcomp.identify.mpi.fit_mpi_path`).
     """
     p = gram.shape[0] - 1
-    G, g, zz, count, mean, z_mean, G_c, g_c = _centred(gram)
-    spread = np.sqrt(np.maximum(np.diag(G_c), 0.0) / count)
+    c = _centred(gram)
+    spread = np.sqrt(np.maximum(np.diag(c.G_c), 0.0) / c.samples)
     varies = spread > flat_tol * np.asarray(scales, dtype=np.float64)
     blocks = [(a, b, bound) for a, b, bound in blocks if b > a]
     for first, _, bound in blocks:
@@ -226,9 +247,9 @@ def constrained_lsq_path(
                 "cannot be identified: the input must vary after the start-up transient."
             )
     idx = np.flatnonzero(varies)
-    scale = 1.0 / np.sqrt(np.diag(G_c)[idx])
-    quad = G_c[np.ix_(idx, idx)] * np.outer(scale, scale)
-    lin = g_c[idx] * scale
+    scale = 1.0 / np.sqrt(np.diag(c.G_c)[idx])
+    quad = c.G_c[np.ix_(idx, idx)] * np.outer(scale, scale)
+    lin = c.g_c[idx] * scale
     rows, bounds = [np.empty((0, idx.size))], [np.empty(0)]
     # one row per coefficient that varies (partial sums at a fixed, zero, coefficient
     # repeat the one before): partial sums from `first` for blocks and caps, itself for floors
@@ -257,11 +278,8 @@ def constrained_lsq_path(
                 "that the record is one experiment (input and displacement of the same "
                 "samples) and try fewer operators."
             ) from None
-        coef = np.zeros(p)
-        coef[idx] = solution * scale
-        coef[-1] = z_mean - mean @ coef[:-1]
-        rss = float(zz - 2.0 * g @ coef + coef @ G @ coef)
-        solutions.append(LsqSolution(coef=coef, rss=max(rss, 0.0), varies=varies))
+        coef, rss = _unscaled(c, solution, idx, scale)
+        solutions.append(LsqSolution(coef=coef, rss=rss, varies=varies))
     return solutions
 
 
@@ -318,16 +336,14 @@ def solve_inequality_qp(
     IdentificationError
         If quadprog finds no solution.
     """
-    p = gram.shape[0] - 1
-    G, g, zz, _, mean, z_mean, quad_full, g_c = _centred(gram)
-    if penalty is not None:
-        quad_full = quad_full + penalty
+    c = _centred(gram)
+    quad_full = c.G_c if penalty is None else c.G_c + penalty
     diag = np.maximum(np.diag(quad_full), 0.0)
     idx = np.flatnonzero(diag > 1e-14 * max(float(diag.max()), 1e-300))
     scale = 1.0 / np.sqrt(diag[idx])
     quad = quad_full[np.ix_(idx, idx)] * np.outer(scale, scale)
     quad[np.diag_indices_from(quad)] += ridge
-    lin = g_c[idx] * scale
+    lin = c.g_c[idx] * scale
     cons = np.asarray(constraints, dtype=np.float64)[:, idx] * scale
     keep = np.any(cons != 0.0, axis=1)  # rows on dropped coefficients only hold at 0
     cons = cons[keep]
@@ -341,8 +357,4 @@ def solve_inequality_qp(
             f"The constrained least-squares problem could not be solved ({exc}). Check that "
             "the record is one experiment (input and displacement of the same samples)."
         ) from None
-    coef = np.zeros(p)
-    coef[idx] = solution * scale
-    coef[-1] = z_mean - mean @ coef[:-1]
-    rss = float(zz - 2.0 * g @ coef + coef @ G @ coef)
-    return coef, max(rss, 0.0)
+    return _unscaled(c, solution, idx, scale)
