@@ -72,8 +72,9 @@ back to ``v_min`` then ends above its start by ``sum_i w_i r_i``. A piezo that h
 driven before (by its own identification run, for one) rests at ``v_min`` in the state
 that the last descent left, and most stages close their loops there. The physical fit
 therefore also fits the *descended* start, every play at the top of its band as after a
-descent from above (:func:`~hystcomp.identify.pi.initial_play_states`; for the plays, the state of a Preisach
-model with every relay off, where :class:`~hystcomp.Preisach` starts), and
+descent from above (:func:`~hystcomp.identify.pi.initial_play_states`; for the plays, the
+state of a Preisach model with every relay off, where :class:`~hystcomp.Preisach`
+starts), and
 ``ModifiedPrandtlIshlinskii`` keeps the one whose compensator is predicted to track best
 (the same criterion as the regularisation). On the panel it keeps the better of the two in
 all 20 cells: the twin from the paper's triangles goes from 0.24x to 0.075x the
@@ -145,7 +146,8 @@ class MPIFit:
     regularization : float
         The penalty it was fitted with.
     initial_memory : {"virgin", "descended"}
-        The plays' initial memory it was fitted with (:func:`~hystcomp.identify.pi.initial_play_states`).
+        The plays' initial memory it was fitted with
+        (:func:`~hystcomp.identify.pi.initial_play_states`).
     folds : ndarray or None
         With ``held_out``: the fold of each of the ``samples`` (-1 before the first).
     held_out : tuple of MPIFit
@@ -237,8 +239,9 @@ def fit_mpi(
         ``"physical"``: also ``w_i >= 0`` for the plays beyond the first; ``"paper"``:
         the partial-sum constraints of eq. (19) only.
     initial_memory : {"virgin", "descended"}, default "virgin"
-        The plays' state at the first sample (:func:`~hystcomp.identify.pi.initial_play_states`): eq. (18)'s
-        ``"virgin"`` state, or ``"descended"``, as after a descent from above.
+        The plays' state at the first sample
+        (:func:`~hystcomp.identify.pi.initial_play_states`): eq. (18)'s ``"virgin"``
+        state, or ``"descended"``, as after a descent from above.
 
     Returns
     -------
@@ -286,8 +289,9 @@ def fit_mpi_path(
     regularizations : sequence of float, default :data:`REGULARIZATION_GRID`
         The penalties (>= 0), in the order of the fits returned.
     initial_memories : sequence of {"virgin", "descended"}, default ("virgin",)
-        The plays' initial memories to fit (:func:`~hystcomp.identify.pi.initial_play_states`), each with every
-        penalty, in this order.
+        The plays' initial memories to fit
+        (:func:`~hystcomp.identify.pi.initial_play_states`), each with every penalty, in
+        this order.
     n_folds : int, default 0
         With 2 or more, also fit each value on all but one fold of the record's reversal
         segments (:func:`~hystcomp.identify.scoring.reversal_folds`), for every fold, from
