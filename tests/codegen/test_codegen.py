@@ -68,9 +68,18 @@ def _small_mpi(rng):
     )
 
 
+def _descended_mpi(rng):
+    """The paper's MPI model with its plays started descended, as the MPI fit may choose:
+    non-zero initial states (eq. 26 carries them into the inverse)."""
+    params = hystcomp.presets.paper_mpi().parameters()
+    params["initial_state"] = np.asarray(params["thresholds"], dtype=float)
+    return hystcomp.ModifiedPrandtlIshlinskii.from_parameters(**params)
+
+
 MODELS = {
     "paper_pi": lambda rng: hystcomp.presets.paper_pi(),
     "paper_mpi": lambda rng: hystcomp.presets.paper_mpi(),
+    "descended_mpi": _descended_mpi,
     "bipolar_pi": _bipolar_pi,
     "small_mpi": _small_mpi,
 }
