@@ -305,7 +305,8 @@ def _setup_lines(c) -> list[str]:
             "Twin hysteresis: a rate-independent Bouc-Wen model calibrated on the loops of the "
             "paper's Preisach model (eq. 6); like them, its loops close at the rest position "
             "whenever the voltage returns to 0 V, which a Preisach model reproduces by "
-            "structure and a PI or MPI model cannot."
+            "structure and a PI or MPI model only with its plays started descended, not with "
+            "eq. 18's virgin start."
         ),
         (
             f"Uncompensated baseline: v = x_ref / k_lin with k_lin = {c.gain:.4f} µm/V, the "
