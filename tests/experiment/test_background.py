@@ -1,10 +1,13 @@
-"""Figures drawn in a forked process: the same files as drawn in place, or drawn in place."""
+"""Work in a forked process: the same results as done in place, or done in place."""
 
 import sys
 
+import numpy as np
 import pytest
 
-from hystcomp.experiment.background import BackgroundFigures
+from hystcomp.experiment.background import BackgroundJob, draw_in_background
+from hystcomp.experiment.compare_dynamics import identify_twin_dynamics
+from hystcomp.plant import Twin, creep_twin
 
 pytestmark = pytest.mark.skipif(not sys.platform.startswith("linux"), reason="fork on Linux only")
 
@@ -21,7 +24,7 @@ def _fail(text, folder):
 
 
 def test_the_files_and_notes_come_back_as_drawn():
-    job = BackgroundFigures.start(_draw, "xyz")
+    job = draw_in_background(_draw, "xyz")
     assert job is not None
     notes, files = job.collect()
     assert list(notes.items()) == [("b.png", None), ("a.png", None), ("c.png", "not drawn")]
@@ -29,6 +32,31 @@ def test_the_files_and_notes_come_back_as_drawn():
 
 
 def test_a_failure_gives_nothing_so_that_the_caller_draws():
-    job = BackgroundFigures.start(_fail, "broken")
+    job = draw_in_background(_fail, "broken")
     assert job is not None
     assert job.collect() is None
+
+
+def test_a_job_returns_its_result_and_none_when_it_fails():
+    job = BackgroundJob.start(divmod, 17, 5)
+    assert job is not None
+    assert job.collect() == (3, 2)
+    failed = BackgroundJob.start(divmod, 1, 0)
+    assert failed is not None
+    assert failed.collect() is None
+
+
+def test_the_dynamics_identified_in_a_second_process_are_those_identified_here():
+    params = creep_twin(resonance_hz=900.0)
+    job = BackgroundJob.start(identify_twin_dynamics, params, 3)
+    assert job is not None
+    record, there = job.collect()
+    again, here = identify_twin_dynamics(params, 3)
+    np.testing.assert_array_equal(record.x, again.x)
+    assert there.parameters() == here.parameters()
+    assert there.resonance_hz_ == pytest.approx(900.0, rel=0.01)
+    # the inverse's filter came along: no SciPy solver needed where it arrives
+    assert there._inverse_firs.keys() == here._inverse_firs.keys()
+    np.testing.assert_array_equal(there.inverse().taps, here.inverse().taps)
+    # its noise is a stream of its own, not the twin's that measures Table I
+    assert not np.array_equal(record.x, Twin(params, seed=3).run(record.v))

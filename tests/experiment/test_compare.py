@@ -12,7 +12,7 @@ from hystcomp import presets
 from hystcomp.cli import main
 from hystcomp.errors import InvalidParameterError
 from hystcomp.experiment import compare as compare_module
-from hystcomp.experiment.background import BackgroundFigures
+from hystcomp.experiment.background import draw_in_background
 from hystcomp.experiment.compare import CompareConfig, run_comparison
 from hystcomp.experiment.figures import BACKGROUND_FIGURES, write_figures
 from hystcomp.experiment.report import write_outputs
@@ -83,14 +83,14 @@ def test_figures_drawn_in_a_forked_process_are_those_drawn_in_place(comparison, 
     there = write_outputs(
         comparison,
         tmp_path / "there",
-        figures=BackgroundFigures.start(
+        figures=draw_in_background(
             functools.partial(write_figures, names=BACKGROUND_FIGURES), comparison
         ),
     )
     assert [p.name for p in there] == [p.name for p in here]
     for a, b in zip(here, there, strict=True):
         assert a.read_bytes() == b.read_bytes(), a.name
-    failed = BackgroundFigures.start(_no_figures, comparison)  # drawn in place instead
+    failed = draw_in_background(_no_figures, comparison)  # drawn in place instead
     again = write_outputs(comparison, tmp_path / "again", figures=failed)
     assert [p.read_bytes() for p in again] == [p.read_bytes() for p in here]
 

@@ -1,13 +1,19 @@
-"""Figures drawn in a second process while the experiment goes on (``hystcomp compare``).
+"""Work done in a second, forked process while ``hystcomp compare`` goes on.
 
-The paper's figures need only Table I's runs: :func:`hystcomp.experiment.compare.run_comparison`
-hands Table I over as soon as it is measured, and a forked process draws
-:data:`~hystcomp.experiment.figures.BACKGROUND_FIGURES` while the calling process goes on
-with the dynamics part and then draws the others (about as much drawing each);
-:func:`~hystcomp.experiment.report.write_outputs` takes the image files from it and writes
-them with the tables and the report, all at once. Where ``fork`` is not available, or if
-the process fails in any way, those figures are drawn in the calling process instead: the
-files are the same either way.
+Two jobs run there (:class:`BackgroundJob`):
+
+* the twin's answer to the dynamics excitation and the linear dynamics identified from it
+  (:func:`hystcomp.experiment.compare_dynamics.identify_twin_dynamics`), from the start of
+  the run, on the core that the first process leaves idle until Table I is measured;
+* the paper's figures (:func:`draw_in_background`): :func:`hystcomp.experiment.compare.
+  run_comparison` hands Table I over as soon as it is measured, and the forked process
+  draws :data:`~hystcomp.experiment.figures.BACKGROUND_FIGURES` while the calling process
+  goes on with the dynamics part and then draws the others (about as much drawing each);
+  :func:`~hystcomp.experiment.report.write_outputs` takes the image files from it and
+  writes them with the tables and the report, all at once.
+
+Where ``fork`` is not available, or if the process fails in any way, the calling process
+does the job itself instead: the results are the same either way.
 """
 
 from __future__ import annotations
@@ -20,6 +26,7 @@ import tempfile
 import warnings
 from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 #: The start of Python's warning on a fork in a process with threads (3.12 and later).
 FORK_WARNING = r"This process \(pid=\d+\) is multi-threaded"
@@ -29,8 +36,8 @@ FORK_WARNING = r"This process \(pid=\d+\) is multi-threaded"
 Notes = dict[str, str | None]
 
 
-class BackgroundFigures:
-    """``function(*args, folder) -> notes`` run in a forked process; its files come back.
+class BackgroundJob:
+    """``function(*args)`` run in a forked process; its result comes back (pickled).
 
     Start it with :meth:`start` (None where the platform cannot fork), take the result
     with :meth:`collect`.
@@ -41,8 +48,8 @@ class BackgroundFigures:
         self._connection = connection
 
     @classmethod
-    def start(cls, function: Callable[..., Notes], *args) -> BackgroundFigures | None:
-        """Fork a process that draws ``function(*args, folder)`` into a folder of its own.
+    def start(cls, function: Callable[..., Any], *args) -> BackgroundJob | None:
+        """Fork a process that computes ``function(*args)``.
 
         The process inherits ``args`` as they are (nothing is copied but the memory pages
         it touches). Returns None where ``fork`` is not the platform's way (only Linux
@@ -54,22 +61,22 @@ class BackgroundFigures:
             context = multiprocessing.get_context("fork")
             receiver, sender = context.Pipe(duplex=False)
             process = context.Process(
-                target=_draw, args=(sender, function, args), daemon=True, name="hystcomp-figures"
+                target=_run, args=(sender, function, args), daemon=True, name="hystcomp-job"
             )
             with warnings.catch_warnings():
                 # Python >= 3.12 warns of a fork beside threads (BLAS's, here): they may hold
-                # a lock the child needs. The child only draws, with matplotlib and NumPy,
-                # whose BLAS re-creates its threads after a fork.
+                # a lock the child needs. The child only computes, with NumPy, numba and
+                # matplotlib, whose BLAS re-creates its threads after a fork.
                 warnings.filterwarnings("ignore", FORK_WARNING, DeprecationWarning)
                 process.start()
-        except (OSError, ValueError):  # no fork, no pipe: draw in this process
+        except (OSError, ValueError):  # no fork, no pipe: the caller does the job
             return None
         sender.close()
         return cls(process, receiver)
 
-    def collect(self) -> tuple[Notes, dict[str, bytes]] | None:
-        """Wait for the drawings: ``(notes, {file name: contents})``, or None if the
-        process failed (the caller then draws the figures itself)."""
+    def collect(self) -> Any:
+        """Wait for the result: ``function(*args)``, or None if the process failed (the
+        caller then does the job itself)."""
         try:
             reply = self._connection.recv()
         except (EOFError, OSError):
@@ -81,20 +88,30 @@ class BackgroundFigures:
                 self._process.kill()
         if not reply or reply[0] != "ok":
             return None
-        return reply[1], reply[2]
+        return reply[1]
 
 
-def _draw(connection, function, args) -> None:
-    """The forked process: draw, send the notes and the files' bytes, or why not."""
+def draw_in_background(function: Callable[..., Notes], *args) -> BackgroundJob | None:
+    """A :class:`BackgroundJob` that draws ``function(*args, folder)`` into a folder of its
+    own; its result is ``(notes, {file name: contents})``."""
+    return BackgroundJob.start(_drawn_files, function, args)
+
+
+def _drawn_files(function, args) -> tuple[Notes, dict[str, bytes]]:
+    with tempfile.TemporaryDirectory(prefix="hystcomp-figures-") as folder:
+        notes = function(*args, Path(folder))
+        return notes, {p.name: p.read_bytes() for p in Path(folder).iterdir()}
+
+
+def _run(connection, function, args) -> None:
+    """The forked process: compute, send the result, or why not."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the caller's to answer
     signal.signal(signal.SIGTERM, signal.SIG_DFL)  # as the caller ends it when it exits
     try:
-        with tempfile.TemporaryDirectory(prefix="hystcomp-figures-") as folder:
-            notes = function(*args, Path(folder))
-            files = {p.name: p.read_bytes() for p in Path(folder).iterdir()}
-        connection.send(("ok", notes, files))
-    except Exception as exc:  # noqa: BLE001 - any failure: the caller draws them itself
+        result = function(*args)
+        connection.send(("ok", result))
+    except Exception as exc:  # noqa: BLE001 - any failure: the caller does the job itself
         with contextlib.suppress(OSError):  # the caller may be gone
-            connection.send(("failed", f"{type(exc).__name__}: {exc}", {}))
+            connection.send(("failed", f"{type(exc).__name__}: {exc}"))
     finally:
         connection.close()

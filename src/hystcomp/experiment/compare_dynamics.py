@@ -20,6 +20,7 @@ from hystcomp.experiment.tracking import TrackingResult, run_tracking
 from hystcomp.identify.dynamics import dynamics_excitation
 from hystcomp.io.records import Record
 from hystcomp.models.dynamics import LinearDynamics
+from hystcomp.plant import Twin, TwinParameters
 
 #: Frequencies of the rows with the dynamics (Hz): Table I's, and two faster.
 FAST_FREQUENCIES = (100.0, 200.0)
@@ -27,6 +28,9 @@ FAST_FREQUENCIES = (100.0, 200.0)
 WITH_DYNAMICS = ("preisach", "mpi")
 STEP_HOLD = 3.0  # s
 STEP_FROM = 0.02  # s after the step: the window of the step's mean |error| starts here
+#: Second entropy word of the seed of the dynamics record's sensor noise (the first is the
+#: comparison's seed): a stream of its own, see :func:`identify_twin_dynamics`.
+DYNAMICS_STREAM = 1
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -59,12 +63,37 @@ class DynamicsComparison:
     step_drift: dict
 
 
-def run_dynamics(twin, models, compensators, amplitude, *, periods, frequencies):
-    """The dynamics part of the comparison (see the module); ``compensators`` by method."""
+def identify_twin_dynamics(params: TwinParameters, seed: int) -> tuple[Record, LinearDynamics]:
+    """Step 1 of the module: the twin's answer to the dynamics excitation, and the model.
+
+    The twin here is one of its own, built at rest from ``params``, with a sensor noise
+    stream of its own drawn from ``seed`` (independent of the stream of the twin that
+    measures Table I): the result is the same whichever process computes it and whenever,
+    so that ``hystcomp compare`` computes it in a second process from the start
+    (:class:`~hystcomp.experiment.background.BackgroundJob`). The inverse's FIR for the
+    default band is computed here too and travels with the model
+    (:meth:`hystcomp.LinearDynamics.inverse`).
+    """
+    stream = int(np.random.SeedSequence([seed, DYNAMICS_STREAM]).generate_state(1)[0])
+    twin = Twin(params, seed=stream)
     fs = twin.sample_rate
     t, v = dynamics_excitation(sample_rate=fs, voltage_range=twin.voltage_range)
     record = Record(t=t, v=v, x=twin.run(v), source="the twin")
     dynamics = LinearDynamics().fit(record.v, record.x, fs)
+    dynamics.inverse()
+    return record, dynamics
+
+
+def run_dynamics(
+    twin, models, compensators, amplitude, *, periods, frequencies, seed=0, identified=None
+):
+    """The dynamics part of the comparison (see the module); ``compensators`` by method.
+
+    ``identified`` is :func:`identify_twin_dynamics` ``(twin.params, seed)`` if already
+    computed (elsewhere); None computes it here.
+    """
+    fs = twin.sample_rate
+    record, dynamics = identified or identify_twin_dynamics(twin.params, seed)
     with_dyn = {m: models[m].inverse(dynamics=dynamics) for m in WITH_DYNAMICS}
     results: dict[float, dict[str, TrackingResult]] = {}
     for f in (*frequencies, *FAST_FREQUENCIES):

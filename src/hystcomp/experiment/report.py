@@ -131,8 +131,8 @@ def write_outputs(comparison, out_dir, *, figures=None) -> list[Path]:
     renamed into place together (:func:`hystcomp.io.atomic.replace_all`): a failure or an
     interruption leaves the files of an earlier run as they were, never a mix of two runs.
 
-    ``figures``, if given, is a :class:`~hystcomp.experiment.background.BackgroundFigures`
-    drawing :data:`~hystcomp.experiment.figures.BACKGROUND_FIGURES` with
+    ``figures``, if given, is a :class:`~hystcomp.experiment.background.BackgroundJob`
+    (:func:`~hystcomp.experiment.background.draw_in_background`) drawing :data:`~hystcomp.experiment.figures.BACKGROUND_FIGURES` with
     :func:`~hystcomp.experiment.figures.write_figures` for this comparison (from its Table
     I) while the others are drawn here; its files are written as they came, or its figures
     are drawn here too if it failed.

@@ -68,7 +68,7 @@ def start(job=compile_later_kernels):
     after the first: loading the kernels would cost the second process as much as the
     first, about 0.5 s of CPU for numba's start, on a core that the figures need), nor
     where the platform does not fork (Linux only, as
-    :class:`~hystcomp.experiment.background.BackgroundFigures`). The process is not
+    :class:`~hystcomp.experiment.background.BackgroundJob`). The process is not
     waited for: its only output is the kernel cache, and a kernel that it has not compiled
     yet when this process needs it is compiled here as it would be without it.
     """
