@@ -568,3 +568,11 @@ def test_c_counts_clamped_outputs_as_python(name, identified_preisach, tmp_path,
         assert clamped_c == 0
     else:  # the reference is out of reach often
         assert 0.05 * x.size < clamped_c < 0.9 * x.size
+
+
+def test_a_model_is_refused_with_the_call_that_exports_its_compensator():
+    from hystcomp.codegen import generate_c
+    from hystcomp.errors import InvalidTypeError
+
+    with pytest.raises(InvalidTypeError, match=r"model\.inverse\(\)"):
+        generate_c(hystcomp.presets.paper_pi())

@@ -438,3 +438,20 @@ def test_identification_does_not_import_scipy_signal():
     )
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert done.stdout.strip() == "False"
+
+
+def test_creep_fraction_and_frequency_response_refuse_what_is_not_a_time_or_a_frequency():
+    dyn = LinearDynamics.from_parameters(
+        sample_rate=20_000.0,
+        resonance_hz=780.0,
+        damping_ratio=0.05,
+        creep_time_constants=[0.01, 0.1],
+        creep_weights=[0.01, 0.02],
+    )
+    assert dyn.creep_fraction(0.0) == pytest.approx(0.03 / 1.03)
+    for bad in (-1.0, float("nan"), float("inf")):
+        with pytest.raises(InvalidParameterError):
+            dyn.creep_fraction(bad)
+    for bad in ([np.nan], [np.inf]):
+        with pytest.raises(InvalidParameterError):
+            dyn.frequency_response(bad)

@@ -279,3 +279,14 @@ def test_unfitted_model_says_how_to_fit():
     with pytest.raises(NotFittedError, match=r"Call fit\(v, x\)"):
         Preisach().simulate([0.0])
     assert hystcomp.io.MODEL_KINDS["preisach"] is Preisach
+
+
+def test_the_memory_bound_has_a_ceiling_so_that_a_stepper_cannot_ask_for_terabytes():
+    v = np.r_[np.linspace(0.0, 120.0, 200), np.linspace(120.0, 0.0, 200)]
+    x = presets.paper_preisach().simulate(v)
+    with pytest.raises(InvalidParameterError, match="max_extrema"):
+        hystcomp.Preisach(max_extrema=pk.MAX_DEPTH + 1).fit(v, x)
+    data = presets.paper_preisach().to_dict()
+    data["hyperparameters"]["max_extrema"] = 10**12
+    with pytest.raises(InvalidParameterError, match="max_extrema"):
+        hystcomp.Preisach.from_dict(data)

@@ -13,6 +13,7 @@ from hystcomp import presets
 from hystcomp._kernels import chain
 from hystcomp._kernels import preisach as pk
 from hystcomp._kernels._jit import step_function
+from hystcomp.errors import InvalidParameterError, InvalidSignalError, InvalidTypeError
 from hystcomp.models.preisach import Preisach, PreisachStepper
 from tests.conftest import random_walk
 
@@ -133,3 +134,83 @@ def test_every_system_has_the_one_stepper_class():
     assert [type(s).kernels for s in steppers[2:]] == [pk.PREISACH_KERNELS] * 3
     assert all(isinstance(s, PreisachStepper) for s in steppers[2:])
     assert all(type(s).kernels is chain.CHAIN_KERNELS for s in steppers[:2])
+
+
+def _dynamic_compensator():
+    dyn = hystcomp.LinearDynamics.from_parameters(
+        sample_rate=20_000.0,
+        resonance_hz=780.0,
+        damping_ratio=0.05,
+        creep_time_constants=[0.01, 0.1],
+        creep_weights=[0.01, 0.01],
+    )
+    return presets.paper_mpi().inverse(dynamics=dyn)
+
+
+@pytest.mark.parametrize(
+    "make",
+    [
+        lambda: presets.paper_mpi().inverse().stepper(),
+        lambda: presets.paper_preisach().inverse().stepper(),
+        lambda: _dynamic_compensator().stepper(),
+    ],
+    ids=["chain", "preisach", "with dynamics"],
+)
+def test_a_deep_copy_or_a_pickled_stepper_steps_a_state_of_its_own(make):
+    import copy
+    import pickle
+
+    s = make()
+    s.step(10.0)
+    for other in (copy.deepcopy(s), pickle.loads(pickle.dumps(s))):
+        before = s.last_output
+        expected = s.copy().step(25.0)
+        assert other.step(25.0) == expected
+        assert s.last_output == before  # the original did not move
+        assert other.last_output == expected
+
+
+def test_the_stepper_of_a_dynamic_compensator_checks_its_samples_and_its_preview():
+    comp = _dynamic_compensator()
+    s = comp.stepper()
+    for bad in ("1.0", True, None, [1.0]):
+        with pytest.raises(InvalidTypeError, match="real number"):
+            s.step(bad)
+    with pytest.raises(InvalidSignalError, match="preview"):
+        s.prime(np.full(comp.preview + 1, 3.0))
+    with pytest.raises(InvalidTypeError):
+        s.step_block(["a", "b"])
+
+
+def test_an_integer_beyond_the_floats_is_held_as_an_infinite_sample():
+    s = presets.paper_mpi().inverse().stepper()
+    held = s.step(10.0)
+    assert s.step(10**400) == held
+    assert s.step(-(10**400)) == held
+    assert s.nonfinite_count == 2
+
+
+@pytest.mark.parametrize(
+    "packed",
+    [np.zeros(3), np.full(30, 1e6), np.zeros((2, 20)), "abc"],
+    ids=["short", "counts", "2-D", "text"],
+)
+def test_a_stepper_refuses_an_array_that_is_not_a_packed_chain(packed):
+    with pytest.raises((InvalidParameterError, InvalidTypeError)):
+        hystcomp.Stepper(packed)
+    with pytest.raises((InvalidParameterError, InvalidTypeError)):
+        hystcomp.Compensator(packed, kind="pi", voltage_range=(0.0, 120.0))
+
+
+def test_a_compensator_is_built_only_with_the_clamp_its_packed_chain_holds():
+    packed = presets.paper_pi().inverse().packed
+    lo, hi = float(packed[chain.LOW]), float(packed[chain.HIGH])
+    assert hystcomp.Compensator(packed, kind="pi", voltage_range=(lo, hi)).voltage_range == (lo, hi)
+    with pytest.raises(InvalidParameterError, match="clamp held in 'packed'"):
+        hystcomp.Compensator(packed, kind="pi", voltage_range=(lo, 5 * hi))
+    with pytest.raises(InvalidParameterError, match="'kind'"):
+        hystcomp.Compensator(packed, kind="banana", voltage_range=(lo, hi))
+    broken = packed.copy()
+    broken[chain.HEADER] = np.nan  # a parameter
+    with pytest.raises(InvalidParameterError, match="non-finite"):
+        hystcomp.Compensator(broken, kind="pi", voltage_range=(lo, hi))

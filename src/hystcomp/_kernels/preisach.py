@@ -64,6 +64,8 @@ ST_TOP, ST_INPUT, ST_H, ST_LAST, ST_NONFINITE, ST_CLAMPED = range(6)
 N_STATE = 6
 #: Default bound on the stored extrema: 512 nested reversals, far beyond measured signals.
 DEFAULT_DEPTH = 1024
+#: Largest memory bound a model may ask for (a packed system holds it whole).
+MAX_DEPTH = 1_000_000
 
 
 @intrinsic

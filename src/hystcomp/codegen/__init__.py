@@ -53,6 +53,12 @@ def generate_c(
         The texts of ``PREFIX.h`` and ``PREFIX.c``.
     """
     kind = getattr(compensator, "kind", None)
+    if callable(getattr(compensator, "inverse", None)):  # a model, not its compensator
+        raise InvalidTypeError(
+            f"'compensator' must be a compensator; got the model {type(compensator).__name__}. "
+            "Export its inverse: generate_c(model.inverse(), ...) (hystcomp export-c MODEL "
+            "does this)."
+        )
     if not hasattr(compensator, "voltage_range") or not isinstance(kind, str):
         raise InvalidTypeError(
             "'compensator' must be a hystcomp compensator, as returned by model.inverse(). "

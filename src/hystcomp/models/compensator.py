@@ -13,9 +13,13 @@ import numpy as np
 
 from hystcomp._kernels import chain
 from hystcomp._validation import as_signal
-from hystcomp.models.system import PackedSystem, Stepper
+from hystcomp.errors import InvalidParameterError
+from hystcomp.models.system import PackedSystem, Stepper, check_packed_chain
 
 __all__ = ["Compensator", "CompensatorRun", "Stepper"]
+
+#: The kinds of model whose inverse is a packed chain.
+KINDS = ("pi", "mpi")
 
 
 class CompensatorRun(NamedTuple):
@@ -59,11 +63,27 @@ class Compensator(PackedSystem):
     _input_name = "x_ref"
 
     def __init__(self, packed: np.ndarray, *, kind: str, voltage_range: tuple[float, float]):
-        packed = packed.copy()
+        packed = check_packed_chain(packed, "Compensator")
+        if kind not in KINDS:
+            raise InvalidParameterError(
+                f"The 'kind' parameter of Compensator must be one of {KINDS}. Got {kind!r}."
+            )
+        rails = (float(packed[chain.LOW]), float(packed[chain.HIGH]))
+        try:
+            declared = tuple(float(b) for b in voltage_range)
+        except (TypeError, ValueError):
+            declared = ()
+        if declared != rails:
+            # the kernels clamp to the rails in the array; C export and users read this
+            raise InvalidParameterError(
+                f"The 'voltage_range' parameter of Compensator must be the clamp held in "
+                f"'packed', {rails}. Got {voltage_range!r}; build compensators with "
+                "model.inverse(voltage_range=...) to narrow the range."
+            )
         packed.setflags(write=False)
         self._chain = packed
         self.kind = kind
-        self.voltage_range = voltage_range
+        self.voltage_range = rails
         self.max_step = float(packed[chain.MAX_STEP])
 
     def _packed(self) -> np.ndarray:

@@ -9,7 +9,6 @@
 
 from __future__ import annotations
 
-import functools
 import math
 
 import numpy as np
@@ -17,6 +16,8 @@ import numpy as np
 from hystcomp._kernels import dynamics as dk
 from hystcomp._kernels._jit import step_function
 from hystcomp._validation import as_signal, check_int
+from hystcomp.errors import InvalidSignalError
+from hystcomp.models.system import block, checked_step
 
 #: Frequency (Hz) at which a hysteresis compensator and the inverse of the dynamics are
 #: matched in :func:`with_dynamics`: that of the paper's identification signals.
@@ -137,7 +138,7 @@ class DynamicsInverse:
 
     def stepper(self) -> DynamicsInverseStepper:
         """A streaming filter at rest."""
-        return DynamicsInverseStepper(self._packed)
+        return DynamicsInverseStepper(self._packed, self.preview)
 
     def __repr__(self) -> str:
         return f"DynamicsInverse({self.taps.size} taps, preview={self.preview} samples)"
@@ -146,12 +147,22 @@ class DynamicsInverse:
 class DynamicsInverseStepper:
     """The inverse filter one sample at a time (same kernel as the batch run)."""
 
-    def __init__(self, packed: np.ndarray):
+    def __init__(self, packed: np.ndarray, preview: int):
         self._initial = packed
         self._p = packed.copy()
-        self.step = functools.partial(  # type: ignore[method-assign]  # bound fast path
-            step_function(dk.inverse_step), self._p
-        )
+        self.preview = preview
+        self._bind()
+
+    def _bind(self) -> None:
+        # bound fast path, with the stepper's check of the sample's type
+        self.step = checked_step(step_function(dk.inverse_step), self._p)  # type: ignore[method-assign]
+
+    def __getstate__(self) -> dict:
+        return {k: v for k, v in self.__dict__.items() if k != "step"}  # bound again
+
+    def __setstate__(self, state: dict) -> None:
+        self.__dict__.update(state)
+        self._bind()
 
     def step(self, x_ref: float) -> float:
         """One reference sample (µm, ``preview`` samples ahead) -> filter output; NaN held out."""
@@ -159,14 +170,21 @@ class DynamicsInverseStepper:
 
     def step_block(self, x_ref) -> np.ndarray:
         """A block of reference samples."""
-        u = np.ascontiguousarray(x_ref, dtype=np.float64).reshape(-1)
+        u = block(x_ref, "step_block")
         out = np.empty_like(u)
         dk.inverse_run(self._p, u, out)
         return out
 
     def prime(self, x_ref) -> None:
         """Feed the first ``preview`` reference samples, whose outputs come before time 0."""
-        self.step_block(x_ref)
+        u = block(x_ref, "prime")
+        if u.size > self.preview:
+            raise InvalidSignalError(
+                f"prime takes the first 'preview' = {self.preview} reference samples, the "
+                f"filter's look-ahead. Got {u.size}; pass x_ref[:{self.preview}], then step "
+                f"from x_ref[{self.preview}]."
+            )
+        self.step_block(u)
 
     def reset(self) -> None:
         """Back to rest."""
@@ -174,7 +192,7 @@ class DynamicsInverseStepper:
 
     def copy(self) -> DynamicsInverseStepper:
         """An independent stepper in the same state."""
-        other = type(self)(self._initial)
+        other = type(self)(self._initial, self.preview)
         other._p[:] = self._p
         return other
 
@@ -244,8 +262,18 @@ class DynamicStepper:
     def __init__(self, dynamics, hysteresis):
         self._dyn = dynamics
         self._hyst = hysteresis
-        dyn_step, hyst_step = dynamics.step, hysteresis.step
-        self.step = lambda x_ref: hyst_step(dyn_step(x_ref))
+        self._bind()
+
+    def _bind(self) -> None:
+        dyn_step, hyst_step = self._dyn.step, self._hyst.step
+        self.step = lambda x_ref: hyst_step(dyn_step(x_ref))  # type: ignore[method-assign]
+
+    def __getstate__(self) -> dict:
+        return {"_dyn": self._dyn, "_hyst": self._hyst}  # the step is bound again
+
+    def __setstate__(self, state: dict) -> None:
+        self.__dict__.update(state)
+        self._bind()
 
     def step(self, x_ref: float) -> float:
         """One reference sample (µm, :attr:`preview` ahead) -> the voltage to apply now (V)."""

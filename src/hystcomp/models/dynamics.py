@@ -189,7 +189,7 @@ class LinearDynamics:
         """``D(exp(j 2 pi f Ts))`` at ``frequencies`` in Hz (complex, unit gain at 0 Hz)."""
         self._check_fitted()
         return _lti.frequency_response(
-            frequencies,
+            as_vector(frequencies, "frequencies", "LinearDynamics.frequency_response"),
             self.sample_rate_,
             self.resonance_hz_,
             self.damping_ratio_,
@@ -214,6 +214,13 @@ class LinearDynamics:
 
     def creep_fraction(self, seconds: float) -> float:
         """How far a step response still has to rise after ``seconds``, as a fraction of its end."""
+        self._check_fitted()
+        seconds = check_real(seconds, "seconds", "LinearDynamics.creep_fraction")
+        if seconds < 0.0:
+            raise InvalidParameterError(
+                "The 'seconds' parameter of LinearDynamics.creep_fraction is the time since "
+                f"the step, >= 0. Got {seconds:g}."
+            )
         return _lti.creep_fraction(seconds, self.creep_time_constants_, self.creep_weights_)
 
     # -- the inverse -----------------------------------------------------------------------

@@ -46,6 +46,11 @@ class PreisachStepper(Stepper):
 
     kernels = pk.PREISACH_KERNELS
 
+    @classmethod
+    def _checked(cls, packed) -> np.ndarray:
+        # made only by Preisach models and their compensators, from arrays they packed
+        return packed
+
     @property
     def memory_depth(self) -> int:
         """How many extrema the memory holds now (``beta_0`` included)."""
@@ -110,7 +115,8 @@ class Preisach(HysteresisModel):
     max_extrema : int, default 1024
         Bound of the memory (stored extrema, ``beta_0`` included). When a reversal would
         exceed it the innermost stored minor loop is wiped out first; the default is far
-        beyond what measured signals reach.
+        beyond what measured signals reach. At most 1,000,000 (the memory of a stepper is
+        allocated whole: 16 bytes per extremum).
     fit_method : {"least-squares", "reversal-curves", "auto"}, default "least-squares"
         How ``fit`` identifies X: ``"least-squares"`` fits the model's output over the
         whole record, any record that sweeps the range (``hystcomp excite rich``, the
@@ -193,7 +199,7 @@ class Preisach(HysteresisModel):
                 "eq. 5) and 'table' (X on a grid). Got "
                 f"{'both' if theta is not None else 'neither'}."
             )
-        check_int(max_extrema, "max_extrema", owner, minimum=3)
+        check_int(max_extrema, "max_extrema", owner, minimum=3, maximum=pk.MAX_DEPTH)
         model = cls(max_extrema=max_extrema)
         model.voltage_range_ = check_range(voltage_range, "voltage_range", owner)
         model.output_offset_ = check_real(output_offset, "output_offset", owner)
@@ -225,7 +231,7 @@ class Preisach(HysteresisModel):
         is not an int >= 3, is refused here rather than failing later.
         """
         model = super().from_dict(data)
-        check_int(model.max_extrema, "max_extrema", cls.__name__, minimum=3)
+        check_int(model.max_extrema, "max_extrema", cls.__name__, minimum=3, maximum=pk.MAX_DEPTH)
         if model.theta_ is not None:
             sizes = {pk.n_monomials(d): d for d in range(1, MAX_DEGREE + 1)}
             degree = sizes[model.theta_.size]
@@ -288,7 +294,7 @@ class Preisach(HysteresisModel):
         super()._check_hyperparameters()
         owner = type(self).__name__
         check_options(self.degree, self.everett, self.grid_size, self.zero_diagonal, owner)
-        check_int(self.max_extrema, "max_extrema", owner, minimum=3)
+        check_int(self.max_extrema, "max_extrema", owner, minimum=3, maximum=pk.MAX_DEPTH)
 
     def parameters(self) -> dict:
         """The learned parameters as plain Python values (``theta`` or ``table``)."""
@@ -298,7 +304,9 @@ class Preisach(HysteresisModel):
     def _packed(self, mode=pk.FORWARD, rho=1.0, max_step=np.inf, clamp=None) -> np.ndarray:
         """The packed Preisach system of :mod:`hystcomp._kernels.preisach` (not a play chain)."""
         self._check_fitted()
-        depth = check_int(self.max_extrema, "max_extrema", type(self).__name__, minimum=3)
+        depth = check_int(
+            self.max_extrema, "max_extrema", type(self).__name__, minimum=3, maximum=pk.MAX_DEPTH
+        )
         lo, hi = self.voltage_range_
         if self.theta_ is not None:
             kind, coef = pk.POLYNOMIAL, pk.coefficient_matrix(self.theta_, self.degree)

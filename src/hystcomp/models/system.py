@@ -10,6 +10,7 @@ kernels its class names.
 
 from __future__ import annotations
 
+import math
 import numbers
 from abc import ABC, abstractmethod
 from typing import ClassVar
@@ -19,7 +20,7 @@ import numpy as np
 from hystcomp._kernels import chain
 from hystcomp._kernels._jit import step_function
 from hystcomp._validation import as_signal
-from hystcomp.errors import InvalidSignalError, InvalidTypeError
+from hystcomp.errors import InvalidParameterError, InvalidSignalError, InvalidTypeError
 
 
 def _sample(u) -> float:
@@ -27,7 +28,10 @@ def _sample(u) -> float:
     if isinstance(u, numbers.Real | np.floating | np.integer) and not isinstance(
         u, bool | np.bool_
     ):
-        return float(u)
+        try:
+            return float(u)
+        except OverflowError:  # an integer beyond the floats: as an infinite sample, held
+            return math.inf if str(u)[0] != "-" else -math.inf
     raise InvalidTypeError(
         f"Stepper.step takes one sample, a real number. Got {u!r:.40} of type "
         f"{type(u).__name__}; convert it with float(...), or pass a block of samples to "
@@ -35,7 +39,76 @@ def _sample(u) -> float:
     )
 
 
-def _checked_step(kernel, p):
+def check_packed_chain(packed, owner: str) -> np.ndarray:
+    """``packed`` as a float64 packed chain (:mod:`hystcomp._kernels.chain`) that the
+    kernels can run: its counts, its length and its numbers agree with the layout.
+
+    The kernels read the array without bounds checks, so an array of another layout would
+    make them read or write outside it. Raises InvalidTypeError or InvalidParameterError.
+    """
+    fix = "build it with model.inverse() (or take the .packed of one)"
+    try:
+        p = np.array(packed, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise InvalidTypeError(
+            f"The 'packed' parameter of {owner} must be a packed chain, an array of floats. "
+            f"Got {type(packed).__name__}; {fix}."
+        ) from None
+    ok = p.ndim == 1 and p.size >= chain.HEADER
+    if ok:
+        counts = p[chain.N_PRE : chain.N_POST + 1]
+        ok = bool(np.all((counts >= 0) & (counts <= p.size) & (counts == np.floor(counts))))
+        start = chain.HEADER + 2 * int(counts.sum()) if ok else 0
+        ok = ok and p.size == start + chain.STATE_PLAYS + int(counts[1])
+    if not ok:
+        raise InvalidParameterError(
+            f"The 'packed' parameter of {owner} is not a packed chain: its length "
+            f"({p.size}) and counts do not agree with the layout of hystcomp._kernels.chain; "
+            f"{fix}."
+        )
+    parts = chain.chain_parts.py_func(p)
+    low, high, max_step = float(parts.low), float(parts.high), float(parts.max_step)
+    finite = np.delete(p, [chain.LOW, chain.HIGH, chain.MAX_STEP])
+    thresholds = np.concatenate([parts.pre_r, parts.play_r, parts.post_r])
+    if not (
+        np.isfinite(finite).all()
+        and (thresholds >= 0.0).all()
+        and low < high
+        and max_step > 0.0  # NaN fails each of these
+        and not np.isnan([low, high]).any()
+    ):
+        raise InvalidParameterError(
+            f"The 'packed' parameter of {owner} holds values that no chain has: non-finite "
+            f"parameters or state, a negative threshold, a clamp with low >= high "
+            f"({low:g}, {high:g}) or a slew limit <= 0 ({max_step:g}); {fix}."
+        )
+    return p
+
+
+def block(u, owner: str) -> np.ndarray:
+    """A block of samples for a block kernel: 1-D, contiguous, writeable float64, or raise
+    (text, booleans, objects, more than one dimension)."""
+    try:
+        arr = np.asarray(u)
+    except (TypeError, ValueError):  # ragged nesting
+        arr = np.asarray(u, dtype=object)
+    if arr.dtype.kind not in "fiu":
+        raise InvalidTypeError(
+            f"{owner} takes real numbers. Got an array of {arr.dtype} "
+            f"({type(u).__name__}); convert it with np.asarray(u, dtype=float)."
+        )
+    if arr.ndim > 1:
+        raise InvalidSignalError(
+            f"{owner} takes a 1-D block of samples. Got shape {arr.shape}; "
+            "pass one channel at a time (for example u[:, 0])."
+        )
+    u = np.ascontiguousarray(arr, dtype=np.float64).reshape(-1)
+    if not u.flags.writeable:  # one array type for the kernel (see as_signal)
+        u = u.copy()
+    return u
+
+
+def checked_step(kernel, p):
     """``step(u) = kernel(p, u)`` for a float ``u`` (the fast path: one type test), and
     for any other real number after conversion; text, bools and arrays are refused (the
     compiled kernel alone would parse a string)."""
@@ -76,14 +149,33 @@ class Stepper:
     kernels = chain.CHAIN_KERNELS
 
     def __init__(self, packed: np.ndarray):
+        packed = self._checked(packed)
         self._initial = packed
         self._p = packed.copy()
         self._start = int(self.kernels.state_start(packed))
+        self._bind()
+
+    @classmethod
+    def _checked(cls, packed) -> np.ndarray:
+        """``packed`` checked against the layout of :attr:`kernels` (a play chain here)."""
+        return check_packed_chain(packed, cls.__name__)
+
+    def _bind(self) -> None:
+        """Bind the fast :meth:`step` and the block kernel to this stepper's state."""
         self._run = self.kernels.run  # looked up once: a block call is short too
         # an instance attribute hides the method below, which documents it
-        self.step = _checked_step(  # type: ignore[method-assign]
+        self.step = checked_step(  # type: ignore[method-assign]
             step_function(self.kernels.step), self._p
         )
+
+    def __getstate__(self) -> dict:
+        # the bound step is a closure over the state: bound again on unpickling, so that
+        # a pickled or deep-copied stepper steps its own state
+        return {k: v for k, v in self.__dict__.items() if k not in ("step", "_run", "_kernel")}
+
+    def __setstate__(self, state: dict) -> None:
+        self.__dict__.update(state)
+        self._bind()
 
     def step(self, u: float) -> float:
         """Advance one sample and return the output.
@@ -116,20 +208,7 @@ class Stepper:
         InvalidTypeError
             If ``u`` holds text, booleans or objects.
         """
-        arr = np.asarray(u)
-        if arr.dtype.kind not in "fiu":
-            raise InvalidTypeError(
-                f"Stepper.step_block takes real numbers. Got an array of {arr.dtype} "
-                f"({type(u).__name__}); convert it with np.asarray(u, dtype=float)."
-            )
-        if arr.ndim > 1:
-            raise InvalidSignalError(
-                f"Stepper.step_block takes a 1-D block of samples. Got shape {arr.shape}; "
-                "pass one channel at a time (for example u[:, 0])."
-            )
-        u = np.ascontiguousarray(arr, dtype=np.float64).reshape(-1)
-        if not u.flags.writeable:  # one array type for the kernel (see as_signal)
-            u = u.copy()
+        u = block(u, "Stepper.step_block")
         out = np.empty_like(u)
         self._run(self._p, u, out)
         return out

@@ -150,6 +150,13 @@ class TwinStepper(Stepper):
         self._offset = params.sensor_offset
         self._sigma = params.sensor_noise / params.sensor_gain
         self._rng = rng
+
+    @classmethod
+    def _checked(cls, packed) -> np.ndarray:
+        return packed  # made only by Twin.stepper, from the array the twin packed
+
+    def _bind(self) -> None:
+        super()._bind()
         self._kernel = step_function(self.kernels.step)
         del self.step  # the base class binds a step without the sensor; use the method below
 
