@@ -173,3 +173,10 @@ def test_holdout_verdict_reads_worse_below_one():
     assert _verdict(2.5) == "2.5x better"
     assert _verdict(0.879) == "1.14x worse"
     assert _verdict(1.0) == "1x better"
+
+
+def test_none_for_a_signal_is_named_a_type_error():
+    from hystcomp.errors import InvalidTypeError
+
+    with pytest.raises(InvalidTypeError, match="'v' must be a 1-D array of real numbers"):
+        hystcomp.PrandtlIshlinskii().fit(None, None)

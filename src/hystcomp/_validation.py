@@ -150,6 +150,8 @@ def as_signal(value, name: str, *, min_samples: int = 1) -> np.ndarray:
     compiled once, not once more for read-only input. The kernels do not write into it.
     """
     try:
+        if value is None:
+            raise TypeError
         arr = _real_array(value, copy=False)
     except (TypeError, ValueError, OverflowError):
         raise InvalidTypeError(
