@@ -180,3 +180,13 @@ def test_none_for_a_signal_is_named_a_type_error():
 
     with pytest.raises(InvalidTypeError, match="'v' must be a 1-D array of real numbers"):
         hystcomp.PrandtlIshlinskii().fit(None, None)
+
+
+@pytest.mark.parametrize("make", [
+    lambda: hystcomp.PrandtlIshlinskii(n_operators=257),
+    lambda: hystcomp.ModifiedPrandtlIshlinskii(n_deadzones=1000),
+])  # fmt: skip
+def test_a_fit_with_more_operators_than_it_can_solve_in_time_is_refused_at_once(make):
+    v = np.r_[np.linspace(0.0, 120.0, 500), np.linspace(120.0, 0.0, 500)]
+    with pytest.raises(InvalidParameterError, match="at most 256"):
+        make().fit(v, presets.paper_mpi().simulate(v))

@@ -10,6 +10,7 @@ import math
 
 import click
 
+from hystcomp._hyperparameters import MAX_OPERATORS
 from hystcomp._progress import Progress
 from hystcomp._validation import MAX_MAGNITUDE
 from hystcomp.errors import InvalidParameterError
@@ -17,9 +18,6 @@ from hystcomp.io.records import X_UNITS  # light: the readers load compiled code
 
 # hystcomp.io.records, hystcomp.io.models and the models are imported where used: a command that
 # needs no kernel (``excite``) then loads neither numba nor SciPy's sparse solvers.
-
-#: Largest --operators / --deadzones (the paper uses 16; the fit's cost grows as n^2 per sample).
-MAX_OPERATORS = 1000
 
 
 def _finite(value: float, param) -> float:
@@ -67,10 +65,12 @@ def fraction(ctx, param, value):
 
 
 def count(ctx, param, value):
-    """A callback: an operator count between 1 and :data:`MAX_OPERATORS`."""
+    """A callback: an operator count between 1 and
+    :data:`~hystcomp._hyperparameters.MAX_OPERATORS`."""
     if value is not None and not 1 <= value <= MAX_OPERATORS:
         raise click.BadParameter(
-            f"must be between 1 and {MAX_OPERATORS} (the paper uses 16); got {value}.",
+            f"must be between 1 and {MAX_OPERATORS} (the paper uses 16; the fit grows as the "
+            f"cube of the count); got {value}.",
             param=param,
         )
     return value

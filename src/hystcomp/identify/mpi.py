@@ -105,6 +105,7 @@ from hystcomp._hyperparameters import (
     DEFAULT_MARGIN,
     check_constraints,
     check_margin,
+    check_operator_count,
     check_regularization,
 )
 from hystcomp._validation import as_vector, check_int, check_real
@@ -306,8 +307,8 @@ def fit_mpi_path(
         One fit per initial memory and value of ``regularizations``, memory by memory.
     """
     owner = "fit_mpi"
-    n = check_int(n_operators, "n_operators", owner)
-    m = check_int(n_deadzones, "n_deadzones", owner)
+    n = check_operator_count(n_operators, "n_operators", owner)
+    m = check_operator_count(n_deadzones, "n_deadzones", owner)
     margin = check_margin(margin, owner)
     constraints = check_constraints(constraints, owner)
     penalties = [check_regularization(value, owner) for value in regularizations]

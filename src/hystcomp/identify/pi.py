@@ -53,7 +53,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from hystcomp import paper
-from hystcomp._hyperparameters import DEFAULT_MARGIN, check_constraints, check_margin
+from hystcomp._hyperparameters import (
+    DEFAULT_MARGIN,
+    check_constraints,
+    check_margin,
+    check_operator_count,
+)
 from hystcomp._validation import as_signal, check_int, check_real
 from hystcomp.errors import IdentificationError, InvalidParameterError, InvalidSignalError
 from hystcomp.identify import scoring
@@ -302,7 +307,7 @@ def fit_pi(
     ([0.5, 0.0], 2.0)
     """
     owner = "fit_pi"
-    n = check_int(n_operators, "n_operators", owner)
+    n = check_operator_count(n_operators, "n_operators", owner)
     margin = check_margin(margin, owner)
     constraints = check_constraints(constraints, owner)
     n_folds = check_int(n_folds, "n_folds", owner, minimum=0)

@@ -11,7 +11,7 @@ from typing import Any, Self
 import numpy as np
 
 from hystcomp import paper
-from hystcomp._hyperparameters import check_regularization_option
+from hystcomp._hyperparameters import check_operator_count, check_regularization_option
 from hystcomp._validation import as_vector, check_int, check_thresholds
 from hystcomp.identify.compensation import CV_FOLDS, tracking_scorer
 from hystcomp.identify.mpi import REGULARIZATION_GRID, fit_mpi_path
@@ -147,8 +147,8 @@ class ModifiedPrandtlIshlinskii(PrandtlIshlinskii):
         """
         owner = type(self).__name__
         self._check_hyperparameters()
-        n = check_int(self.n_operators, "n_operators", owner)
-        m = check_int(self.n_deadzones, "n_deadzones", owner)
+        n = check_operator_count(self.n_operators, "n_operators", owner)
+        m = check_operator_count(self.n_deadzones, "n_deadzones", owner)
         penalties = self._penalties(owner)
         # eq. 18's virgin plays, and with the physical constraints the descended ones too
         fits = fit_mpi_path(

@@ -13,7 +13,7 @@ from typing import Any, ClassVar, Self
 import numpy as np
 
 from hystcomp import paper
-from hystcomp._hyperparameters import check_constraints, check_margin
+from hystcomp._hyperparameters import check_constraints, check_margin, check_operator_count
 from hystcomp._kernels import chain
 from hystcomp._validation import as_vector, check_int, check_range, check_real, check_thresholds
 from hystcomp.identify.compensation import CV_FOLDS, tracking_scorer
@@ -143,7 +143,7 @@ class PrandtlIshlinskii(HysteresisModel):
         """
         owner = type(self).__name__
         self._check_hyperparameters()
-        n = check_int(self.n_operators, "n_operators", owner)
+        n = check_operator_count(self.n_operators, "n_operators", owner)
         fit = fit_pi(
             v,
             x,
