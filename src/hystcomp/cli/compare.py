@@ -45,7 +45,6 @@ def compare(out_dir: Path, seed: int, periods: int | None, quick: bool) -> None:
     from hystcomp.experiment import warmup
     from hystcomp.experiment.background import BackgroundJob, draw_in_background
     from hystcomp.experiment.compare import CompareConfig, run_comparison
-    from hystcomp.experiment.compare_dynamics import identify_twin_dynamics
     from hystcomp.experiment.figures import (  # matplotlib, for a forked process
         BACKGROUND_FIGURES,
         write_figures,
@@ -55,15 +54,11 @@ def compare(out_dir: Path, seed: int, periods: int | None, quick: bool) -> None:
     start = time.perf_counter()
     _collect_garbage_less()
     prepare_output_dir(out_dir)  # refuse a bad --out before the work
-    compiling = warmup.start()  # a first run: the kernels needed later compile on the 2nd core
+    warmup.start()  # on a first run, the kernels needed later compile on the second core
     changes: dict[str, Any] = (
         {"seed": seed} if periods is None else {"seed": seed, "periods": periods}
     )
     config = CompareConfig.quick(**changes) if quick else CompareConfig(**changes)
-    # a later run: the second core, idle until Table I, identifies the linear dynamics
-    dynamics = None
-    if compiling is None and config.dynamics:
-        dynamics = BackgroundJob.start(identify_twin_dynamics, config.twin, config.seed)
 
     def progress(line: str) -> None:
         click.echo(f"hystcomp compare: {line}", err=True)
@@ -75,12 +70,7 @@ def compare(out_dir: Path, seed: int, periods: int | None, quick: bool) -> None:
             functools.partial(write_figures, names=BACKGROUND_FIGURES), table1
         )
 
-    comparison = run_comparison(
-        config,
-        progress=progress,
-        table1=draw_figures,
-        identified_dynamics=dynamics.collect if dynamics is not None else None,
-    )
+    comparison = run_comparison(config, progress=progress, table1=draw_figures)
     progress(f"writing tables, figures and report into {out_dir}")
     files = write_outputs(comparison, out_dir, figures=figures.get("paper"))
     click.echo(format_table(comparison))

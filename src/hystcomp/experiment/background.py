@@ -1,16 +1,12 @@
 """Work done in a second, forked process while ``hystcomp compare`` goes on.
 
-Two jobs run there (:class:`BackgroundJob`):
-
-* the twin's answer to the dynamics excitation and the linear dynamics identified from it
-  (:func:`hystcomp.experiment.compare_dynamics.identify_twin_dynamics`), from the start of
-  the run, on the core that the first process leaves idle until Table I is measured;
-* the paper's figures (:func:`draw_in_background`): :func:`hystcomp.experiment.compare.
-  run_comparison` hands Table I over as soon as it is measured, and the forked process
-  draws :data:`~hystcomp.experiment.figures.BACKGROUND_FIGURES` while the calling process
-  goes on with the dynamics part and then draws the others (about as much drawing each);
-  :func:`~hystcomp.experiment.report.write_outputs` takes the image files from it and
-  writes them with the tables and the report, all at once.
+:class:`BackgroundJob` computes a function there and hands its result back. The paper's
+figures are drawn that way (:func:`draw_in_background`): :func:`hystcomp.experiment.compare.
+run_comparison` hands Table I over as soon as it is measured, and the forked process draws
+:data:`~hystcomp.experiment.figures.BACKGROUND_FIGURES` while the calling process goes on
+with the dynamics part and then draws the others (about as much drawing each);
+:func:`~hystcomp.experiment.report.write_outputs` takes the image files from it and writes
+them with the tables and the report, all at once.
 
 Where ``fork`` is not available, or if the process fails in any way, the calling process
 does the job itself instead: the results are the same either way.

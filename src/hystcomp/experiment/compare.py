@@ -203,7 +203,6 @@ def run_comparison(
     identify: Callable[[Record, Record, CompareConfig], dict] | None = None,
     progress: Callable[[str], None] | None = None,
     table1: Callable[[Comparison], None] | None = None,
-    identified_dynamics: Callable[[], tuple | None] | None = None,
 ) -> Comparison:
     """Run the paper's experiment on the twin.
 
@@ -220,10 +219,6 @@ def run_comparison(
         Called with the comparison as far as Table I (records, models, ``results``,
         ``datasheet``, ``preisach_exact``; no ``dynamics`` or ``paper_fit`` yet) as soon
         as it is measured: ``hystcomp compare`` draws the paper's figures meanwhile.
-    identified_dynamics : callable, optional
-        Returns :func:`~hystcomp.experiment.compare_dynamics.identify_twin_dynamics`
-        ``(config.twin, config.seed)`` computed elsewhere (``hystcomp compare``: in a second
-        process), or None, in which case it is computed here.
 
     Returns
     -------
@@ -303,7 +298,6 @@ def run_comparison(
             periods=config.periods,
             frequencies=config.frequencies,
             seed=config.seed,
-            identified=identified_dynamics() if identified_dynamics is not None else None,
         )
     paper_fit: dict[str, TrackingResult] = {}
     if identify is identify_models:

@@ -68,11 +68,8 @@ def identify_twin_dynamics(params: TwinParameters, seed: int) -> tuple[Record, L
 
     The twin here is one of its own, built at rest from ``params``, with a sensor noise
     stream of its own drawn from ``seed`` (independent of the stream of the twin that
-    measures Table I): the result is the same whichever process computes it and whenever,
-    so that ``hystcomp compare`` computes it in a second process from the start
-    (:class:`~hystcomp.experiment.background.BackgroundJob`). The inverse's FIR for the
-    default band is computed here too and travels with the model
-    (:meth:`hystcomp.LinearDynamics.inverse`).
+    measures Table I): the identified dynamics do not depend on how many runs came before
+    (``--periods``, ``--quick``).
     """
     stream = int(np.random.SeedSequence([seed, DYNAMICS_STREAM]).generate_state(1)[0])
     twin = Twin(params, seed=stream)
@@ -80,20 +77,14 @@ def identify_twin_dynamics(params: TwinParameters, seed: int) -> tuple[Record, L
     t, v = dynamics_excitation(sample_rate=fs, voltage_range=twin.voltage_range)
     record = Record(t=t, v=v, x=twin.run(v), source="the twin")
     dynamics = LinearDynamics().fit(record.v, record.x, fs)
-    dynamics.inverse()
     return record, dynamics
 
 
-def run_dynamics(
-    twin, models, compensators, amplitude, *, periods, frequencies, seed=0, identified=None
-):
-    """The dynamics part of the comparison (see the module); ``compensators`` by method.
-
-    ``identified`` is :func:`identify_twin_dynamics` ``(twin.params, seed)`` if already
-    computed (elsewhere); None computes it here.
-    """
+def run_dynamics(twin, models, compensators, amplitude, *, periods, frequencies, seed=0):
+    """The dynamics part of the comparison (see the module); ``compensators`` by method,
+    ``seed`` that of the comparison (:func:`identify_twin_dynamics`)."""
     fs = twin.sample_rate
-    record, dynamics = identified or identify_twin_dynamics(twin.params, seed)
+    record, dynamics = identify_twin_dynamics(twin.params, seed)
     with_dyn = {m: models[m].inverse(dynamics=dynamics) for m in WITH_DYNAMICS}
     results: dict[float, dict[str, TrackingResult]] = {}
     for f in (*frequencies, *FAST_FREQUENCIES):

@@ -269,7 +269,7 @@ class LinearDynamics:
                 f"({0.5 * fs:g} Hz). Got {bandwidth_hz:g}."
             )
         rest = check_real(rest, "rest", owner)
-        taps, preview = self._inverse_fir(bandwidth_hz)
+        taps, preview = inverse_fir(self.resonance(), bandwidth_hz, fs)
         match_hz = check_real(match_hz, "match_hz", owner)
         if not 0.0 <= match_hz < 0.5 * fs:
             raise InvalidParameterError(
@@ -293,16 +293,6 @@ class LinearDynamics:
             output_range=(low, high),
             bias=(1.0 - gain) * centre,
         )
-
-    def _inverse_fir(self, bandwidth_hz: float):
-        """:func:`inverse_fir` of the resonance, kept with the model for each band: a
-        model pickled to another process (``hystcomp compare``) takes it along, so that
-        the process it goes to needs neither the fit nor SciPy's solver (0.3 s to import)."""
-        key = (self.resonance_hz_, self.damping_ratio_, self.sample_rate_, bandwidth_hz)
-        kept = self.__dict__.setdefault("_inverse_firs", {})
-        if key not in kept:
-            kept[key] = inverse_fir(self.resonance(), bandwidth_hz, self.sample_rate_)
-        return kept[key]
 
     # -- files -----------------------------------------------------------------------------
 
