@@ -63,6 +63,8 @@ CASES = [
     ("negative slew rate", "compensate model.json ref.csv --slew-rate -1 -o {out}.csv", r"'--slew-rate': must be a number > 0 \(V/s\)"),
     ("widened voltage range", "compensate model.json ref.csv --voltage-range 0 150 -o {out}.csv", r"may only narrow the model's voltage range 0 \.\. 120 V"),
     ("excite: bad sample rate", "excite pi --fs -5 -o {out}.csv", r"'--fs': must be a number > 0"),
+    ("dynamics as the model", "simulate dyn.json rec.csv -o {out}.csv", r"'dyn\.json' holds linear dynamics, not a hysteresis model; simulate runs"),
+    ("file name too long", "excite mpi -o %s.csv" % ("a" * 300), r"cannot use 'a+': File name too long\. Check the path"),
 ]  # fmt: skip
 
 EXTENDED = [
@@ -103,6 +105,11 @@ def _make_files(folder: Path) -> None:
     t, v = triangle_sequence(sample_rate=200.0)
     write_table(folder / "rec.csv", {"t": t, "v": v, "x": presets.paper_mpi().simulate(v)})
     hystcomp.save_model(presets.paper_mpi(), folder / "model.json")
+    dyn = hystcomp.LinearDynamics.from_parameters(
+        sample_rate=200.0, resonance_hz=40.0, damping_ratio=0.1,
+        creep_time_constants=[0.1], creep_weights=[0.01],
+    )  # fmt: skip
+    hystcomp.save_model(dyn, folder / "dyn.json")
     t_ref = np.arange(500) / 1000.0
     write_table(folder / "ref.csv", {"t": t_ref, "x": 10.0 + 5.0 * np.sin(2 * np.pi * t_ref)})
     texts = {

@@ -58,3 +58,22 @@ def test_the_dynamics_identified_in_a_second_process_are_those_identified_here()
     np.testing.assert_array_equal(there.inverse().taps, here.inverse().taps)
     # its noise is a stream of its own, not the twin's that measures Table I
     assert not np.array_equal(record.x, Twin(params, seed=3).run(record.v))
+
+
+def test_a_cancelled_job_ends_at_once():
+    import time
+
+    job = BackgroundJob.start(time.sleep, 60.0)
+    assert job is not None
+    start = time.perf_counter()
+    job.cancel()
+    assert time.perf_counter() - start < 5.0
+    assert not job._process.is_alive()
+
+
+def test_an_output_folder_that_takes_no_file_is_refused_before_the_run():
+    from hystcomp.errors import InvalidParameterError
+    from hystcomp.experiment.report import prepare_output_dir
+
+    with pytest.raises(InvalidParameterError, match="Cannot write into the output folder"):
+        prepare_output_dir("/proc/self")

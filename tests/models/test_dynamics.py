@@ -455,3 +455,9 @@ def test_creep_fraction_and_frequency_response_refuse_what_is_not_a_time_or_a_fr
     for bad in ([np.nan], [np.inf]):
         with pytest.raises(InvalidParameterError):
             dyn.frequency_response(bad)
+
+
+def test_a_record_whose_displacement_does_not_move_is_refused_with_the_reason():
+    _, v = dynamics_excitation(sample_rate=20_000.0, voltage_range=(0.0, 120.0))
+    with pytest.raises(IdentificationError, match="does not move"):
+        LinearDynamics().fit(v, np.full_like(v, 3.0), 20_000.0)

@@ -182,6 +182,16 @@ class _Group(click.Group):
             remove_pending()
             click.echo("hystcomp: interrupted", err=True)
             sys.exit(EXIT_SIGINT)
+        except OSError as exc:  # the system refused a path or a write: bad input, not a fault
+            remove_pending()
+            where = f" {os.fsdecode(exc.filename)[:120]!r}" if exc.filename else ""
+            click.echo(
+                f"hystcomp: error: cannot use{where}: {exc.strerror or exc}. Check the path "
+                "(the length of its names, that its folders exist and are folders), its "
+                "permissions and the free space.",
+                err=True,
+            )
+            sys.exit(EXIT_BAD_INPUT)
         except Exception as exc:  # noqa: BLE001 - an internal fault: say so, briefly
             click.echo(
                 f"hystcomp: internal error: {type(exc).__name__}: {_one_line(exc)} "

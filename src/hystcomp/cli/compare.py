@@ -70,9 +70,14 @@ def compare(out_dir: Path, seed: int, periods: int | None, quick: bool) -> None:
             functools.partial(write_figures, names=BACKGROUND_FIGURES), table1
         )
 
-    comparison = run_comparison(config, progress=progress, table1=draw_figures)
-    progress(f"writing tables, figures and report into {out_dir}")
-    files = write_outputs(comparison, out_dir, figures=figures.get("paper"))
+    try:
+        comparison = run_comparison(config, progress=progress, table1=draw_figures)
+        progress(f"writing tables, figures and report into {out_dir}")
+        files = write_outputs(comparison, out_dir, figures=figures.get("paper"))
+    finally:  # collected by write_outputs, unless the run failed: then ended here
+        job = figures.get("paper")
+        if job is not None:
+            job.cancel()
     click.echo(format_table(comparison))
     seconds = time.perf_counter() - start
     progress(f"done in {seconds:.1f} s; wrote {len(files)} files into {out_dir}")

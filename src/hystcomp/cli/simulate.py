@@ -14,6 +14,7 @@ from hystcomp.cli._options import (
     quiet_option,
     read_options,
 )
+from hystcomp.errors import ModelFileError
 from hystcomp.io.models import load_model
 from hystcomp.io.records import read_table, write_table
 
@@ -32,6 +33,12 @@ def simulate(model_file, input_file, output, columns, sample_rate, quiet):
     """
     check_data_output(output, inputs=(model_file, input_file), what="result file")
     model = load_model(model_file)
+    if getattr(model, "kind", None) == "dynamics":
+        raise ModelFileError(
+            f"{str(model_file)!r} holds linear dynamics, not a hysteresis model; simulate "
+            "runs a PI, MPI or Preisach model file on a voltage (the dynamics act on a "
+            "displacement: LinearDynamics.simulate in Python)."
+        )
     table = read_table(
         input_file, ("v",), **read_options(columns, sample_rate, None, quiet, input_file)
     )

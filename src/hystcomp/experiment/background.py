@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import contextlib
 import multiprocessing
+import os
 import signal
 import sys
 import tempfile
@@ -86,6 +87,27 @@ class BackgroundJob:
             return None
         return reply[1]
 
+    def cancel(self) -> None:
+        """End the process if it still runs, its result unread (the command failed)."""
+        with contextlib.suppress(OSError, ValueError):
+            self._connection.close()
+            if self._process.is_alive():
+                self._process.kill()
+            self._process.join(timeout=10.0)
+
+
+def detach_output() -> None:
+    """Point a forked process's standard output and error at the null device.
+
+    It prints nothing, and a process that held the caller's would keep a pipeline such as
+    ``hystcomp compare | tail`` waiting after the caller has ended.
+    """
+    with contextlib.suppress(OSError, ValueError):
+        null = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(null, 1)
+        os.dup2(null, 2)
+        os.close(null)
+
 
 def draw_in_background(function: Callable[..., Notes], *args) -> BackgroundJob | None:
     """A :class:`BackgroundJob` that draws ``function(*args, folder)`` into a folder of its
@@ -103,6 +125,7 @@ def _run(connection, function, args) -> None:
     """The forked process: compute, send the result, or why not."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the caller's to answer
     signal.signal(signal.SIGTERM, signal.SIG_DFL)  # as the caller ends it when it exits
+    detach_output()
     try:
         result = function(*args)
         connection.send(("ok", result))

@@ -15,6 +15,7 @@ from __future__ import annotations
 import csv
 import io
 import os
+import tempfile
 from pathlib import Path
 
 from hystcomp import paper
@@ -120,6 +121,14 @@ def prepare_output_dir(out_dir) -> Path:
     except OSError as exc:
         raise InvalidParameterError(
             f"Cannot create the output folder {str(path)!r}: {exc.strerror}. Choose another path."
+        ) from None
+    try:  # before the run, not after it: can files be written there?
+        with tempfile.TemporaryFile(dir=path):
+            pass
+    except OSError as exc:
+        raise InvalidParameterError(
+            f"Cannot write into the output folder {str(path)!r}: {exc.strerror}. Choose "
+            "another --out folder or check its permissions."
         ) from None
     return path
 

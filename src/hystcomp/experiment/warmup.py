@@ -27,7 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from hystcomp._kernels import chain
-from hystcomp.experiment.background import FORK_WARNING
+from hystcomp.experiment.background import FORK_WARNING, detach_output
 
 
 def compile_later_kernels() -> None:
@@ -97,5 +97,6 @@ def _run(job) -> None:
     # inherits): numba writes each cache file whole, under a temporary name first
     signal.signal(signal.SIGINT, signal.SIG_DFL)
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    detach_output()  # it may outlive the caller: not with the caller's pipes
     with contextlib.suppress(Exception):  # a failure here only costs the caller time
         job()

@@ -165,6 +165,12 @@ def fit_dynamics(v, x, sample_rate: float) -> DynamicsFit:
     fs = check_real(sample_rate, "sample_rate", owner, positive=True)
     v, x = as_signal_pair(v, x, ("v", "x"), owner, min_samples=8)
     step, multisine, n_period = _layout(v, fs)
+    if np.ptp(x[step:]) <= 1e-9 * max(1.0, float(np.max(np.abs(x)))):
+        raise IdentificationError(
+            f"The displacement 'x' does not move after the step of the dynamics excitation "
+            f"(constant at {x[step]:.6g} µm): nothing to identify. Check that the column "
+            "is the displacement sensor's and that the actuator was driven."
+        )
     hold = (multisine - step) / fs
     periods = (v.size - multisine) // n_period
     lines = multisine_lines(fs)
