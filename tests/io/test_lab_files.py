@@ -47,6 +47,8 @@ def _same(path, record, **kwargs):
         ("units.csv", ["t,v,x", "s,V,um"], ",", "."),
         ("units-brackets.csv", ["t;v;x", "[s];[V];[µm]"], ";", ","),
         ("comment-units.dat", ["# t v x", "# (s) (V) (um)"], " ", "."),
+        ("comment-header-then-note.csv", ["# t,v,x", "# operator: A.B."], ",", "."),
+        ("comment-header-units-note.csv", ["# rig 3", "# t,v,x", "# s,V,um", "# note"], ",", "."),
         ("upper.csv", ["T,V,X"], ",", "."),
         ("names-units.csv", ["t [s];V (V);x [µm]"], ";", ","),
         ("mixed.csv", ['"Time","v","X"'], ",", "."),

@@ -140,6 +140,8 @@ def _header(path: Path, above, delimiter, n: int):
         if not comment:
             break
         comments.insert(0, line)
+    if not plain:  # a header in comment lines: those with a name per column ("# t,v,x")
+        comments = [line for line in comments if len(_split(line, delimiter)) == n]
     candidates = plain[-2:] if plain else comments[-2:]
     if not candidates:
         return None, None
