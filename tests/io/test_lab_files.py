@@ -256,3 +256,11 @@ def test_writing_and_reading_stay_in_bounded_memory(tmp_path):
     assert _growth(make + "write_table(sys.argv[1], table)", path) < 100
     # the parsed table and the record's own copies (2 x 12 MB), chunk buffers (2 MB of text)
     assert _growth("rec = read_record(sys.argv[1])", path) < 50
+
+
+def test_the_unit_warning_asks_to_check_a_unit_the_user_gave_instead_of_suggesting_another():
+    given = x_unit_warning([0.0, 3.7e7], "rec.csv", "m")
+    assert "read in m as --x-unit says" in given
+    assert "give --x-unit" not in given
+    assert "give --x-unit nm" in x_unit_warning([0.0, 3.7e7], "rec.csv")
+    assert x_unit_warning([0.0, 37.0], "rec.csv", "m") is None

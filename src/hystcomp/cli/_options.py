@@ -160,11 +160,11 @@ def progress(label: str, quiet: bool):
     return Progress(label, enabled=False if quiet else None)
 
 
-def warn_x_unit(x, source, quiet: bool) -> None:
+def warn_x_unit(x, source, quiet: bool, x_unit: str | None = None) -> None:
     """The one-line warning of :func:`hystcomp.io.records.x_unit_warning`, unless --quiet."""
     from hystcomp.io.records import x_unit_warning
 
-    message = x_unit_warning(x, str(source))
+    message = x_unit_warning(x, str(source), x_unit)
     if message and not quiet:
         click.echo(f"hystcomp: warning: {message}", err=True)
 

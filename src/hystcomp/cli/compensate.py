@@ -124,7 +124,7 @@ def compensate(
     chosen = method_options(model, model_file, method)
     options = read_options(columns, sample_rate, x_unit, quiet, reference_file)
     table = read_table(reference_file, ("x",), **options)
-    warn_x_unit(table["x"], reference_file, quiet)
+    warn_x_unit(table["x"], reference_file, quiet, x_unit)
     options = inverse_options(model, table, slew_rate=slew_rate, narrow_range=narrow_range)
     if dynamics_file is not None:
         options["dynamics"] = dynamics_for(load_dynamics(dynamics_file), table)

@@ -238,7 +238,7 @@ def identify(
     _check_options(kind, options)
     model = build_estimator(kind, voltage_range=voltage_range, **options)
     rec = read_record(data, **read_options(columns, sample_rate, x_unit, quiet, data))
-    warn_x_unit(rec.x, data, quiet)
+    warn_x_unit(rec.x, data, quiet, x_unit)
     n = len(rec)
     n_fit = fit_samples(n, holdout)
     if holdout is not None and not 2 <= n_fit < n:

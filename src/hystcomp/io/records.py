@@ -441,12 +441,13 @@ def read_table(
     return {"t": out["t"], **{key: out[key] for key in keys}}
 
 
-def x_unit_warning(x, source: str) -> str | None:
+def x_unit_warning(x, source: str, given: str | None = None) -> str | None:
     """A warning if the span of displacements ``x`` (µm) looks like metres or nanometres.
 
     A piezo actuator's stroke is between about 0.01 µm and a few mm: a span below
     :data:`SPAN_METRES` µm is likely metres, one above :data:`SPAN_NANOMETRES` µm likely
-    nanometres (give ``--x-unit``). Returns the message, or None if the span is plausible.
+    nanometres (give ``--x-unit``). ``given``, the unit the user gave (``--x-unit``), if any:
+    then the message asks to check it. Returns the message, or None if the span is plausible.
 
     Examples
     --------
@@ -457,6 +458,12 @@ def x_unit_warning(x, source: str) -> str | None:
     """
     span = float(np.ptp(np.asarray(x, dtype=np.float64)))
     for unit, looks in (("m", 0 < span < SPAN_METRES), ("nm", span > SPAN_NANOMETRES)):
+        if looks and given not in (None, "um", "µm"):
+            return (
+                f"the displacement in {source}, read in {given} as --x-unit says, spans "
+                f"{span:.4g} µm, which is no piezo stroke; check --x-unit (the unit the "
+                "file's displacement is in)."
+            )
         if looks:
             name = {"m": "metres", "nm": "nanometres"}[unit]
             return (
