@@ -77,7 +77,7 @@ EXTENDED = [
     ("huge value", "identify huge.csv --model pi -o {out}.json", r"value 1e\+13 in data row 2, beyond 1e\+12"),
     ("absurd time", "identify tiny_t.csv --model pi -o {out}.json", r"no usable sample rate"),
     ("--fs and t disagree", "identify rec.csv --model pi --fs 100 -o {out}.json", r"says 200 Hz .* 100 Hz"),
-    ("operators too many", "identify rec.csv --model pi --operators 5000 -o {out}.json", r"between 1 and 1000"),
+    ("operators too many", "identify rec.csv --model pi --operators 5000 -o {out}.json", r"between 1 and 256"),
     ("operators not a number", "identify rec.csv --model pi --operators abc -o {out}.json", r"'abc' is not a valid integer"),
     ("holdout NaN", "identify rec.csv --model pi --holdout nan -o {out}.json", r"between 0 and 1"),
     ("transient inf", "identify rec.csv --model pi --transient inf -o {out}.json", r"finite number"),
