@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import gc
 import time
@@ -52,48 +53,55 @@ def compare(out_dir: Path, seed: int, periods: int | None, quick: bool) -> None:
     from hystcomp.experiment.report import format_table, prepare_output_dir, write_outputs
 
     start = time.perf_counter()
-    _collect_garbage_less()
-    prepare_output_dir(out_dir)  # refuse a bad --out before the work
-    warmup.start()  # on a first run, the kernels needed later compile on the second core
-    changes: dict[str, Any] = (
-        {"seed": seed} if periods is None else {"seed": seed, "periods": periods}
-    )
-    config = CompareConfig.quick(**changes) if quick else CompareConfig(**changes)
-
-    def progress(line: str) -> None:
-        click.echo(f"hystcomp compare: {line}", err=True)
-
-    figures: dict[str, BackgroundJob | None] = {}
-
-    def draw_figures(table1) -> None:  # Table I measured: its figures, beside the rest
-        figures["paper"] = draw_in_background(
-            functools.partial(write_figures, names=BACKGROUND_FIGURES), table1
+    with _collecting_garbage_less():  # after the imports: they stay frozen
+        prepare_output_dir(out_dir)  # refuse a bad --out before the work
+        warmup.start()  # on a first run, the kernels needed later compile on the second core
+        changes: dict[str, Any] = (
+            {"seed": seed} if periods is None else {"seed": seed, "periods": periods}
         )
+        config = CompareConfig.quick(**changes) if quick else CompareConfig(**changes)
 
-    try:
-        comparison = run_comparison(config, progress=progress, table1=draw_figures)
-        progress(f"writing tables, figures and report into {out_dir}")
-        files = write_outputs(comparison, out_dir, figures=figures.get("paper"))
-    finally:  # collected by write_outputs, unless the run failed: then ended here
-        job = figures.get("paper")
-        if job is not None:
-            job.cancel()
-    click.echo(format_table(comparison))
-    seconds = time.perf_counter() - start
-    progress(f"done in {seconds:.1f} s; wrote {len(files)} files into {out_dir}")
+        def progress(line: str) -> None:
+            click.echo(f"hystcomp compare: {line}", err=True)
+
+        figures: dict[str, BackgroundJob | None] = {}
+
+        def draw_figures(table1) -> None:  # Table I measured: its figures, beside the rest
+            figures["paper"] = draw_in_background(
+                functools.partial(write_figures, names=BACKGROUND_FIGURES), table1
+            )
+
+        try:
+            comparison = run_comparison(config, progress=progress, table1=draw_figures)
+            progress(f"writing tables, figures and report into {out_dir}")
+            files = write_outputs(comparison, out_dir, figures=figures.get("paper"))
+        finally:  # collected by write_outputs, unless the run failed: then ended here
+            job = figures.get("paper")
+            if job is not None:
+                job.cancel()
+        click.echo(format_table(comparison))
+        seconds = time.perf_counter() - start
+        progress(f"done in {seconds:.1f} s; wrote {len(files)} files into {out_dir}")
 
 
-def _collect_garbage_less() -> None:
+@contextlib.contextmanager
+def _collecting_garbage_less():
     """Keep Python's cycle collector off the objects that live for the whole command.
 
     The imports above leave about a million objects (numba's, matplotlib's, SciPy's), and
     the experiment and its figures allocate many small objects that mostly live until the
     end. With the default thresholds the collector scans them again and again: it took
-    0.3-0.7 s of a 4 s run. :func:`gc.freeze` sets the imported objects aside for good
+    0.3-0.7 s of a 4 s run. :func:`gc.freeze` sets the imported objects aside meanwhile
     (the forked figure process then also leaves their memory pages shared), and a first
     generation of 200,000 objects instead of 700 collects rarely, as mypy's command line
-    does. The command's garbage is bounded (one experiment, eight figures), and the
-    process ends when the command does.
+    does. The command's garbage is bounded (one experiment, six figures). The collector is
+    as it was again when the command returns (it may run inside another program).
     """
+    thresholds = gc.get_threshold()
     gc.freeze()
     gc.set_threshold(200_000, 30, 30)
+    try:
+        yield
+    finally:
+        gc.set_threshold(*thresholds)
+        gc.unfreeze()
