@@ -64,6 +64,7 @@ CASES = [
     ("widened voltage range", "compensate model.json ref.csv --voltage-range 0 150 -o {out}.csv", r"may only narrow the model's voltage range 0 \.\. 120 V"),
     ("excite: bad sample rate", "excite pi --fs -5 -o {out}.csv", r"'--fs': must be a number > 0"),
     ("dynamics as the model", "simulate dyn.json rec.csv -o {out}.csv", r"'dyn\.json' holds linear dynamics, not a hysteresis model; simulate runs"),
+    ("export-c negative slew rate", "export-c model.json -o {out}_c --slew-rate -1", r"'--slew-rate': must be a number > 0 \(V/s\)"),
     ("file name too long", "excite mpi -o %s.csv" % ("a" * 300), r"cannot use 'a+': File name too long\. Check the path"),
 ]  # fmt: skip
 

@@ -10,7 +10,7 @@ import click
 from hystcomp import paper
 from hystcomp.cli import main
 from hystcomp.cli._dynamics import load_dynamics, refuse_dynamics_as_model
-from hystcomp.cli._options import method_option, method_options
+from hystcomp.cli._options import method_option, method_options, positive
 from hystcomp.codegen import DEFAULT_PREFIX, check_prefix, export_c
 from hystcomp.io.atomic import check_output_path
 from hystcomp.io.models import load_model
@@ -48,6 +48,7 @@ def _rate(ctx, param, value):
     type=float,
     default=None,
     metavar="V_PER_S",
+    callback=positive("V/s"),
     help="Largest output slew rate in V/s, baked into the code (none by default).",
 )
 @click.option(
