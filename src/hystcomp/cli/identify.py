@@ -54,6 +54,11 @@ def _check_options(kind: str, given: dict) -> None:
         raise click.UsageError("--degree applies to --everett polynomial; a table has --grid.")
     if given["grid"] is not None and given["everett"] == "polynomial":
         raise click.UsageError("--grid applies to --everett table.")
+    if given["grid"] is not None and given["degree"] is not None:
+        raise click.UsageError(
+            "--grid and --degree exclude each other: --degree fits the polynomial of eq. 5, "
+            "--grid a table; give one of them."
+        )
 
 
 def _regularization(ctx, param, value):
