@@ -66,6 +66,8 @@ CASES = [
     ("dynamics as the model", "simulate dyn.json rec.csv -o {out}.csv", r"'dyn\.json' holds linear dynamics, not a hysteresis model; simulate runs"),
     ("export-c negative slew rate", "export-c model.json -o {out}_c --slew-rate -1", r"'--slew-rate': must be a number > 0 \(V/s\)"),
     ("degree with grid", "identify rec.csv --model preisach --degree 3 --grid 10 -o {out}.json", r"--grid and --degree exclude each other"),
+    ("empty output name", "identify rec.csv --model pi -o ''", r"its path is empty\. Give a file name"),
+    ("output folder is a file", "identify rec.csv --model pi -o rec.csv/{out}.json", r"the folder 'rec\.csv' is a file, not a folder"),
     ("file name too long", "excite mpi -o %s.csv" % ("a" * 300), r"cannot use 'a+': File name too long\. Check the path"),
 ]  # fmt: skip
 

@@ -46,6 +46,8 @@ def check_output_path(path: str | os.PathLike, *, inputs=(), what: str = "output
         (replacing one would break what uses it), or ``path`` is one of ``inputs``. A
         symbolic link is checked as the file it names (see :func:`write_target`).
     """
+    if isinstance(path, str) and not path:
+        raise OutputPathError(f"Cannot write the {what}: its path is empty. Give a file name.")
     path = as_path(path, "path", "check_output_path")
     if path.is_dir():
         raise OutputPathError(
@@ -59,9 +61,10 @@ def check_output_path(path: str | os.PathLike, *, inputs=(), what: str = "output
             "a regular file, and replacing it would break whatever uses it. Choose a file."
         )
     if not target.parent.is_dir():
+        why = "is a file, not a folder" if target.parent.exists() else "does not exist"
         raise OutputPathError(
-            f"Cannot write the {what} {str(path)!r}: the folder {str(target.parent)!r} does "
-            "not exist. Create it first or choose another output path."
+            f"Cannot write the {what} {str(path)!r}: the folder {str(target.parent)!r} {why}. "
+            "Create the folder first or choose another output path."
         )
     for source in inputs:
         if source is not None and _same_file(path, as_path(source, "inputs", "check_output_path")):
