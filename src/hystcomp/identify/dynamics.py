@@ -105,9 +105,10 @@ def dynamics_excitation(
     bias = lo + BIAS_FRACTION * (hi - lo)
     if amplitude > 0.25 * (hi - lo):
         raise InvalidParameterError(
-            f"The 'amplitude' parameter of {owner} must be small against the range "
-            f"({0.25 * (hi - lo):g} V at most): the dynamics are identified in small signal. "
-            f"Got {amplitude:g} V."
+            f"The 'amplitude' parameter of {owner} must be small against the voltage range "
+            f"{lo:g} .. {hi:g} V ({0.25 * (hi - lo):g} V at most): the dynamics are identified "
+            f"in small signal. Got {amplitude:g} V; use a wider voltage range (--voltage-range) "
+            "or a smaller amplitude."
         )
     n_period = round(PERIOD * fs)
     lines = multisine_lines(fs)
