@@ -63,7 +63,7 @@ class Compensator(PackedSystem):
     _input_name = "x_ref"
 
     def __init__(self, packed: np.ndarray, *, kind: str, voltage_range: tuple[float, float]):
-        packed = check_packed_chain(packed, "Compensator")
+        packed = check_packed_chain(packed, "Compensator").copy()  # its own, read-only
         if kind not in KINDS:
             raise InvalidParameterError(
                 f"The 'kind' parameter of Compensator must be one of {KINDS}. Got {kind!r}."

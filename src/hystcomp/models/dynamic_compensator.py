@@ -17,7 +17,7 @@ from hystcomp._kernels import dynamics as dk
 from hystcomp._kernels._jit import step_function
 from hystcomp._validation import as_signal, check_int
 from hystcomp.errors import InvalidSignalError
-from hystcomp.models.system import block, checked_step
+from hystcomp.models.system import Rebound, block, checked_step
 
 #: Frequency (Hz) at which a hysteresis compensator and the inverse of the dynamics are
 #: matched in :func:`with_dynamics`: that of the paper's identification signals.
@@ -144,7 +144,7 @@ class DynamicsInverse:
         return f"DynamicsInverse({self.taps.size} taps, preview={self.preview} samples)"
 
 
-class DynamicsInverseStepper:
+class DynamicsInverseStepper(Rebound):
     """The inverse filter one sample at a time (same kernel as the batch run)."""
 
     def __init__(self, packed: np.ndarray, preview: int):
@@ -156,13 +156,6 @@ class DynamicsInverseStepper:
     def _bind(self) -> None:
         # bound fast path, with the stepper's check of the sample's type
         self.step = checked_step(step_function(dk.inverse_step), self._p)  # type: ignore[method-assign]
-
-    def __getstate__(self) -> dict:
-        return {k: v for k, v in self.__dict__.items() if k != "step"}  # bound again
-
-    def __setstate__(self, state: dict) -> None:
-        self.__dict__.update(state)
-        self._bind()
 
     def step(self, x_ref: float) -> float:
         """One reference sample (µm, ``preview`` samples ahead) -> filter output; NaN held out."""
@@ -253,7 +246,7 @@ class DynamicCompensator:
         return f"DynamicCompensator({self.hysteresis!r}, {self.dynamics_inverse!r})"
 
 
-class DynamicStepper:
+class DynamicStepper(Rebound):
     """The stepper of a :class:`DynamicCompensator`: the inverse filter, then the hysteresis.
 
     A non-finite reference leaves the filter as it was and holds the last voltage.
@@ -267,13 +260,6 @@ class DynamicStepper:
     def _bind(self) -> None:
         dyn_step, hyst_step = self._dyn.step, self._hyst.step
         self.step = lambda x_ref: hyst_step(dyn_step(x_ref))  # type: ignore[method-assign]
-
-    def __getstate__(self) -> dict:
-        return {"_dyn": self._dyn, "_hyst": self._hyst}  # the step is bound again
-
-    def __setstate__(self, state: dict) -> None:
-        self.__dict__.update(state)
-        self._bind()
 
     def step(self, x_ref: float) -> float:
         """One reference sample (µm, :attr:`preview` ahead) -> the voltage to apply now (V)."""

@@ -48,7 +48,7 @@ def check_packed_chain(packed, owner: str) -> np.ndarray:
     """
     fix = "build it with model.inverse() (or take the .packed of one)"
     try:
-        p = np.array(packed, dtype=np.float64)
+        p = np.asarray(packed, dtype=np.float64)
     except (TypeError, ValueError):
         raise InvalidTypeError(
             f"The 'packed' parameter of {owner} must be a packed chain, an array of floats. "
@@ -123,7 +123,28 @@ def checked_step(kernel, p):
     return step
 
 
-class Stepper:
+class Rebound(ABC):
+    """Steppers whose fast ``step`` is a closure over their state, bound by ``_bind``.
+
+    A pickled or deep-copied stepper must step its own state, not the original's: the
+    names in ``_bound`` are left out of the pickled state and bound again on unpickling.
+    """
+
+    _bound: ClassVar[tuple[str, ...]] = ("step",)
+
+    @abstractmethod
+    def _bind(self) -> None:
+        """Bind the fast ``step`` (and whatever else ``_bound`` names) to the state."""
+
+    def __getstate__(self) -> dict:
+        return {k: v for k, v in self.__dict__.items() if k not in self._bound}
+
+    def __setstate__(self, state: dict) -> None:
+        self.__dict__.update(state)
+        self._bind()
+
+
+class Stepper(Rebound):
     """Streaming evaluation, one sample per call, bit for bit equal to the batch run.
 
     A non-finite input sample holds the last output (the amplifier keeps its voltage) and
@@ -147,6 +168,7 @@ class Stepper:
     """
 
     kernels = chain.CHAIN_KERNELS
+    _bound = ("step", "_run", "_kernel")  # _kernel: the twin's stepper binds one too
 
     def __init__(self, packed: np.ndarray):
         packed = self._checked(packed)
@@ -167,15 +189,6 @@ class Stepper:
         self.step = checked_step(  # type: ignore[method-assign]
             step_function(self.kernels.step), self._p
         )
-
-    def __getstate__(self) -> dict:
-        # the bound step is a closure over the state: bound again on unpickling, so that
-        # a pickled or deep-copied stepper steps its own state
-        return {k: v for k, v in self.__dict__.items() if k not in ("step", "_run", "_kernel")}
-
-    def __setstate__(self, state: dict) -> None:
-        self.__dict__.update(state)
-        self._bind()
 
     def step(self, u: float) -> float:
         """Advance one sample and return the output.
