@@ -3,16 +3,14 @@
 from __future__ import annotations
 
 import numpy as np
-from matplotlib.backends.backend_agg import FigureCanvasAgg
-from matplotlib.figure import Figure
 
 from hystcomp.experiment._layout import (
-    PNG_OPTIONS,
     TITLE_Y,
     envelope,
     fixed_layout,
     new_figure,
     pixel_columns,
+    save_figure,
 )
 
 
@@ -24,8 +22,7 @@ def plot_bode(model, path, *, measured=None) -> None:
     """
     f = np.geomspace(1.0, 0.45 * model.sample_rate_, 600)
     d = model.frequency_response(f)
-    fig = Figure(figsize=(6.4, 5.2))
-    FigureCanvasAgg(fig)
+    fig = new_figure((6.4, 5.2))
     mag, phase = fig.subplots(2, 1, sharex=True)
     mag.semilogx(f, 20 * np.log10(np.abs(d)), label="model D (unit steady-state gain)")
     phase.semilogx(f, np.degrees(np.unwrap(np.angle(d))))
@@ -44,7 +41,7 @@ def plot_bode(model, path, *, measured=None) -> None:
     phase.grid(True, which="both", alpha=0.3)
     mag.legend(loc="lower left")
     fig.tight_layout()
-    fig.savefig(path)
+    save_figure(fig, path, dpi=fig.dpi)
 
 
 def plot_step(t, x_ref, runs: dict, path) -> None:
@@ -77,4 +74,4 @@ def plot_step(t, x_ref, runs: dict, path) -> None:
     slow.set_title("creep: 10 ms to the end", y=TITLE_Y)
     slow.legend()
     fig.suptitle("Step and hold on the simulated axis with creep")
-    fig.savefig(path, pil_kwargs=PNG_OPTIONS)
+    save_figure(fig, path, dpi=fig.dpi)

@@ -6,12 +6,9 @@ import os
 from pathlib import Path
 
 import numpy as np
-from matplotlib.backends.backend_agg import FigureCanvasAgg
-from matplotlib.figure import Figure
 
 from hystcomp.errors import InvalidParameterError
-from hystcomp.experiment._layout import PNG_OPTIONS, TITLE_Y, _thin, fixed_layout
-from hystcomp.io.atomic import atomic_path
+from hystcomp.experiment._layout import TITLE_Y, _thin, fixed_layout, new_figure, save_figure
 
 FORMATS = (".png", ".pdf", ".svg")
 
@@ -43,8 +40,7 @@ def plot_identification(v, x, before, after, path, *, model_name: str = "model")
             f"Cannot save a figure as {str(path)!r}: use a name ending in {', '.join(FORMATS)}."
         )
     v, x = np.asarray(v, dtype=np.float64), np.asarray(x, dtype=np.float64)
-    fig = Figure(figsize=(10.0, 4.2))
-    FigureCanvasAgg(fig)
+    fig = new_figure((10.0, 4.2))
     fixed_layout(fig, left=0.75, right=0.15, top=0.4, bottom=0.6, wgap=0.3, cols=2)
     axes = fig.subplots(1, 2, sharey=True)
     panels = [
@@ -63,8 +59,4 @@ def plot_identification(v, x, before, after, path, *, model_name: str = "model")
         ax.grid(alpha=0.3)
         ax.legend(loc="upper left")
     axes[0].set_ylabel("displacement x (µm)")
-    with atomic_path(path) as tmp:
-        if suffix == ".png":
-            fig.savefig(tmp, format="png", dpi=150, pil_kwargs=PNG_OPTIONS)
-        else:
-            fig.savefig(tmp, format=suffix[1:], dpi=150)
+    save_figure(fig, path, dpi=150)

@@ -4,14 +4,10 @@ from __future__ import annotations
 
 import os
 
-from matplotlib.backends.backend_agg import FigureCanvasAgg
-from matplotlib.figure import Figure
-
 from hystcomp._validation import as_signal, check_real
 from hystcomp.errors import InvalidParameterError, InvalidSignalError
-from hystcomp.experiment._layout import PNG_OPTIONS, TITLE_Y, fixed_layout
+from hystcomp.experiment._layout import TITLE_Y, fixed_layout, new_figure, save_figure
 from hystcomp.identify.excitation import scaled_amplitudes, sinusoid_sequence
-from hystcomp.io.atomic import atomic_path
 from hystcomp.paper import FIG5_AMPLITUDES
 
 
@@ -55,8 +51,7 @@ def plot_preisach_loops(
     x = model.simulate(v)
     per_period = round(sample_rate / frequency)
 
-    fig = Figure(figsize=(6.4, 4.8))
-    FigureCanvasAgg(fig)
+    fig = new_figure((6.4, 4.8))
     fixed_layout(fig, left=0.75, right=0.15, top=0.4, bottom=0.6)
     ax = fig.add_subplot()
     if measured is not None:
@@ -79,5 +74,4 @@ def plot_preisach_loops(
     ax.set_title(f"Preisach model, {frequency:g} Hz sinusoids of growing amplitude", y=TITLE_Y)
     ax.grid(True, alpha=0.3)
     ax.legend(loc="upper left")
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, format="png", dpi=120, pil_kwargs=PNG_OPTIONS)
+    save_figure(fig, path, dpi=120)

@@ -14,21 +14,19 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from matplotlib.figure import Figure
 
 from hystcomp.experiment._layout import (
-    PNG_OPTIONS,
     TITLE_Y,
     _thin,
     envelope,
     fixed_layout,
     new_figure,
     pixel_columns,
+    save_figure,
 )
 from hystcomp.experiment.fig_identification import plot_identification
 from hystcomp.experiment.fig_preisach import plot_preisach_loops
 from hystcomp.experiment.metrics import SATURATION_ZONE
-from hystcomp.io.atomic import atomic_path
 from hystcomp.paper import LABELS, METHODS
 
 COLOURS = {"uncompensated": "0.45", "preisach": "tab:green", "pi": "tab:blue", "mpi": "tab:red"}
@@ -36,11 +34,6 @@ COLOURS = {"uncompensated": "0.45", "preisach": "tab:green", "pi": "tab:blue", "
 
 #: Resolution of the saved figures (dots per inch).
 DPI = 130
-
-
-def _save(fig: Figure, path: Path) -> None:
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, format="png", dpi=DPI, pil_kwargs=PNG_OPTIONS)
 
 
 def figure_9(results: dict, path: Path) -> None:
@@ -81,7 +74,7 @@ def figure_9(results: dict, path: Path) -> None:
     frequency = next(iter(results.values())).frequency
     ax.set_title(f"Hysteresis compensation, {frequency:g} Hz triangle (twin)", y=TITLE_Y)
     ax.legend(loc="upper left", fontsize=8)
-    _save(fig, path)
+    save_figure(fig, path, dpi=DPI)
 
 
 def figure_10(results: dict, path: Path) -> None:
@@ -117,7 +110,7 @@ def figure_10(results: dict, path: Path) -> None:
             ax.grid(alpha=0.3)
     handles, labels = axes[0, 0].get_legend_handles_labels()
     fig.legend(handles, labels, loc="upper center", ncols=len(labels), frameon=False)
-    _save(fig, path)
+    save_figure(fig, path, dpi=DPI)
 
 
 def _fig9(comparison, path: Path) -> None:
