@@ -95,13 +95,15 @@ def _collecting_garbage_less():
     (the forked figure process then also leaves their memory pages shared), and a first
     generation of 200,000 objects instead of 700 collects rarely, as mypy's command line
     does. The command's garbage is bounded (one experiment, six figures). The collector is
-    as it was again when the command returns (it may run inside another program).
+    as it was again when the command returns (it may run inside another program), its
+    thresholds restored and every object in its oldest generation.
     """
     thresholds = gc.get_threshold()
     gc.freeze()
     gc.set_threshold(200_000, 30, 30)
     try:
         yield
-    finally:
+    finally:  # the command's objects join the oldest generation unscanned, as if frozen
+        gc.freeze()  # too: a young generation of 200,000 objects costs 50 ms to scan
         gc.set_threshold(*thresholds)
         gc.unfreeze()
