@@ -29,21 +29,32 @@ def resonance_zoh(resonance_hz: float, damping_ratio: float, sample_rate: float)
     >>> round(float(sum(b) / sum(a)), 12)
     1.0
     """
+    ad, bd = zoh_matrices(resonance_hz, damping_ratio, sample_rate)
+    b = np.array([bd[0], ad[0, 1] * bd[1] - ad[1, 1] * bd[0]])
+    a = np.array([1.0, -np.trace(ad), np.linalg.det(ad)])
+    return b, a
+
+
+def zoh_matrices(resonance_hz: float, damping_ratio: float, sample_rate: float):
+    """``(Ad, Bd)`` of the exact zero-order-hold discretisation of the resonance.
+
+    The states are position (µm) and velocity (µm/s) of ``x'' = -wn^2 x - 2 zeta wn x' +
+    wn^2 u``; the position is the output and the steady-state gain is 1. ``Ad = exp(M Ts)``
+    of the 2x2 matrix ``M`` in closed form, ``e^(s Ts) (cosh(q Ts) I + sinh(q Ts)/q (M -
+    s I))`` with ``s = -zeta wn`` and ``q = sqrt(s^2 - wn^2)`` (complex below critical
+    damping, 0 at it), and ``Bd = M^-1 (Ad - I) (0, wn^2)``.
+    """
     wn = 2.0 * math.pi * resonance_hz
     ts = 1.0 / sample_rate
     m = np.array([[0.0, 1.0], [-(wn**2), -2.0 * damping_ratio * wn]])
-    # exp(M Ts) of a 2x2 matrix in closed form: e^(s Ts) (cosh(q Ts) I + sinh(q Ts)/q (M - s I))
     shift = -damping_ratio * wn
     q = cmath.sqrt(shift**2 - wn**2)
     sinhc = ts if abs(q * ts) < 1e-12 else cmath.sinh(q * ts) / q
     ad = np.real(
         math.exp(shift * ts) * (cmath.cosh(q * ts) * np.eye(2) + sinhc * (m - shift * np.eye(2)))
     )
-    # Bd = M^-1 (Ad - I) B with B = (0, wn^2)
     bd = np.linalg.solve(m, (ad - np.eye(2)) @ np.array([0.0, wn**2]))
-    b = np.array([bd[0], ad[0, 1] * bd[1] - ad[1, 1] * bd[0]])
-    a = np.array([1.0, -np.trace(ad), np.linalg.det(ad)])
-    return b, a
+    return ad, bd
 
 
 def creep_response(lags, weights, z1) -> np.ndarray:

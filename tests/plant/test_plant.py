@@ -204,3 +204,21 @@ def test_calibration_fit_reproduces_the_defaults():
         assert value == pytest.approx(default[name], rel=0.01)
     v = triangle_sequence(sample_rate=2000.0)[1]
     np.testing.assert_allclose(refit.hysteresis(v), Twin().hysteresis(v), atol=0.02)
+
+
+@pytest.mark.parametrize("damping", [0.001, 0.1, 0.7, 1.0, 1.0 + 1e-9, 3.0])
+@pytest.mark.parametrize(
+    ("resonance", "rate"), [(630.0, 20_000.0), (50.0, 100_000.0), (4000.0, 10_000.0)]
+)
+def test_dynamics_matrices_are_the_exact_zero_order_hold(damping, resonance, rate):
+    from scipy.linalg import expm
+
+    from hystcomp.plant.parameters import TwinParameters, dynamics_matrices
+
+    params = TwinParameters(resonance_hz=resonance, damping_ratio=damping, sample_rate=rate)
+    wn = 2.0 * np.pi * resonance
+    augmented = np.array([[0.0, 1.0, 0.0], [-(wn**2), -2.0 * damping * wn, wn**2], [0, 0, 0]])
+    exact = expm(augmented / rate)
+    ad, bd = dynamics_matrices(params)
+    np.testing.assert_allclose(ad, exact[:2, :2], rtol=1e-12, atol=1e-12 * np.abs(exact).max())
+    np.testing.assert_allclose(bd, exact[:2, 2], rtol=1e-12, atol=1e-12 * np.abs(exact).max())

@@ -8,6 +8,7 @@ from __future__ import annotations
 import math
 import os
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
@@ -113,13 +114,13 @@ def save_figure(fig: Figure, path: str | os.PathLike, *, dpi: float) -> None:
                 axis.set_major_locator(MaxNLocator(nbins=MAJOR_TICKS, steps=[1, 2, 2.5, 5, 10]))
     path = Path(os.fspath(path))
     kind = path.suffix.lower().lstrip(".") or "png"
-    options = {"pil_kwargs": PNG_OPTIONS} if kind == "png" else {}
+    options: dict[str, Any] = {"pil_kwargs": PNG_OPTIONS} if kind == "png" else {}
     with atomic_path(path) as tmp:
         fig.savefig(tmp, format=kind, dpi=dpi, **options)
 
 
 def _every_axes(fig: Figure):
-    stack = list(fig.axes)
+    stack: list[Any] = list(fig.axes)
     while stack:
         ax = stack.pop()
         stack.extend(ax.child_axes)
