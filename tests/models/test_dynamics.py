@@ -112,6 +112,31 @@ def test_inverse_is_stable_for_any_resonance_and_creep():
         assert np.abs(y).max() < 1e3
 
 
+@pytest.mark.parametrize("kept_as", ["deepcopy", "pickle"])
+def test_the_inverse_is_designed_once_per_resonance_and_band(kept_as, monkeypatch):
+    import copy
+    import pickle
+
+    from hystcomp.models import dynamics as dynamics_module
+
+    dyn = _stage()
+    first = dyn.inverse()
+    kept = copy.deepcopy(dyn) if kept_as == "deepcopy" else pickle.loads(pickle.dumps(dyn))
+    designs = []
+    original = dynamics_module.inverse_fir
+    monkeypatch.setattr(
+        dynamics_module, "inverse_fir", lambda *a: designs.append(a) or original(*a)
+    )
+    np.testing.assert_array_equal(kept.inverse().taps, first.taps)  # kept, not designed again
+    assert designs == []
+    kept.inverse(bandwidth_hz=500.0)  # another band: designed
+    kept.resonance_hz_ = 700.0  # another resonance: designed, never the old design
+    moved = kept.inverse()
+    assert len(designs) == 2
+    np.testing.assert_array_equal(moved.taps, _stage(resonance_hz=700.0).inverse().taps)
+    assert dyn.inverse().taps is not first.taps  # each inverse owns its taps
+
+
 def test_inverse_of_a_step_rises_monotonically_and_never_amplifies():
     rng = np.random.default_rng(5)
     for _ in range(20):

@@ -46,42 +46,54 @@ def compare(out_dir: Path, seed: int, periods: int | None, quick: bool) -> None:
     from hystcomp.experiment import warmup
     from hystcomp.experiment.background import BackgroundJob, draw_in_background
     from hystcomp.experiment.compare import CompareConfig, run_comparison
-    from hystcomp.experiment.figures import (  # matplotlib, for a forked process
-        BACKGROUND_FIGURES,
-        write_figures,
-    )
-    from hystcomp.experiment.report import format_table, prepare_output_dir, write_outputs
+    from hystcomp.experiment.compare_dynamics import designed_twin_dynamics
 
     start = time.perf_counter()
-    with _collecting_garbage_less():  # after the imports: they stay frozen
-        prepare_output_dir(out_dir)  # refuse a bad --out before the work
-        warmup.start()  # on a first run, the kernels needed later compile on the second core
-        changes: dict[str, Any] = (
-            {"seed": seed} if periods is None else {"seed": seed, "periods": periods}
+    changes: dict[str, Any] = (
+        {"seed": seed} if periods is None else {"seed": seed, "periods": periods}
+    )
+    config = CompareConfig.quick(**changes) if quick else CompareConfig(**changes)
+    jobs: dict[str, BackgroundJob | None] = {}
+    try:
+        # On a first run, the kernels needed later compile on the second core. Otherwise
+        # that core identifies the twin's dynamics (SciPy's optimize, 0.3 s to import, and
+        # the fits) from the start: before matplotlib's import here, far ahead of their use.
+        if warmup.start() is None:
+            warmup.load_shared(config.twin)
+            jobs["dynamics"] = BackgroundJob.start(designed_twin_dynamics, config.twin, seed)
+        from hystcomp.experiment.figures import (  # matplotlib, for a forked process
+            BACKGROUND_FIGURES,
+            write_figures,
         )
-        config = CompareConfig.quick(**changes) if quick else CompareConfig(**changes)
+        from hystcomp.experiment.report import format_table, prepare_output_dir, write_outputs
 
-        def progress(line: str) -> None:
-            click.echo(f"hystcomp compare: {line}", err=True)
+        with _collecting_garbage_less():  # after the imports: they stay frozen
+            prepare_output_dir(out_dir)  # refuse a bad --out before the work
 
-        figures: dict[str, BackgroundJob | None] = {}
+            def progress(line: str) -> None:
+                click.echo(f"hystcomp compare: {line}", err=True)
 
-        def draw_figures(table1) -> None:  # Table I measured: its figures, beside the rest
-            figures["paper"] = draw_in_background(
-                functools.partial(write_figures, names=BACKGROUND_FIGURES), table1
+            def draw_figures(table1) -> None:  # Table I measured: its figures, beside the rest
+                jobs["figures"] = draw_in_background(
+                    functools.partial(write_figures, names=BACKGROUND_FIGURES), table1
+                )
+
+            identified = jobs.get("dynamics")
+            comparison = run_comparison(
+                config,
+                progress=progress,
+                table1=draw_figures,
+                twin_dynamics=None if identified is None else identified.collect,
             )
-
-        try:
-            comparison = run_comparison(config, progress=progress, table1=draw_figures)
             progress(f"writing tables, figures and report into {out_dir}")
-            files = write_outputs(comparison, out_dir, figures=figures.get("paper"))
-        finally:  # collected by write_outputs, unless the run failed: then ended here
-            job = figures.get("paper")
+            files = write_outputs(comparison, out_dir, figures=jobs.get("figures"))
+            click.echo(format_table(comparison))
+            seconds = time.perf_counter() - start
+            progress(f"done in {seconds:.1f} s; wrote {len(files)} files into {out_dir}")
+    finally:  # collected by now, unless the run failed: then ended here
+        for job in jobs.values():
             if job is not None:
                 job.cancel()
-        click.echo(format_table(comparison))
-        seconds = time.perf_counter() - start
-        progress(f"done in {seconds:.1f} s; wrote {len(files)} files into {out_dir}")
 
 
 @contextlib.contextmanager

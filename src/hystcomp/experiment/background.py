@@ -1,7 +1,9 @@
 """Work done in a second, forked process while ``hystcomp compare`` goes on.
 
-:class:`BackgroundJob` computes a function there and hands its result back. The paper's
-figures are drawn that way (:func:`draw_in_background`): :func:`hystcomp.experiment.compare.
+:class:`BackgroundJob` computes a function there and hands its result back. The twin's
+linear dynamics are identified that way from the start, with the design of their inverse
+(:func:`~hystcomp.experiment.compare_dynamics.designed_twin_dynamics`: the work that needs
+SciPy's optimisers, whose import alone takes 0.3 s). The paper's figures are drawn that way (:func:`draw_in_background`): :func:`hystcomp.experiment.compare.
 run_comparison` hands Table I over as soon as it is measured, and the forked process draws
 :data:`~hystcomp.experiment.figures.BACKGROUND_FIGURES` while the calling process goes on
 with the dynamics part and then draws the others (about as much drawing each);

@@ -203,6 +203,7 @@ def run_comparison(
     identify: Callable[[Record, Record, CompareConfig], dict] | None = None,
     progress: Callable[[str], None] | None = None,
     table1: Callable[[Comparison], None] | None = None,
+    twin_dynamics: Callable[[], tuple | None] | None = None,
 ) -> Comparison:
     """Run the paper's experiment on the twin.
 
@@ -219,6 +220,10 @@ def run_comparison(
         Called with the comparison as far as Table I (records, models, ``results``,
         ``datasheet``, ``preisach_exact``; no ``dynamics`` or ``paper_fit`` yet) as soon
         as it is measured: ``hystcomp compare`` draws the paper's figures meanwhile.
+    twin_dynamics : callable, optional
+        Returns what :func:`~hystcomp.experiment.compare_dynamics.identify_twin_dynamics`
+        returns for ``config.twin`` and ``config.seed``, computed elsewhere (``hystcomp
+        compare``: in a second process, from the start), or None: then it is computed here.
 
     Returns
     -------
@@ -298,6 +303,7 @@ def run_comparison(
             periods=config.periods,
             frequencies=config.frequencies,
             seed=config.seed,
+            identified=None if twin_dynamics is None else twin_dynamics(),
         )
     paper_fit: dict[str, TrackingResult] = {}
     if identify is identify_models:

@@ -80,11 +80,26 @@ def identify_twin_dynamics(params: TwinParameters, seed: int) -> tuple[Record, L
     return record, dynamics
 
 
-def run_dynamics(twin, models, compensators, amplitude, *, periods, frequencies, seed=0):
+def designed_twin_dynamics(params: TwinParameters, seed: int) -> tuple[Record, LinearDynamics]:
+    """:func:`identify_twin_dynamics`, and the design of the inverse that the compensators
+    with dynamics use: all of the comparison's work that needs SciPy (a least-squares fit,
+    non-negative least squares), which ``hystcomp compare`` runs in a second process while
+    the first measures Table I. The design goes with the model (pickled)."""
+    record, dynamics = identify_twin_dynamics(params, seed)
+    dynamics.inverse()  # the band of with_dynamics (the default): designed and kept
+    return record, dynamics
+
+
+def run_dynamics(
+    twin, models, compensators, amplitude, *, periods, frequencies, seed=0, identified=None
+):
     """The dynamics part of the comparison (see the module); ``compensators`` by method,
-    ``seed`` that of the comparison (:func:`identify_twin_dynamics`)."""
+    ``seed`` that of the comparison (:func:`identify_twin_dynamics`); ``identified``, if
+    given, is what :func:`identify_twin_dynamics` returns for them, computed elsewhere."""
     fs = twin.sample_rate
-    record, dynamics = identify_twin_dynamics(twin.params, seed)
+    if identified is None:
+        identified = identify_twin_dynamics(twin.params, seed)
+    record, dynamics = identified
     with_dyn = {m: models[m].inverse(dynamics=dynamics) for m in WITH_DYNAMICS}
     results: dict[float, dict[str, TrackingResult]] = {}
     for f in (*frequencies, *FAST_FREQUENCIES):

@@ -149,7 +149,7 @@ FIGURES = {
 
 #: The figures ``hystcomp compare`` draws in a second process, while the first goes on with
 #: the dynamics part and then draws the others: about as much drawing each.
-BACKGROUND_FIGURES = ("fig10_tracking.png", "fig5_preisach.png", "fig8_pi.png", "fig8_mpi.png")
+BACKGROUND_FIGURES = ("fig10_tracking.png", "fig5_preisach.png", "fig8_pi.png")
 
 
 def write_figures(comparison, out_dir: Path, names=None) -> dict[str, str | None]:

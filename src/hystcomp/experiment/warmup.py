@@ -9,7 +9,10 @@ cache, the kernels the experiment needs later: the Everett function's, the play 
 (PI and MPI fits and their inverses) and the linear dynamics'
 (:func:`compile_later_kernels`). Meanwhile the first process compiles the twin's and the
 Preisach model's run, which it needs first; when it reaches the others, it loads them.
-Once the cache holds them, no second process is started.
+Once the cache holds them, no compiling process is started: on such a run the second core
+identifies the twin's linear dynamics instead, from the start
+(:func:`~hystcomp.experiment.compare_dynamics.designed_twin_dynamics`, after
+:func:`load_shared`).
 
 Nothing the experiment computes depends on which process compiled a kernel: the cache
 holds the same machine code.
@@ -28,6 +31,7 @@ import numpy as np
 
 from hystcomp._kernels import chain
 from hystcomp.experiment.background import FORK_WARNING, detach_output
+from hystcomp.plant.parameters import TwinParameters
 
 
 def compile_later_kernels() -> None:
@@ -59,6 +63,16 @@ def compile_later_kernels() -> None:
     _, u = dynamics_excitation(sample_rate=fs, voltage_range=twin.voltage_range)
     dynamics = LinearDynamics().fit(u, twin.run(u), fs)
     models[1].inverse(dynamics=dynamics).simulate(np.linspace(0.0, float(x.max()), 100))
+
+
+def load_shared(twin: TwinParameters) -> None:
+    """Load here what a process forked next would load again: numba's compiler context
+    (its start, 0.3 s, which imports SciPy's BLAS wrappers) and the twin's kernel, by
+    running the twin for one sample. ``hystcomp compare`` calls it before it forks the
+    process that identifies the twin's dynamics, which both need."""
+    from hystcomp.plant.twin import Twin
+
+    Twin(twin).run_noiseless([0.0])
 
 
 def start(job=compile_later_kernels):

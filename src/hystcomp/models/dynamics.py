@@ -269,7 +269,7 @@ class LinearDynamics:
                 f"({0.5 * fs:g} Hz). Got {bandwidth_hz:g}."
             )
         rest = check_real(rest, "rest", owner)
-        taps, preview = inverse_fir(self.resonance(), bandwidth_hz, fs)
+        taps, preview = self._inverse_fir(bandwidth_hz)
         match_hz = check_real(match_hz, "match_hz", owner)
         if not 0.0 <= match_hz < 0.5 * fs:
             raise InvalidParameterError(
@@ -293,6 +293,21 @@ class LinearDynamics:
             output_range=(low, high),
             bias=(1.0 - gain) * centre,
         )
+
+    def _inverse_fir(self, bandwidth_hz: float) -> tuple[np.ndarray, int]:
+        """:func:`inverse_fir` of this model's resonance, designed once per band.
+
+        The design (a non-negative least squares) depends only on the resonance, the
+        sample rate and the band, which key the designs kept; a copy or a pickled model
+        carries them (``hystcomp compare`` designs the inverse in the process that
+        identifies the dynamics, so that its own never imports SciPy).
+        """
+        key = (bandwidth_hz, self.sample_rate_, self.resonance_hz_, self.damping_ratio_)
+        designs = self.__dict__.setdefault("_fir_designs", {})
+        if key not in designs:
+            designs[key] = inverse_fir(self.resonance(), bandwidth_hz, self.sample_rate_)
+        taps, preview = designs[key]
+        return taps.copy(), preview
 
     # -- files -----------------------------------------------------------------------------
 
