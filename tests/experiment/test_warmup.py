@@ -36,20 +36,30 @@ def _python(code, cache):
 
 @pytest.mark.slow
 def test_compare_loads_every_kernel_the_warmup_compiled(tmp_path):
-    _python("from hystcomp.experiment.warmup import compile_later_kernels as f; f()", tmp_path)
+    _python(
+        "from hystcomp.experiment.warmup import prepare; from hystcomp.plant import creep_twin; "
+        "prepare(creep_twin(), 0, True)",
+        tmp_path,
+    )
     counts = json.loads(_python(_COMPARE, tmp_path).splitlines()[-1])
     assert {"everett_many", "chain_run", "regressor_rows", "inverse_run"} <= set(counts)
     missed = {name: c for name, c in counts.items() if c[1]}
     assert not missed  # compiled by compare itself: the warm-up called it differently
 
 
-def test_no_process_once_the_cache_holds_the_kernels(monkeypatch):
-    ran = []
+def test_the_job_compiles_first_only_on_a_first_run(monkeypatch):
+    from hystcomp.plant import creep_twin
+
+    started, loaded = [], []
+    monkeypatch.setattr(warmup.BackgroundJob, "start", lambda *args: started.append(args))
+    monkeypatch.setattr(warmup, "load_shared", loaded.append)
     presets.paper_mpi().simulate([0.0, 1.0])  # chain_run: compiled or loaded, now cached
     assert warmup._in_cache(chain.chain_run)
-    assert warmup.start(lambda: ran.append(1)) is None
+    twin = creep_twin()
+    warmup.start(twin, 7)
+    assert started == [(warmup.prepare, twin, 7, False)]
+    assert loaded == [twin]  # numba's context and the twin kernel, before the fork
     monkeypatch.setattr(warmup, "_in_cache", lambda kernel: False)
-    process = warmup.start(lambda: None)
-    assert process is not None
-    process.join(timeout=30)
-    assert process.exitcode == 0
+    warmup.start(twin, 7)
+    assert started[1] == (warmup.prepare, twin, 7, True)
+    assert loaded == [twin]

@@ -46,7 +46,6 @@ def compare(out_dir: Path, seed: int, periods: int | None, quick: bool) -> None:
     from hystcomp.experiment import warmup
     from hystcomp.experiment.background import BackgroundJob, draw_in_background
     from hystcomp.experiment.compare import CompareConfig, run_comparison
-    from hystcomp.experiment.compare_dynamics import designed_twin_dynamics
 
     start = time.perf_counter()
     changes: dict[str, Any] = (
@@ -55,12 +54,9 @@ def compare(out_dir: Path, seed: int, periods: int | None, quick: bool) -> None:
     config = CompareConfig.quick(**changes) if quick else CompareConfig(**changes)
     jobs: dict[str, BackgroundJob | None] = {}
     try:
-        # On a first run, the kernels needed later compile on the second core. Otherwise
-        # that core identifies the twin's dynamics (SciPy's optimize, 0.3 s to import, and
-        # the fits) from the start: before matplotlib's import here, far ahead of their use.
-        if warmup.start() is None:
-            warmup.load_shared(config.twin)
-            jobs["dynamics"] = BackgroundJob.start(designed_twin_dynamics, config.twin, seed)
+        # the second core: on a first run the kernels needed later, then on every run the
+        # twin's dynamics (SciPy's optimisers and the fits), before matplotlib's import here
+        jobs["dynamics"] = warmup.start(config.twin, seed)
         from hystcomp.experiment.figures import (  # matplotlib, for a forked process
             BACKGROUND_FIGURES,
             write_figures,

@@ -1,36 +1,34 @@
-"""Kernels compiled on the second core while ``hystcomp compare`` starts (a first run).
+"""The second core's work while ``hystcomp compare`` starts: kernels, then the dynamics.
 
 numba compiles a kernel at its first call and keeps the result in its on-disk cache; a
 later first call, in any process, loads it from there in milliseconds. On a first run
 (an empty cache) ``compare`` spends about 11 s of CPU compiling, one kernel after the
-other on one core, while the second core idles until the figures are drawn. So
-``hystcomp compare`` forks a process first (:func:`start`) that compiles, into the same
-cache, the kernels the experiment needs later: the Everett function's, the play chain's
-(PI and MPI fits and their inverses) and the linear dynamics'
-(:func:`compile_later_kernels`). Meanwhile the first process compiles the twin's and the
-Preisach model's run, which it needs first; when it reaches the others, it loads them.
-Once the cache holds them, no compiling process is started: on such a run the second core
-identifies the twin's linear dynamics instead, from the start
-(:func:`~hystcomp.experiment.compare_dynamics.designed_twin_dynamics`, after
-:func:`load_shared`).
+other, and on every run it imports SciPy's optimisers (0.3 s) for the twin's linear
+dynamics alone. So ``hystcomp compare`` forks one process first (:func:`start`) that
 
-Nothing the experiment computes depends on which process compiled a kernel: the cache
-holds the same machine code.
+1. on a first run, compiles into the same cache the kernels the experiment needs later:
+   the Everett function's, the play chain's (PI and MPI fits and their inverses)
+   (:func:`compile_later_kernels`). Meanwhile the first process compiles the twin's and
+   the Preisach model's run, which it needs first; when it reaches the others, it loads
+   them;
+2. on every run, identifies the twin's linear dynamics and designs their inverse
+   (:func:`~hystcomp.experiment.compare_dynamics.designed_twin_dynamics`), which the first
+   process takes when it reaches the dynamics part (:func:`prepare`); on a first run it
+   also compiles there the kernels of a compensator with dynamics.
+
+Nothing the experiment computes depends on which process compiled a kernel (the cache
+holds the same machine code) or identified the dynamics (the same computation, pickled).
 """
 
 from __future__ import annotations
 
-import contextlib
-import multiprocessing
-import signal
 import sys
-import warnings
 from pathlib import Path
 
 import numpy as np
 
 from hystcomp._kernels import chain
-from hystcomp.experiment.background import FORK_WARNING, detach_output
+from hystcomp.experiment.background import BackgroundJob
 from hystcomp.plant.parameters import TwinParameters
 
 
@@ -38,31 +36,38 @@ def compile_later_kernels() -> None:
     """Call the kernels that ``compare`` needs after the twin's, on small inputs.
 
     Through the public calls that ``compare`` makes (a PI and an MPI fit with their
-    defaults, their compensators, an MPI compensator with an inverse of the dynamics, the
-    twin), so that every kernel is compiled for the argument types it meets there.
+    defaults, their compensators), so that every kernel is compiled for the argument types
+    it meets there; those of the dynamics follow in :func:`prepare`.
     """
     from hystcomp import presets
-    from hystcomp.identify.dynamics import dynamics_excitation
     from hystcomp.identify.excitation import triangle_sequence
-    from hystcomp.models.dynamics import LinearDynamics
     from hystcomp.models.mpi import ModifiedPrandtlIshlinskii
     from hystcomp.models.pi import PrandtlIshlinskii
-    from hystcomp.plant.twin import Twin
 
     # first the Everett function's kernel, which the first process needs soon after the
-    # twin's (to fit the Preisach model), then the play chain's and the dynamics' kernels
+    # twin's (to fit the Preisach model), then the play chain's
     presets.paper_preisach().everett_function([1.0], [0.0])
     _, v = triangle_sequence(sample_rate=400.0)
     x = presets.paper_mpi().simulate(v)
-    models = [PrandtlIshlinskii(), ModifiedPrandtlIshlinskii()]
-    for model in models:
+    for model in (PrandtlIshlinskii(), ModifiedPrandtlIshlinskii()):
         model.fit(v, x).inverse().simulate(x)
-    # the twin last: the first process compiles it first, so that here it is loaded
-    twin = Twin(seed=0)
-    fs = twin.sample_rate
-    _, u = dynamics_excitation(sample_rate=fs, voltage_range=twin.voltage_range)
-    dynamics = LinearDynamics().fit(u, twin.run(u), fs)
-    models[1].inverse(dynamics=dynamics).simulate(np.linspace(0.0, float(x.max()), 100))
+
+
+def prepare(twin: TwinParameters, seed: int, compile_first: bool):
+    """The job of :func:`start`: :func:`compile_later_kernels` if ``compile_first``, then
+    :func:`~hystcomp.experiment.compare_dynamics.designed_twin_dynamics` (the twin's kernel
+    last: the first process compiles it first, so that here it is loaded) and, if
+    ``compile_first``, an MPI compensator with that inverse (the dynamics' kernels)."""
+    from hystcomp import presets
+    from hystcomp.experiment.compare_dynamics import designed_twin_dynamics
+
+    if compile_first:
+        compile_later_kernels()
+    identified = designed_twin_dynamics(twin, seed)
+    if compile_first:
+        model = presets.paper_mpi()
+        model.inverse(dynamics=identified[1]).simulate(np.linspace(0.0, 10.0, 100))
+    return identified
 
 
 def load_shared(twin: TwinParameters) -> None:
@@ -75,28 +80,20 @@ def load_shared(twin: TwinParameters) -> None:
     Twin(twin).run_noiseless([0.0])
 
 
-def start(job=compile_later_kernels):
-    """Fork a daemon process that runs ``job`` (and ends), or None if there is no need.
+def start(twin: TwinParameters, seed: int) -> BackgroundJob | None:
+    """Fork the process of :func:`prepare` for ``(twin, seed)``, or None where the platform
+    does not fork (Linux only, as :class:`~hystcomp.experiment.background.BackgroundJob`).
 
-    Nothing is started if the cache already holds the play chain's batch kernel (a run
-    after the first: loading the kernels would cost the second process as much as the
-    first, about 0.5 s of CPU for numba's start, on a core that the figures need), nor
-    where the platform does not fork (Linux only, as
-    :class:`~hystcomp.experiment.background.BackgroundJob`). The process is not
-    waited for: its only output is the kernel cache, and a kernel that it has not compiled
-    yet when this process needs it is compiled here as it would be without it.
+    Its result is what :func:`~hystcomp.experiment.compare_dynamics.identify_twin_dynamics`
+    returns. It compiles first only if the cache lacks the play chain's batch kernel (a
+    first run); otherwise this process first loads what both need (:func:`load_shared`).
     """
-    if not sys.platform.startswith("linux") or _in_cache(chain.chain_run):
+    if not sys.platform.startswith("linux"):
         return None
-    try:
-        context = multiprocessing.get_context("fork")
-        process = context.Process(target=_run, args=(job,), daemon=True, name="hystcomp-warmup")
-        with warnings.catch_warnings():
-            warnings.filterwarnings("ignore", FORK_WARNING, DeprecationWarning)
-            process.start()
-    except (OSError, ValueError):
-        return None
-    return process
+    compile_first = not _in_cache(chain.chain_run)
+    if not compile_first:
+        load_shared(twin)
+    return BackgroundJob.start(prepare, twin, seed, compile_first)
 
 
 def _in_cache(kernel) -> bool:
@@ -104,13 +101,3 @@ def _in_cache(kernel) -> bool:
     after it, as numba names them: ``<module>.<name>-<line>.py<version>.<n>.nbc``)."""
     folder = Path(kernel.stats.cache_path)
     return any(folder.glob(f"*.{kernel.py_func.__name__}-*.nbc"))
-
-
-def _run(job) -> None:
-    # Ctrl-C or SIGTERM end it at once and silently (not the caller's handlers, which it
-    # inherits): numba writes each cache file whole, under a temporary name first
-    signal.signal(signal.SIGINT, signal.SIG_DFL)
-    signal.signal(signal.SIGTERM, signal.SIG_DFL)
-    detach_output()  # it may outlive the caller: not with the caller's pipes
-    with contextlib.suppress(Exception):  # a failure here only costs the caller time
-        job()
