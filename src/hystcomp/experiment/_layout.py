@@ -13,7 +13,13 @@ from typing import Any
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
-from matplotlib.ticker import AutoLocator, LogLocator, MaxNLocator
+from matplotlib.ticker import (
+    AutoLocator,
+    FormatStrFormatter,
+    LogLocator,
+    MaxNLocator,
+    NullFormatter,
+)
 
 from hystcomp.io.atomic import atomic_path
 
@@ -103,13 +109,18 @@ def save_figure(fig: Figure, path: str | os.PathLike, *, dpi: float) -> None:
     """Save ``fig`` into ``path`` at ``dpi``, atomically, in the format of its suffix.
 
     Every axes of the figure, insets included, first gets at most :data:`MAJOR_TICKS`
-    major ticks per linear axis and minor ticks at :data:`LOG_MINOR_SUBS` on a log axis
-    (where the figure has not chosen its own). A PNG is written with :data:`PNG_OPTIONS`.
+    major ticks per linear axis (where the figure has not chosen its own), and on a log
+    axis minor ticks at :data:`LOG_MINOR_SUBS` and its powers of ten as plain numbers. A
+    PNG is written with :data:`PNG_OPTIONS`.
     """
     for ax in _every_axes(fig):
         for axis in (ax.xaxis, ax.yaxis):
             if axis.get_scale() == "log":
                 axis.set_minor_locator(LogLocator(subs=LOG_MINOR_SUBS))
+                axis.set_minor_formatter(NullFormatter())
+                # plain numbers, not matplotlib's 10^n in mathtext, whose parser takes a
+                # first figure 0.1-0.2 s to build
+                axis.set_major_formatter(FormatStrFormatter("%g"))
             elif type(axis.get_major_locator()) is AutoLocator:
                 axis.set_major_locator(MaxNLocator(nbins=MAJOR_TICKS, steps=[1, 2, 2.5, 5, 10]))
     path = Path(os.fspath(path))
