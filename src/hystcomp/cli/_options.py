@@ -146,9 +146,32 @@ quiet_option = click.option(
 
 
 def read_options(
-    columns: dict | None, sample_rate: float | None, x_unit=None, quiet: bool = False, path=""
+    columns: dict | None,
+    sample_rate: float | None,
+    x_unit=None,
+    quiet: bool = False,
+    path="",
+    *,
+    reads: tuple[str, ...] = ("v", "x"),
 ) -> dict:
-    """Keyword arguments for :func:`hystcomp.io.records.read_table` from the shared options."""
+    """Keyword arguments for :func:`hystcomp.io.records.read_table` from the shared options.
+
+    ``reads`` are the columns the command reads besides t: a ``--columns`` entry for
+    another one is refused (it would be ignored, and was most likely meant for one read).
+    """
+    from hystcomp.io.records import MEANINGS
+
+    named = columns or {}
+    unused = [key for key in named if key not in ("t", *reads)]
+    if unused:
+        key, spec = unused[0], named[unused[0]]
+        meant = next((k for k in reads if k not in named), reads[0])
+        raise click.BadParameter(
+            f"{key}={spec} names a column of {MEANINGS[key].split(' in ')[0]}, which this "
+            f"command does not read (it reads t and {' and '.join(reads)}); name the column "
+            f"of {MEANINGS[meant].split(' in ')[0]} instead, e.g. --columns {meant}={spec}.",
+            param_hint="'--columns'",
+        )
     options = {"columns": columns, "sample_rate": sample_rate, "x_unit": x_unit}
     if not quiet:
         options["progress"] = Progress(f"reading {click.format_filename(str(path))}")

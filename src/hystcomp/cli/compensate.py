@@ -122,7 +122,7 @@ def compensate(
     model = load_model(model_file)
     refuse_dynamics_as_model(model, model_file)
     chosen = method_options(model, model_file, method)
-    options = read_options(columns, sample_rate, x_unit, quiet, reference_file)
+    options = read_options(columns, sample_rate, x_unit, quiet, reference_file, reads=("x",))
     table = read_table(reference_file, ("x",), **options)
     warn_x_unit(table["x"], reference_file, quiet, x_unit)
     options = inverse_options(model, table, slew_rate=slew_rate, narrow_range=narrow_range)

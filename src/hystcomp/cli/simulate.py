@@ -40,7 +40,9 @@ def simulate(model_file, input_file, output, columns, sample_rate, quiet):
             "displacement: LinearDynamics.simulate in Python)."
         )
     table = read_table(
-        input_file, ("v",), **read_options(columns, sample_rate, None, quiet, input_file)
+        input_file,
+        ("v",),
+        **read_options(columns, sample_rate, None, quiet, input_file, reads=("v",)),
     )
     v = table["v"]
     lo, hi = getattr(model, "voltage_range_", (-float("inf"), float("inf")))
