@@ -395,12 +395,21 @@ def identify_record(
     else:
         start = int(np.searchsorted(record.t - record.t[0], transient, side="left"))
     with contextlib.nullcontext() if progress is None else progress:
-        if "transient" in model.get_params():
-            if transient is not None:
-                model.transient = start
-            model.fit(v, x)
-        else:  # a model without its own transient option is fitted on the settled part only
-            model.fit(v[start:], x[start:])
+        try:
+            if "transient" in model.get_params():
+                if transient is not None:
+                    model.transient = start
+                model.fit(v, x)
+            else:  # a model without its own transient option is fitted on the settled part
+                model.fit(v[start:], x[start:])
+        except IdentificationError as exc:
+            if holdout is None:
+                raise
+            raise IdentificationError(
+                f"{exc} The 'holdout' argument of {_OWNER}, {holdout}, leaves the first "
+                f"{n_fit} of {n} samples to fit on: hold out a smaller fraction (0.2 leaves "
+                f"{fit_samples(n, 0.2)})."
+            ) from None
     x_model = model.simulate(v)
     fit = error_report(x, x_model, start)
     tracking = compensation_error(model, v, x, start=start)
