@@ -64,6 +64,46 @@ def test_lab_text_layouts_read_as_the_canonical_csv(tmp_path, record, name, head
     _same(path, record, columns=columns)
 
 
+@pytest.mark.parametrize(
+    ("name", "head", "sep", "decimal", "edit"),
+    [
+        ("quoted.csv", ['"t","v","x"'], ",", ".", lambda row, sep: sep.join(f'"{f}"' for f in row.split(sep))),
+        ("quoted-decimal-comma.csv", ["t;v;x"], ";", ",", lambda row, sep: sep.join(f'"{f}"' for f in row.split(sep))),
+        ("trailing.csv", ["t,v,x,"], ",", ".", lambda row, sep: row + sep),
+        ("trailing-data-only.csv", ["t,v,x"], ",", ".", lambda row, sep: row + sep),
+        ("trailing-units.csv", ["t;v;x;", "s;V;mm;"], ";", ",", lambda row, sep: row + sep),
+        ("trailing-tabs.txt", ["t\tv\tx\t"], "\t", ".", lambda row, sep: row + sep),
+    ],
+)  # fmt: skip
+def test_spreadsheet_quotes_and_trailing_separators_are_read(
+    tmp_path, record, name, head, sep, decimal, edit
+):
+    path = tmp_path / name
+    rows = [edit(row, sep) for row in _rows(record, sep, decimal)]
+    path.write_text("\n".join([*head, *rows]) + "\n", "utf-8")
+    expected = dict(record, x=record["x"] * 1e3) if "units" in name else record  # mm
+    rec = read_record(path)
+    for key in "tv":
+        np.testing.assert_array_equal(getattr(rec, key), expected[key])
+    np.testing.assert_allclose(rec.x, expected["x"], rtol=1e-15)
+    # a row that misses a value is still refused, with where
+    path.write_text("\n".join([*head, *rows[:3], sep.join(["1"] * 2), *rows[3:]]) + "\n")
+    with pytest.raises(DataFileError, match="not a table of numbers"):
+        read_record(path)
+
+
+def test_a_windows_1252_table_is_read_and_binary_data_still_refused(tmp_path, record):
+    path = tmp_path / "windows.csv"
+    rows = _rows(record, ";", ",")
+    text = "\r\n".join(["Zeit;Spannung;Weg", "s;V;µm", *rows[:5], "# 23 °C", *rows[5:]])
+    path.write_bytes(text.encode("cp1252"))
+    _same(path, record, columns={"t": "zeit", "v": "spannung", "x": "weg"})
+    binary = tmp_path / "binary.csv"
+    binary.write_bytes(b"t,v,x\n" + bytes(range(256)) * 4)
+    with pytest.raises(DataFileError, match="is not text"):
+        read_record(binary)
+
+
 def test_numpy_savetxt_header_and_semicolon_comma_export(tmp_path, record):
     table = np.column_stack([record[k] for k in "tvx"])
     path = tmp_path / "savetxt.txt"

@@ -3,7 +3,8 @@
 The layout is decided from the first data row and the lines above it, by these rules (no
 guessing from statistics, unlike :class:`csv.Sniffer`):
 
-1. The text is UTF-8 (a byte-order mark is dropped). Blank lines are skipped everywhere.
+1. The text is UTF-8 (a byte-order mark is dropped), or else Windows-1252 (a header
+   with ``µm`` written by Windows software). Blank lines are skipped everywhere.
 2. The **first data row** is the first line, not starting with ``#``, whose fields are all
    numbers. Its **separator** is ``;`` if the line holds one, else a tab if it holds one,
    else ``,`` if it holds one, else runs of spaces.
@@ -18,6 +19,9 @@ guessing from statistics, unlike :class:`csv.Sniffer`):
 5. Header names and units lose surrounding quotes (units also brackets); a name such as
    ``x [um]`` or ``t (s)`` gives the column's name and unit when there is no units row.
    The header and the units row must have as many fields as the data rows.
+6. As spreadsheets and loggers write them: a number may be quoted (``"0.5"``), and a
+   separator at the end of the first data row (``0,0.5,1,``) is a **trailing separator**,
+   its empty last field ignored in every row (and in the header and units row).
 
 The data rows are parsed in chunks of :data:`CHUNK_BYTES` by :func:`numpy.loadtxt` (its C
 parser) into one preallocated array, so a read needs about the memory of the values
@@ -64,6 +68,8 @@ class Layout:
     decimal_comma: bool
     n_columns: int
     data_offset: int  # byte offset of the first data row
+    trailing: bool = False  # a separator ends each row: an empty last field to ignore
+    encoding: str = "utf-8"
 
 
 def _split(line: str, delimiter: str | None) -> list[str]:
@@ -73,6 +79,7 @@ def _split(line: str, delimiter: str | None) -> list[str]:
 def _numbers(tokens: list[str], decimal_comma: bool) -> bool:
     try:
         for tok in tokens:
+            tok = tok[1:-1] if len(tok) > 1 and tok[0] == tok[-1] == '"' else tok
             float(tok.replace(",", ".") if decimal_comma else tok)
     except ValueError:
         return False
@@ -100,16 +107,18 @@ def sniff(path: Path) -> Layout:
     """
     with path.open("rb") as f:
         head = f.read(HEAD_BYTES)
-    text = head.decode("utf-8", errors="strict") if len(head) < HEAD_BYTES else None
-    if text is None:  # cut at the last complete line
-        text = head[: head.rfind(b"\n") + 1].decode("utf-8")
+    whole = len(head) < HEAD_BYTES
+    if not whole:  # cut at the last complete line
+        head = head[: head.rfind(b"\n") + 1]
+    encoding = _encoding(head)
+    text = head.decode(encoding)
     bom = 3 if head.startswith(b"\xef\xbb\xbf") else 0
     text = text[1:] if bom else text
     offset, chars = bom, 0
     above: list[tuple[bool, str]] = []  # (is a comment, text) of the lines above the data
     for line in text.splitlines(keepends=True):
         stripped = line.strip()
-        start, offset = offset, offset + len(line.encode("utf-8"))
+        start, offset = offset, offset + len(line.encode(encoding))
         first, chars = chars, chars + len(line)
         if not stripped:
             continue
@@ -119,17 +128,36 @@ def sniff(path: Path) -> Layout:
         delimiter = _delimiter(stripped)
         decimal_comma = delimiter != "," and "," in text[first:]
         tokens = _split(stripped, delimiter)
+        # (a tab ending the line is gone from the stripped line: look at the line itself)
+        trailing = delimiter is not None and line.rstrip("\r\n ").endswith(delimiter)
+        if trailing and len(tokens) > 1 and tokens[-1] == "":
+            tokens = tokens[:-1]
         if _numbers(tokens, decimal_comma):
             names, units = _header(path, above, delimiter, len(tokens))
-            return Layout(names, units, delimiter, decimal_comma, len(tokens), start)
+            n = len(tokens)
+            return Layout(names, units, delimiter, decimal_comma, n, start, trailing, encoding)
         above.append((False, stripped))
     if not above and not text.strip():
         raise DataFileError(f"Data file {str(path)!r} is empty: it has no data rows.")
     raise DataFileError(
         f"Data file {str(path)!r} has a header but no data rows"
-        + ("" if len(head) < HEAD_BYTES else f" in its first {HEAD_BYTES} bytes")
+        + ("" if whole else f" in its first {HEAD_BYTES} bytes")
         + ": a data row is a line of numbers only, separated by ',', ';', tabs or spaces."
     )
+
+
+def _encoding(head: bytes) -> str:
+    """UTF-8, or Windows-1252 for a text that is not UTF-8 (``µm`` and ``°C`` in the header
+    of a table written by Windows software); raises UnicodeDecodeError for binary data (a
+    control character other than tab and line ends, or a byte that no text has)."""
+    try:
+        head.decode("utf-8")
+        return "utf-8"
+    except UnicodeDecodeError:
+        if re.search(rb"[\x00-\x08\x0b\x0c\x0e-\x1f\x7f]", head):
+            raise
+        head.decode("cp1252")  # raises for the five bytes that cp1252 leaves undefined
+        return "cp1252"
 
 
 def _header(path: Path, above, delimiter, n: int):
@@ -146,6 +174,8 @@ def _header(path: Path, above, delimiter, n: int):
     if not candidates:
         return None, None
     rows = [_split(line, delimiter) for line in candidates]
+    # a separator ending the header or units row, as it may end every row (rule 6)
+    rows = [row[:-1] if len(row) == n + 1 and row[-1] == "" else row for row in rows]
     units = None
     if len(rows) == 2 and _is_units(rows[1]) and not _is_units(rows[0]):
         units = [tok.strip(_STRIP) for tok in rows[1]]
@@ -213,7 +243,7 @@ def read_rows(path: Path, layout: Layout, limit: int, progress=None) -> np.ndarr
             cut = chunk.rfind(b"\n") + 1 if block else len(chunk)
             chunk, rest = chunk[:cut], chunk[cut:]
             if chunk.strip():
-                rows = _parse(chunk.decode("utf-8"), layout, where, n)
+                rows = _parse(chunk.decode(layout.encoding), layout, where, n)
                 if n + rows.shape[0] > limit:
                     raise DataFileError(
                         f"{where} has more than {limit} rows, the most a record may have "
@@ -239,7 +269,14 @@ def _parse(text: str, layout: Layout, where: str, before: int) -> np.ndarray:
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", UserWarning)  # "input contained no data"
-            rows = np.loadtxt(text.splitlines(), delimiter=layout.delimiter, comments="#", ndmin=2)
+            rows = np.loadtxt(
+                text.splitlines(),
+                delimiter=layout.delimiter,
+                comments="#",
+                quotechar='"',
+                usecols=range(layout.n_columns) if layout.trailing else None,
+                ndmin=2,
+            )
     except (ValueError, IndexError, OverflowError) as exc:
         raise DataFileError(
             f"{where} is not a table of numbers ({_reason(exc, before)}). Every row after "
