@@ -70,6 +70,7 @@ CASES = [
     ("output folder is a file", "identify rec.csv --model pi -o rec.csv/{out}.json", r"the folder 'rec\.csv' is a file, not a folder"),
     ("file name too long", "excite mpi -o %s.csv" % ("a" * 300), r"cannot use 'a+': File name too long\. Check the path"),
     ("holdout leaves too few", "identify rec.csv --model pi --holdout 0.99 -o {out}.json", r"fewer than the \d+ needed.*'holdout' .*0\.99, leaves the first 8 of 801 samples .*smaller fraction"),
+    ("regularization too large", "identify rec.csv --model mpi --regularization 1e308 -o {out}.json", r"'--regularization': must be 'auto' or a number from 0 to 1e\+12; got '1e308'"),
     ("--columns not read", "compensate model.json ref.csv --columns v=2 -o {out}.csv", r"'--columns': v=2 names a column of voltage, which this command does not read .* --columns x=2"),
     ("--columns not read (sim)", "simulate model.json rec.csv --columns t=1,x=3 -o {out}.csv", r"'--columns': x=3 .*reads t and v.* --columns v=3"),
 ]  # fmt: skip

@@ -140,11 +140,11 @@ def test_real_record_in_one_command_beats_a_straight_line(tmp_path, kind):
         ),
         (
             ["identify", "rec.csv", "--model", "mpi", "--regularization", "-1", "-o", "m.json"],
-            "must be 'auto' or a number >= 0; got '-1'",
+            "must be 'auto' or a number from 0 to 1e+12; got '-1'",
         ),
         (
             ["identify", "rec.csv", "--model", "mpi", "--regularization", "best", "-o", "m.json"],
-            "must be 'auto' or a number >= 0; got 'best'",
+            "must be 'auto' or a number from 0 to 1e+12; got 'best'",
         ),
         (
             ["identify", "rec.csv", "--model", "pi", "--degree", "2", "-o", "m.json"],

@@ -11,6 +11,7 @@ from pathlib import Path
 import click
 
 from hystcomp._hyperparameters import EVERETT_KINDS, MAX_DEGREE
+from hystcomp._validation import MAX_MAGNITUDE
 from hystcomp.cli import main
 from hystcomp.cli._options import (
     columns_option,
@@ -69,8 +70,10 @@ def _regularization(ctx, param, value):
         number = float(value)
     except ValueError:
         number = float("nan")
-    if not number >= 0 or number == float("inf"):
-        raise click.BadParameter(f"must be 'auto' or a number >= 0; got {value!r}.", param=param)
+    if not 0 <= number <= MAX_MAGNITUDE:
+        raise click.BadParameter(
+            f"must be 'auto' or a number from 0 to {MAX_MAGNITUDE:g}; got {value!r}.", param=param
+        )
     return number
 
 
