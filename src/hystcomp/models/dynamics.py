@@ -300,7 +300,7 @@ class LinearDynamics:
         The design (a non-negative least squares) depends only on the resonance, the
         sample rate and the band, which key the designs kept; a copy or a pickled model
         carries them (``hystcomp compare`` designs the inverse in the process that
-        identifies the dynamics, so that its own never imports SciPy).
+        identifies the dynamics, so that its own never imports SciPy's optimisers).
         """
         key = (bandwidth_hz, self.sample_rate_, self.resonance_hz_, self.damping_ratio_)
         designs = self.__dict__.setdefault("_fir_designs", {})
