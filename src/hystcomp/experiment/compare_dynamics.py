@@ -83,8 +83,9 @@ def identify_twin_dynamics(params: TwinParameters, seed: int) -> tuple[Record, L
 def designed_twin_dynamics(params: TwinParameters, seed: int) -> tuple[Record, LinearDynamics]:
     """:func:`identify_twin_dynamics`, and the design of the inverse that the compensators
     with dynamics use: all of the comparison's work that needs SciPy's optimisers (a
-    least-squares fit, non-negative least squares), which ``hystcomp compare`` runs in a second process while
-    the first measures Table I. The design goes with the model (pickled)."""
+    least-squares fit, non-negative least squares), which ``hystcomp compare`` runs in a
+    second process while the first measures Table I. The design goes with the model
+    (pickled)."""
     record, dynamics = identify_twin_dynamics(params, seed)
     dynamics.inverse()  # the band of with_dynamics (the default): designed and kept
     return record, dynamics
