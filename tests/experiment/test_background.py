@@ -68,6 +68,17 @@ def test_the_dynamics_identified_in_a_second_process_are_those_identified_here(m
     assert not np.array_equal(record.x, Twin(params, seed=3).run(record.v))
 
 
+def test_a_job_that_gives_nothing_in_time_is_ended_and_done_here():
+    import time
+
+    job = BackgroundJob.start(time.sleep, 60.0)
+    assert job is not None
+    start = time.perf_counter()
+    assert job.collect(timeout=0.5) is None
+    assert time.perf_counter() - start < 5.0
+    assert not job._process.is_alive()
+
+
 def test_a_cancelled_job_ends_at_once():
     import time
 

@@ -27,6 +27,11 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+#: Seconds that :meth:`BackgroundJob.collect` waits at most: far beyond any job of
+#: ``hystcomp compare`` (a first run's compiling takes about 7 s), so that a process that
+#: hangs (a lock held at the fork) costs time, never the command.
+WAIT_LIMIT = 600.0
+
 #: The start of Python's warning on a fork in a process with threads (3.12 and later).
 FORK_WARNING = r"This process \(pid=\d+\) is multi-threaded"
 
@@ -73,18 +78,20 @@ class BackgroundJob:
         sender.close()
         return cls(process, receiver)
 
-    def collect(self) -> Any:
-        """Wait for the result: ``function(*args)``, or None if the process failed (the
-        caller then does the job itself)."""
+    def collect(self, timeout: float = WAIT_LIMIT) -> Any:
+        """Wait for the result: ``function(*args)``, or None if the process failed or
+        gave nothing within ``timeout`` seconds (it is ended then); the caller then does
+        the job itself."""
         try:
-            reply = self._connection.recv()
+            reply = self._connection.recv() if self._connection.poll(timeout) else None
         except (EOFError, OSError):
             reply = None
         finally:
             self._connection.close()
-            self._process.join(timeout=10.0)
+            self._process.join(timeout=10.0 if reply else 0.0)
             if self._process.is_alive():
                 self._process.kill()
+                self._process.join(timeout=10.0)
         if not reply or reply[0] != "ok":
             return None
         return reply[1]
