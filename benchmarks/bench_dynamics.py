@@ -8,6 +8,10 @@ the rows are ratios measured in the same run:
   inverse of the dynamics (targets <= 1.5 and <= 2.5) and without it (for information);
 * mean |error| from 20 ms to 3 s after a step, with over without the dynamics (target
   < 0.3), and how far the error drifts over that time (the creep left), with over without;
+* the linear floor: the rms that the inverse of the identified dynamics leaves at 100 and
+  200 Hz on the stage's own linear part alone (creep and resonance, no hysteresis), over
+  MPI's 1 Hz rms (information: what the dynamics inverse costs, whatever the hysteresis
+  model; a perfect hysteresis inverse in front of the twin leaves the same);
 * the same step ratio for the exact Preisach inverse (information: the default inverse of
   the Preisach model overshoots the voltage on a fast rise by itself, a minor loop that
   the dynamics cannot undo);
@@ -25,7 +29,10 @@ import time
 import numpy as np
 
 from hystcomp.experiment.compare import CompareConfig, run_comparison
-from hystcomp.experiment.compare_dynamics import STEP_FROM, STEP_HOLD
+from hystcomp.experiment.compare_dynamics import FAST_FREQUENCIES, STEP_FROM, STEP_HOLD
+from hystcomp.experiment.references import triangle_reference
+from hystcomp.experiment.tracking import period_samples
+from hystcomp.models.dynamics import MATCH_HZ, LinearDynamics
 from hystcomp.plant import Twin, creep_twin
 
 STAGES = {
@@ -54,6 +61,28 @@ def _exact_step_ratio(c, params) -> float:
         )
     ]
     return err[0] / err[1]
+
+
+def _linear_floor(c, params, frequency) -> float:
+    """rms (µm) of ``D[D_id^-1[x_ref]] / |D(1 Hz)| - x_ref`` on ``compare``'s triangle at
+    ``frequency``, over the periods that ``compare`` measures: ``D`` the stage's own creep
+    and resonance, ``D_id^-1`` the inverse of the identified model matched at 1 Hz as in
+    ``with_dynamics`` (a hysteresis model identified at 1 Hz holds the gain ``|D(1 Hz)|``)."""
+    fs = float(params.sample_rate)
+    n_creep = len(params.creep_time_constants)
+    stage = LinearDynamics.from_parameters(
+        sample_rate=fs,
+        resonance_hz=params.resonance_hz,
+        damping_ratio=params.damping_ratio,
+        creep_time_constants=params.creep_time_constants,
+        creep_weights=[params.creep_gain / n_creep] * n_creep,
+    )
+    periods = max(c.config.periods, round(c.config.periods * frequency / 10.0))
+    _, x_ref = triangle_reference(c.reference_amplitude, frequency, periods=periods, sample_rate=fs)
+    r = c.dynamics.dynamics.inverse(match_hz=MATCH_HZ).simulate(x_ref)
+    x = stage.simulate(r, initial=0.0) / abs(stage.frequency_response([MATCH_HZ])[0])
+    window = slice(period_samples(frequency, fs), None)
+    return float(np.sqrt(np.mean((x - x_ref)[window] ** 2)))
 
 
 #: Step heights (fractions of the reference's peak) of :func:`step_heights`.
@@ -114,6 +143,10 @@ def run() -> list[dict]:
             )
             drift = abs(dc.step_drift[label]) / abs(dc.step_drift[method])
             rows.append(_row(f"{stage}: {method}, step |drift| 20 ms..3 s with / without", drift))
+        base = dc.results[1.0]["mpi + dynamics"].rms
+        for f in FAST_FREQUENCIES:
+            floor = _linear_floor(c, params, f) / base
+            rows.append(_row(f"{stage}: linear floor at {f:g} Hz / MPI's 1 Hz rms", floor))
         rows.append(
             _row(
                 f"{stage}: preisach (exact inverse), step mean |error| with / without dynamics",
