@@ -43,8 +43,12 @@ def inner_kernel(func):
     optimising it). Without reference counting, a call does not increment and decrement the
     count of every array it is passed (two atomic operations per call: at a call per sample
     or per root-finding step, they cost as much as the arithmetic). It must not allocate.
+    Python cannot call it: it has no wrapper for Python (nor for C), whose compilation is
+    a third of that of a small kernel.
     """
-    return numba.njit(cache=True, fastmath=FASTMATH, _nrt=False)(func)
+    return numba.njit(
+        cache=True, fastmath=FASTMATH, _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True
+    )(func)
 
 
 def step_kernel(func):
