@@ -166,6 +166,34 @@ def test_bad_inverse_options_get_clear_messages(kwargs, message):
         presets.paper_preisach().inverse(**kwargs)
 
 
+def _major_loop_slopes(model, n=2001):
+    """Local slopes (µm/V) of the major loop's branches, from the model's own simulation."""
+    lo, hi = model.voltage_range_
+    up, down = np.linspace(lo, hi, n), np.linspace(hi, lo, n)
+    x = model.simulate(np.r_[up, down])
+    return np.r_[np.diff(x[:n]) / np.diff(up), np.diff(x[n:]) / np.diff(down)]
+
+
+@given(preisach_models(monotone=True))
+def test_default_rho_never_lets_eq_10_amplify_an_error(case):
+    # eq. (10) multiplies a sample's error by 1 - s / rho: within [-1, 1] for 0 <= s <= 2 rho
+    model, _ = case
+    lo, hi = model.voltage_range_
+    chord = float(model.everett_function(hi, lo)) / (hi - lo)
+    rho, s = model.default_rho(), _major_loop_slopes(model)
+    assert rho >= chord
+    assert s.max() <= 2.0 * rho * (1 + 1e-3)
+    if rho > chord:  # raised only as far as the steepest slope needs
+        assert s.max() == pytest.approx(2.0 * rho, rel=1e-3)
+
+
+def test_default_rho_of_a_steep_model_is_half_its_steepest_slope(rng):
+    model = Preisach.from_parameters(theta=monotone_theta(rng, 3, 120.0, 36.0))
+    steepest = _major_loop_slopes(model).max()
+    assert steepest > 2.1 * 36.0 / 120.0  # the chord would not keep eq. (10) contracting
+    assert model.default_rho() == pytest.approx(steepest / 2.0, rel=1e-3)
+
+
 def test_model_without_gain_has_no_default_rho():
     model = Preisach.from_parameters(theta=[0.1, -0.1])  # X = -0.1 (alpha - beta)
     with pytest.raises(InvalidParameterError, match=r"not positive.*rho="):
