@@ -19,7 +19,8 @@ the rows are ratios measured in the same run:
   step) as a fraction of the rest of the run (information: ``compare`` must stay fast).
 
 Run alone with ``python benchmarks/bench_dynamics.py``; ``--heights`` prints the step's
-ratio at several heights instead (:func:`step_heights`).
+ratio at several heights instead (:func:`step_heights`), ``--coupling`` the hysteresis
+model's error alone and through the stage's resonance (:func:`coupling`).
 """
 
 from __future__ import annotations
@@ -63,26 +64,54 @@ def _exact_step_ratio(c, params) -> float:
     return err[0] / err[1]
 
 
-def _linear_floor(c, params, frequency) -> float:
-    """rms (µm) of ``D[D_id^-1[x_ref]] / |D(1 Hz)| - x_ref`` on ``compare``'s triangle at
-    ``frequency``, over the periods that ``compare`` measures: ``D`` the stage's own creep
-    and resonance, ``D_id^-1`` the inverse of the identified model matched at 1 Hz as in
-    ``with_dynamics`` (a hysteresis model identified at 1 Hz holds the gain ``|D(1 Hz)|``)."""
-    fs = float(params.sample_rate)
+def _stage_dynamics(params) -> LinearDynamics:
+    """The stage's own linear part (creep and resonance) as a :class:`LinearDynamics`."""
     n_creep = len(params.creep_time_constants)
-    stage = LinearDynamics.from_parameters(
-        sample_rate=fs,
+    return LinearDynamics.from_parameters(
+        sample_rate=float(params.sample_rate),
         resonance_hz=params.resonance_hz,
         damping_ratio=params.damping_ratio,
         creep_time_constants=params.creep_time_constants,
         creep_weights=[params.creep_gain / n_creep] * n_creep,
     )
+
+
+def _triangle(c, params, frequency):
+    """``compare``'s triangle at ``frequency`` and the window it measures."""
+    fs = float(params.sample_rate)
     periods = max(c.config.periods, round(c.config.periods * frequency / 10.0))
     _, x_ref = triangle_reference(c.reference_amplitude, frequency, periods=periods, sample_rate=fs)
+    return x_ref, slice(period_samples(frequency, fs), None)
+
+
+def _rms(e) -> float:
+    return float(np.sqrt(np.mean(e**2)))
+
+
+def _linear_floor(c, params, frequency) -> float:
+    """rms (µm) of ``D[D_id^-1[x_ref]] / |D(1 Hz)| - x_ref`` on ``compare``'s triangle at
+    ``frequency``, over the periods that ``compare`` measures: ``D`` the stage's own creep
+    and resonance, ``D_id^-1`` the inverse of the identified model matched at 1 Hz as in
+    ``with_dynamics`` (a hysteresis model identified at 1 Hz holds the gain ``|D(1 Hz)|``)."""
+    stage = _stage_dynamics(params)
+    x_ref, window = _triangle(c, params, frequency)
     r = c.dynamics.dynamics.inverse(match_hz=MATCH_HZ).simulate(x_ref)
     x = stage.simulate(r, initial=0.0) / abs(stage.frequency_response([MATCH_HZ])[0])
-    window = slice(period_samples(frequency, fs), None)
-    return float(np.sqrt(np.mean((x - x_ref)[window] ** 2)))
+    return _rms((x - x_ref)[window])
+
+
+def coupling(c, params, method, frequency) -> tuple[float, float]:
+    """``(rms e_h, rms D[e_h])`` in µm: the hysteresis error of ``method``'s compensator with
+    the dynamics, ``e_h = H_stage[v] - |D(1 Hz)| r`` (``r`` what ``D^-1`` asks of the
+    hysteresis inverse, ``v`` the voltage), alone and through the stage's own creep and
+    resonance ``D``, on ``compare``'s triangle at ``frequency`` (docs/dynamics.md)."""
+    stage = _stage_dynamics(params)
+    x_ref, window = _triangle(c, params, frequency)
+    dyn = c.dynamics.dynamics
+    v = c.models[method].inverse(dynamics=dyn).simulate(x_ref)
+    r = dyn.inverse(match_hz=MATCH_HZ).simulate(x_ref)
+    e_h = Twin(params).hysteresis(v) - abs(stage.frequency_response([MATCH_HZ])[0]) * r
+    return _rms(e_h[window]), _rms(stage.simulate(e_h, initial=0.0)[window])
 
 
 #: Step heights (fractions of the reference's peak) of :func:`step_heights`.
@@ -174,6 +203,16 @@ if __name__ == "__main__":
                 print(
                     f"{stage}: {method}, step with / without dynamics (error with, µm): "
                     + ", ".join(f"{h:g}: {r:.2f} ({e:.3f})" for h, (r, e) in cells.items())
+                )
+        sys.exit()
+    if "--coupling" in sys.argv:  # the hysteresis error through the resonance (docs/dynamics.md)
+        for stage, params in STAGES.items():
+            c = run_comparison(CompareConfig(twin=params))
+            for method in ("mpi", "preisach"):
+                cells = [coupling(c, params, method, f) for f in (1.0, *FAST_FREQUENCIES)]
+                print(
+                    f"{stage}: {method}, rms e_h / rms D[e_h] (µm) at 1, 100, 200 Hz: "
+                    + ", ".join(f"{e:.3f} / {d:.3f}" for e, d in cells)
                 )
         sys.exit()
     for row in run():
