@@ -7,6 +7,9 @@ import scipy.io
 from hystcomp.errors import DataFileError, InvalidParameterError
 from hystcomp.io.records import Record, parse_columns, read_record, read_table, write_table
 
+# every test twice: text read by numpy.loadtxt, then by the compiled parser
+pytestmark = pytest.mark.usefixtures("text_reader")
+
 
 @pytest.fixture
 def record(rng):

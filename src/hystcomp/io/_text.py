@@ -23,10 +23,14 @@ guessing from statistics, unlike :class:`csv.Sniffer`):
    separator at the end of the first data row (``0,0.5,1,``) is a **trailing separator**,
    its empty last field ignored in every row (and in the header and units row).
 
-The data rows are parsed in chunks of :data:`CHUNK_BYTES` by :func:`numpy.loadtxt` (its C
-parser) into one preallocated array, so a read needs about the memory of the values
-(8 bytes each) and no more; rows are counted first and a file with more than the limit of
-samples (:func:`hystcomp.io._formats.max_samples`) is refused before any large allocation.
+The data rows are parsed in chunks of :data:`CHUNK_BYTES` into one preallocated array: by the
+compiled parser of :mod:`hystcomp.io._floatparse` (plain decimal numbers, read exactly as
+``float`` reads them) in a table of more than :data:`SMALL_TABLE` values, and by
+:func:`numpy.loadtxt` (its C parser) in a smaller one and wherever the compiled parser gives
+up (quotes, comments, ``nan``, a row of the wrong length: numpy words the error). A read
+needs about the memory of the values (8 bytes each) and no more; rows are counted first and
+a file with more than the limit of samples (:func:`hystcomp.io._formats.max_samples`) is
+refused before any large allocation.
 """
 
 from __future__ import annotations
@@ -42,8 +46,9 @@ from hystcomp.errors import DataFileError
 
 #: Bytes of data rows parsed at once (and written at once).
 CHUNK_BYTES = 1 << 21
-#: Values up to which CSV is formatted by ``repr`` in the interpreter, in one piece: loading
-#: the compiled formatter costs about as much as formatting this many values so.
+#: Values up to which CSV is formatted by ``repr`` in the interpreter, in one piece, and read
+#: by :func:`numpy.loadtxt` alone: loading the compiled formatter (parser) costs about as much
+#: as this many values so.
 SMALL_TABLE = 200_000
 #: Bytes read to recognise the layout; the header and first data row must lie within them.
 HEAD_BYTES = 1 << 16
@@ -232,6 +237,7 @@ def read_rows(path: Path, layout: Layout, limit: int, progress=None) -> np.ndarr
     where = f"Data file {str(path)!r}"
     bound = count_rows(path, layout.data_offset, limit)
     out = np.empty((layout.n_columns, min(bound, limit + 1)))
+    compiled = _compiled_reader(layout, out.size)
     n, done = 0, 0
     size = max(path.stat().st_size, 1)
     with path.open("rb") as f:
@@ -242,25 +248,46 @@ def read_rows(path: Path, layout: Layout, limit: int, progress=None) -> np.ndarr
             chunk = rest + block
             cut = chunk.rfind(b"\n") + 1 if block else len(chunk)
             chunk, rest = chunk[:cut], chunk[cut:]
-            if chunk.strip():
-                rows = _parse(chunk.decode(layout.encoding), layout, where, n)
-                if n + rows.shape[0] > limit:
+            if chunk and not chunk.isspace():  # (no copy, as strip makes)
+                read = compiled(chunk, out, n) if compiled is not None else -1
+                if read < 0:  # numpy reads what the compiled parser does not
+                    rows = _parse(chunk.decode(layout.encoding), layout, where, n)
+                    read = rows.shape[0]
+                    if n + read > out.shape[1] and n + read <= limit:  # ends not "\n" (old Macs)
+                        out = np.concatenate([out[:, :n], rows.T], axis=1)
+                    elif n + read <= limit:
+                        out[:, n : n + read] = rows.T
+                if n + read > limit:
                     raise DataFileError(
                         f"{where} has more than {limit} rows, the most a record may have "
                         "(HYSTCOMP_MAX_SAMPLES raises the limit). Split the record or lower "
                         "its sample rate."
                     )
-                if n + rows.shape[0] > out.shape[1]:  # lines not ended by "\n" (old Macs)
-                    out = np.concatenate([out[:, :n], rows.T], axis=1)
-                else:
-                    out[:, n : n + rows.shape[0]] = rows.T
-                n += rows.shape[0]
+                n += read
             done += len(block)
             if progress is not None:
                 progress(min(1.0, (layout.data_offset + done) / size))
             if not block:
                 break
     return out[:, :n]
+
+
+def _compiled_reader(layout: Layout, values: int):
+    """``read(chunk, out, n)``: the rows of ``chunk`` (bytes) into ``out[:, n:]`` by the
+    compiled parser (:mod:`hystcomp.io._floatparse`), their number or -1 where
+    :func:`numpy.loadtxt` must read the chunk; None for a table too small to be worth
+    loading the parser (:data:`SMALL_TABLE` values)."""
+    if values <= SMALL_TABLE:
+        return None
+    from hystcomp.io._floatparse import parse_rows  # compiled: loaded for large tables
+
+    code = 0 if layout.delimiter is None else ord(layout.delimiter)
+    comma, trailing = layout.decimal_comma, layout.trailing
+
+    def read(chunk: bytes, out: np.ndarray, n: int) -> int:
+        return int(parse_rows(np.frombuffer(chunk, np.uint8), code, comma, trailing, out, n))
+
+    return read
 
 
 def _parse(text: str, layout: Layout, where: str, before: int) -> np.ndarray:
