@@ -253,10 +253,11 @@ def read_rows(path: Path, layout: Layout, limit: int, progress=None) -> np.ndarr
                 if read < 0:  # numpy reads what the compiled parser does not
                     rows = _parse(chunk.decode(layout.encoding), layout, where, n)
                     read = rows.shape[0]
-                    if n + read > out.shape[1] and n + read <= limit:  # ends not "\n" (old Macs)
-                        out = np.concatenate([out[:, :n], rows.T], axis=1)
-                    elif n + read <= limit:
-                        out[:, n : n + read] = rows.T
+                    if n + read <= limit:
+                        if n + read > out.shape[1]:  # lines not ended by "\n" (old Macs)
+                            out = np.concatenate([out[:, :n], rows.T], axis=1)
+                        else:
+                            out[:, n : n + read] = rows.T
                 if n + read > limit:
                     raise DataFileError(
                         f"{where} has more than {limit} rows, the most a record may have "
