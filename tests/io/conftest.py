@@ -11,4 +11,5 @@ def text_reader(request, monkeypatch):
     formatter (every table: the size from which they are used set to 0)."""
     if request.param == "compiled":
         monkeypatch.setattr(hystcomp.io._text, "SMALL_TABLE", 0)
+        monkeypatch.setattr(hystcomp.io._text, "SMALL_READ", 0)
     return request.param

@@ -244,6 +244,7 @@ def test_chunked_read_and_write_round_trip_across_chunks(tmp_path, rng, monkeypa
 
     monkeypatch.setattr(text, "CHUNK_BYTES", 1000)  # many chunks, rows cut anywhere
     monkeypatch.setattr(text, "SMALL_TABLE", 0)  # the compiled formatter, even for few rows
+    monkeypatch.setattr(text, "SMALL_READ", 0)  # and the compiled parser
     n = 2000
     table = {
         "t": np.arange(n) / 3e3,
