@@ -152,8 +152,9 @@ def parse_rows(buf, delimiter, comma, trailing, out, start):
 
     ``delimiter`` is the separator's byte, or 0 for runs of spaces and tabs; ``comma``: a
     ``,`` inside a number is its decimal point; ``trailing``: a separator may end a row.
-    Empty lines are skipped (as numpy does: with a separator, a line of spaces is a row). Returns the number of rows read, or -1 where the caller must
-    read ``buf`` another way (``out[:, start:]`` may have been written then).
+    Empty lines are skipped (as numpy does: with a separator, a line of spaces is a row).
+    Returns the number of rows read, or -1 where the caller must read ``buf`` another way
+    (``out[:, start:]`` may have been written then).
     """
     n_columns, room = out.shape
     row = start
