@@ -21,20 +21,14 @@ from __future__ import annotations
 
 import math
 
-import numba
 import numpy as np
 
-from hystcomp.io._floattext import _KMAX, _KMIN, _P_HI, _P_LO, _two_prod
+from hystcomp.io._floattext import _KMAX, _KMIN, _P_HI, _P_LO, _kernel, _two_prod
 
 #: Significant digits kept in the integer mantissa (10**18 < 2**63).
 _DIGITS = 18
 _EXACT = np.array([10.0**i for i in range(23)])  # exact floats
 _TIE = 2.0**-40  # a remainder this close (in half-ulps) to a tie gives up
-
-
-def _kernel(func):
-    # No fastmath: the error-free transformations need IEEE arithmetic as written.
-    return numba.njit(cache=True, nogil=True)(func)
 
 
 @_kernel
