@@ -20,7 +20,9 @@ the rows are ratios measured in the same run:
 
 Run alone with ``python benchmarks/bench_dynamics.py``; ``--heights`` prints the step's
 ratio at several heights instead (:func:`step_heights`), ``--coupling`` the hysteresis
-model's error alone and through the stage's resonance (:func:`coupling`).
+model's error alone and through the stage's resonance (:func:`coupling`), ``--floor`` the
+least error that any linear inverse whose step response falls back by at most a given
+fraction leaves on the triangles (:func:`best_floor`).
 """
 
 from __future__ import annotations
@@ -33,6 +35,7 @@ from hystcomp.experiment.compare import CompareConfig, run_comparison
 from hystcomp.experiment.compare_dynamics import FAST_FREQUENCIES, STEP_FROM, STEP_HOLD
 from hystcomp.experiment.references import triangle_reference
 from hystcomp.experiment.tracking import period_samples
+from hystcomp.models.dynamic_compensator import MAX_PREVIEW
 from hystcomp.models.dynamics import MATCH_HZ, LinearDynamics
 from hystcomp.plant import Twin, creep_twin
 
@@ -112,6 +115,74 @@ def coupling(c, params, method, frequency) -> tuple[float, float]:
     r = dyn.inverse(match_hz=MATCH_HZ).simulate(x_ref)
     e_h = Twin(params).hysteresis(v) - abs(stage.frequency_response([MATCH_HZ])[0]) * r
     return _rms(e_h[window]), _rms(stage.simulate(e_h, initial=0.0)[window])
+
+
+#: How far (fractions of the step) the step response of the inverses of :func:`best_floor`
+#: may fall back from its highest value so far: 0 is a monotone rise (non-negative taps).
+FALL_BACKS = (0.0, 0.05, 0.2, 0.5, 1.0)
+
+
+def _harmonics(dynamics, peak_to_peak, frequency, lead):
+    """``(m, target)``: the real and imaginary parts of ``R(z) z^lead`` on the odd harmonics
+    ``k f`` of a triangle of ``peak_to_peak`` µm, weighted by their amplitudes
+    ``4 P / (pi^2 k^2)``, and the weighted 1 (``m @ g - target`` is the error of the FIR ``g``
+    with those leads, real parts over imaginary parts)."""
+    b, a = dynamics.resonance()
+    fs = dynamics.sample_rate_
+    k = np.arange(1, int(0.5 * fs / frequency), 2)
+    amp = 4.0 * peak_to_peak / (np.pi**2 * k**2)
+    z = np.exp(2j * np.pi * k * frequency / fs)
+    m = ((b[0] * z + b[1]) / (z**2 + a[1] * z + a[2]))[:, None] * z[:, None] ** np.asarray(lead)
+    return np.vstack([m.real, m.imag]) * np.r_[amp, amp][:, None], np.r_[amp, np.zeros_like(amp)]
+
+
+def _rms_of_harmonics(e) -> float:
+    return float(np.sqrt(np.sum(e**2) / 2.0))
+
+
+def fir_floor(dynamics, peak_to_peak, frequency) -> float:
+    """The rms (µm) that ``dynamics.inverse()``'s FIR leaves on a triangle through the
+    resonance of ``dynamics`` (creep inverted exactly), as :func:`best_floor` measures it."""
+    inverse = dynamics.inverse()
+    m, target = _harmonics(
+        dynamics, peak_to_peak, frequency, inverse.preview - np.arange(inverse.taps.size)
+    )
+    return _rms_of_harmonics(m @ inverse.taps - target)
+
+
+def best_floor(dynamics, peak_to_peak, frequency, fall_back, half=MAX_PREVIEW) -> float:
+    """The least rms (µm) that a linear inverse of the resonance leaves on a triangle.
+
+    Over every FIR ``G`` of ``2 half + 1`` taps (look-ahead up to ``half``) with unit sum
+    whose step response never turns back by more than ``fall_back`` (a fraction of the
+    step: it stays within that of its running maximum, ``s = u - d`` with ``u`` rising and
+    ``0 <= d <= fall_back``), the one that minimises the error ``|1 - R G|`` on the
+    harmonics of a triangle of ``peak_to_peak`` µm at ``frequency`` (:func:`_harmonics`),
+    ``R`` the resonance of ``dynamics``: a quadratic program in the rises of ``u`` and in
+    ``d`` (``quadprog``). The
+    creep is taken as inverted exactly: given the stage's own dynamics, this is what the
+    best such inverse leaves with a perfect hysteresis inverse. ``fall_back = 0`` is a
+    monotone rise (non-negative taps).
+    """
+    import quadprog
+
+    m, target = _harmonics(dynamics, peak_to_peak, frequency, np.arange(half, -half - 1, -1))
+    n = 2 * half + 1
+    rises = np.eye(n) - np.eye(n, k=-1)  # taps g = rises @ s, s = cumsum(p) - d
+    fit = np.hstack([m, -m @ rises])
+    hess = fit.T @ fit
+    hess += 1e-10 * np.trace(hess) / n * np.eye(2 * n)
+    eye, zero = np.eye(2 * n), np.zeros((n, n))
+    constraints = np.vstack(
+        [
+            np.r_[np.ones(n), np.zeros(n - 1), -1.0],  # s[-1] = sum(p) - d[-1] = 1
+            eye,  # p >= 0, d >= 0
+            np.hstack([zero, -np.eye(n)]),  # d <= fall_back
+        ]
+    )
+    bounds = np.r_[1.0, np.zeros(2 * n), np.full(n, -max(fall_back, 1e-9))]  # (0 is degenerate)
+    x = quadprog.solve_qp(hess, fit.T @ target, constraints.T, bounds, 1)[0]
+    return _rms_of_harmonics(fit @ x - target)
 
 
 #: Step heights (fractions of the reference's peak) of :func:`step_heights`.
@@ -213,6 +284,20 @@ if __name__ == "__main__":
                 print(
                     f"{stage}: {method}, rms e_h / rms D[e_h] (µm) at 1, 100, 200 Hz: "
                     + ", ".join(f"{e:.3f} / {d:.3f}" for e, d in cells)
+                )
+        sys.exit()
+    if "--floor" in sys.argv:  # the best linear inverse of each class (docs/dynamics.md)
+        for stage, params in STAGES.items():
+            c = run_comparison(CompareConfig(twin=params))
+            base = c.dynamics.results[1.0]["mpi + dynamics"].rms
+            stage_dyn = _stage_dynamics(params)
+            for f in FAST_FREQUENCIES:
+                cells = [best_floor(stage_dyn, c.reference_amplitude, f, d) for d in FALL_BACKS]
+                print(
+                    f"{stage}: {f:g} Hz, least rms (µm) for a fall-back of "
+                    + ", ".join(f"{d:g}: {e:.3f}" for d, e in zip(FALL_BACKS, cells, strict=True))
+                    + f"; hystcomp's FIR {fir_floor(stage_dyn, c.reference_amplitude, f):.3f}"
+                    + f" (MPI's 1 Hz rms {base:.3f})"
                 )
         sys.exit()
     for row in run():
