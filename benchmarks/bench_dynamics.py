@@ -21,8 +21,9 @@ the rows are ratios measured in the same run:
 Run alone with ``python benchmarks/bench_dynamics.py``; ``--heights`` prints the step's
 ratio at several heights instead (:func:`step_heights`), ``--coupling`` the hysteresis
 model's error alone and through the stage's resonance (:func:`coupling`), ``--floor`` the
-least error that any linear inverse whose step response falls back by at most a given
-fraction leaves on the triangles (:func:`best_floor`).
+least error that any linear inverse whose step response turns back by at most a given
+fraction leaves on the triangles (:func:`best_floor`), ``--turns`` the rows with targets
+when hystcomp's FIR is allowed to turn back (:func:`turning_fir`).
 """
 
 from __future__ import annotations
@@ -35,7 +36,7 @@ from hystcomp.experiment.compare import CompareConfig, run_comparison
 from hystcomp.experiment.compare_dynamics import FAST_FREQUENCIES, STEP_FROM, STEP_HOLD
 from hystcomp.experiment.references import triangle_reference
 from hystcomp.experiment.tracking import period_samples
-from hystcomp.models.dynamic_compensator import MAX_PREVIEW
+from hystcomp.models.dynamic_compensator import MAX_PREVIEW, band_fit
 from hystcomp.models.dynamics import MATCH_HZ, LinearDynamics
 from hystcomp.plant import Twin, creep_twin
 
@@ -120,6 +121,8 @@ def coupling(c, params, method, frequency) -> tuple[float, float]:
 #: How far (fractions of the step) the step response of the inverses of :func:`best_floor`
 #: may fall back from its highest value so far: 0 is a monotone rise (non-negative taps).
 FALL_BACKS = (0.0, 0.05, 0.2, 0.5, 1.0)
+#: The same for the band fit of ``--turns``, measured with the hysteresis.
+TURNS = (0.0, 0.02, 0.05)
 
 
 def _harmonics(dynamics, peak_to_peak, frequency, lead):
@@ -150,39 +153,58 @@ def fir_floor(dynamics, peak_to_peak, frequency) -> float:
     return _rms_of_harmonics(m @ inverse.taps - target)
 
 
-def best_floor(dynamics, peak_to_peak, frequency, fall_back, half=MAX_PREVIEW) -> float:
-    """The least rms (µm) that a linear inverse of the resonance leaves on a triangle.
-
-    Over every FIR ``G`` of ``2 half + 1`` taps (look-ahead up to ``half``) with unit sum
-    whose step response never turns back by more than ``fall_back`` (a fraction of the
-    step: it stays within that of its running maximum, ``s = u - d`` with ``u`` rising and
-    ``0 <= d <= fall_back``), the one that minimises the error ``|1 - R G|`` on the
-    harmonics of a triangle of ``peak_to_peak`` µm at ``frequency`` (:func:`_harmonics`),
-    ``R`` the resonance of ``dynamics``: a quadratic program in the rises of ``u`` and in
-    ``d`` (``quadprog``). The
-    creep is taken as inverted exactly: given the stage's own dynamics, this is what the
-    best such inverse leaves with a perfect hysteresis inverse. ``fall_back = 0`` is a
-    monotone rise (non-negative taps).
-    """
+def _turning_taps(design, target, fall_back):
+    """The taps ``g`` (unit sum) that minimise ``|design @ g - target|`` among those whose
+    step response never turns back by more than ``fall_back`` (a fraction of the step: it
+    stays within that of its running maximum, ``s = u - d`` with ``u`` rising and
+    ``0 <= d <= fall_back``): a quadratic program in the rises of ``u`` and in ``d``
+    (``quadprog``). ``fall_back = 0`` is a monotone rise, non-negative taps."""
     import quadprog
 
-    m, target = _harmonics(dynamics, peak_to_peak, frequency, np.arange(half, -half - 1, -1))
-    n = 2 * half + 1
-    rises = np.eye(n) - np.eye(n, k=-1)  # taps g = rises @ s, s = cumsum(p) - d
-    fit = np.hstack([m, -m @ rises])
+    n = design.shape[1]
+    rises = np.eye(n) - np.eye(n, k=-1)  # taps g = p - rises @ d, p >= 0 the rises of u
+    fit = np.hstack([design, -design @ rises])
     hess = fit.T @ fit
     hess += 1e-10 * np.trace(hess) / n * np.eye(2 * n)
-    eye, zero = np.eye(2 * n), np.zeros((n, n))
     constraints = np.vstack(
         [
             np.r_[np.ones(n), np.zeros(n - 1), -1.0],  # s[-1] = sum(p) - d[-1] = 1
-            eye,  # p >= 0, d >= 0
-            np.hstack([zero, -np.eye(n)]),  # d <= fall_back
+            np.eye(2 * n),  # p >= 0, d >= 0
+            np.hstack([np.zeros((n, n)), -np.eye(n)]),  # d <= fall_back
         ]
     )
-    bounds = np.r_[1.0, np.zeros(2 * n), np.full(n, -max(fall_back, 1e-9))]  # (0 is degenerate)
+    # (an exact 0 makes d >= 0 and d <= 0 a degenerate pair that quadprog refuses)
+    bounds = np.r_[1.0, np.zeros(2 * n), np.full(n, -max(fall_back, 1e-9))]
     x = quadprog.solve_qp(hess, fit.T @ target, constraints.T, bounds, 1)[0]
-    return _rms_of_harmonics(fit @ x - target)
+    return x[:n] - rises @ x[n:]
+
+
+def best_floor(dynamics, peak_to_peak, frequency, fall_back, half=MAX_PREVIEW) -> float:
+    """The least rms (µm) that a linear inverse of the resonance leaves on a triangle.
+
+    Over every FIR of ``2 half + 1`` taps (look-ahead up to ``half``) with unit sum whose
+    step response never turns back by more than ``fall_back`` (:func:`_turning_taps`), the
+    one that minimises the error ``|1 - R G|`` on the harmonics of a triangle of
+    ``peak_to_peak`` µm at ``frequency`` (:func:`_harmonics`), ``R`` the resonance of
+    ``dynamics``. The creep is taken as inverted exactly: given the stage's own dynamics,
+    this is what the best such inverse leaves with a perfect hysteresis inverse.
+    """
+    m, target = _harmonics(dynamics, peak_to_peak, frequency, np.arange(half, -half - 1, -1))
+    return _rms_of_harmonics(m @ _turning_taps(m, target, fall_back) - target)
+
+
+def turning_fir(fall_back):
+    """A stand-in for :func:`hystcomp.models.dynamic_compensator.inverse_fir`: the same band
+    fit, with the step response allowed to turn back by ``fall_back`` (for ``--turns``)."""
+
+    def design(resonance, bandwidth_hz, sample_rate):
+        m, target, lead = band_fit(resonance, bandwidth_hz, sample_rate)
+        g = _turning_taps(m, target, fall_back)
+        kept = np.flatnonzero(np.abs(g) > 1e-12 * np.abs(g).max())
+        taps = g[kept[0] : kept[-1] + 1]
+        return taps / taps.sum(), int(lead[kept[0]])
+
+    return design
 
 
 #: Step heights (fractions of the reference's peak) of :func:`step_heights`.
@@ -209,8 +231,9 @@ def step_heights(c, params, method) -> dict:
     return out
 
 
-def run() -> list[dict]:
-    """Measure and return one row per figure: name, value, unit, target, ok."""
+def run(timing=True) -> list[dict]:
+    """Measure and return one row per figure: name, value, unit, target, ok (without the
+    timing row if not ``timing``)."""
     rows = []
     for stage, params in STAGES.items():
         c = run_comparison(CompareConfig(twin=params))
@@ -253,6 +276,8 @@ def run() -> list[dict]:
                 _exact_step_ratio(c, params),
             )
         )
+    if not timing:
+        return rows
     start = time.perf_counter()
     run_comparison(CompareConfig(dynamics=False))
     plain = time.perf_counter() - start
@@ -299,6 +324,15 @@ if __name__ == "__main__":
                     + f"; hystcomp's FIR {fir_floor(stage_dyn, c.reference_amplitude, f):.3f}"
                     + f" (MPI's 1 Hz rms {base:.3f})"
                 )
+        sys.exit()
+    if "--turns" in sys.argv:  # the same band fit, allowed to turn back (docs/dynamics.md)
+        from unittest import mock
+
+        for turn in TURNS:
+            with mock.patch("hystcomp.models.dynamics.inverse_fir", turning_fir(turn)):
+                for row in run(timing=False):
+                    if row["target"] or "linear floor" in row["name"]:
+                        print(f"turns back {turn:g}: {row['name']}: {row['value']:.3g}")
         sys.exit()
     for row in run():
         print(f"{row['name']}: {row['value']:.4g} {row['unit']} (target {row['target']})")

@@ -50,6 +50,20 @@ def inverse_fir(resonance, bandwidth_hz: float, sample_rate: float):
     """
     from scipy.optimize import nnls
 
+    design, target, lead = band_fit(resonance, bandwidth_hz, sample_rate)
+    g = nnls(np.vstack([design, np.full(lead.size, _SUM_WEIGHT)]), np.r_[target, _SUM_WEIGHT])[0]
+    kept = np.flatnonzero(g > 1e-12 * g.max())
+    taps = g[kept[0] : kept[-1] + 1]
+    return taps / taps.sum(), int(lead[kept[0]])
+
+
+def band_fit(resonance, bandwidth_hz: float, sample_rate: float):
+    """The least-squares problem of :func:`inverse_fir`: ``(design, target, lead)``.
+
+    ``design @ g - target`` is the weighted error of ``R(z) G(z)`` against 1 on the band,
+    real parts over imaginary parts, for taps ``g`` with the look-aheads ``lead`` (from
+    ``P`` down to ``-P``).
+    """
     b, a = resonance
     fn = _resonance_hz(a, sample_rate)
     half = min(max(2, math.ceil(0.5 * sample_rate / fn)), MAX_PREVIEW)
@@ -59,12 +73,7 @@ def inverse_fir(resonance, bandwidth_hz: float, sample_rate: float):
     lead = np.arange(half, -half - 1, -1)  # tap j multiplies z^(half - j)
     m = r[:, None] * np.exp(2j * np.pi * np.outer(f / sample_rate, lead))
     w = 1.0 / (1.0 + (f / (0.3 * bandwidth_hz)) ** 2)
-    design = np.vstack([m.real * w[:, None], m.imag * w[:, None], np.full(lead.size, _SUM_WEIGHT)])
-    target = np.concatenate([w, np.zeros_like(w), [_SUM_WEIGHT]])
-    g = nnls(design, target)[0]
-    kept = np.flatnonzero(g > 1e-12 * g.max())
-    taps = g[kept[0] : kept[-1] + 1]
-    return taps / taps.sum(), int(lead[kept[0]])
+    return np.vstack([m.real, m.imag]) * np.r_[w, w][:, None], np.r_[w, np.zeros_like(w)], lead
 
 
 def _resonance_hz(a, sample_rate: float) -> float:
