@@ -267,6 +267,21 @@ def test_output_clamped_and_slew_limited(compensator):
     assert compensator.max_step == pytest.approx(2e5 / FS)
 
 
+def test_a_reference_out_of_reach_is_counted_once_per_sample():
+    model = hystcomp.presets.paper_mpi()
+    comp = model.inverse(dynamics=_stage())
+    low, high = comp.dynamics_inverse.output_range
+    inside = np.full(3000, 0.5 * (low + high))
+    assert comp.run(inside).clamped == 0
+    for beyond in (low - 50.0, high + 50.0):
+        result = comp.run(np.r_[inside, np.full(2000, beyond)])
+        assert 1990 <= result.clamped <= 2000 + comp.preview  # the filter's look-ahead
+        s = comp.stepper()
+        s.prime(np.full(comp.preview, inside[0]))
+        s.step_block(np.r_[inside[comp.preview :], np.full(2000 + comp.preview, beyond)])
+        assert s.clamped_count == result.clamped
+
+
 def test_nonfinite_reference_holds_the_voltage():
     comp = hystcomp.presets.paper_mpi().inverse(dynamics=_stage())
     s = comp.stepper()
@@ -401,6 +416,23 @@ def test_cli_round_trip(tmp_path):
         dynamics=hystcomp.load_model(tmp_path / "dyn.json")
     )
     np.testing.assert_allclose(v, expected.simulate(15.0 + 10.0 * np.sin(2 * np.pi * 100 * t)))
+    # out of reach with the dynamics: counted and warned about, refused with --strict
+    far = 15.0 + 30.0 * np.sin(2 * np.pi * 10 * t)
+    write_table(tmp_path / "far.csv", {"t": t, "x": far})
+    far_args = ["compensate", str(tmp_path / "mpi.json"), str(tmp_path / "far.csv"),
+                "--dynamics", str(tmp_path / "dyn.json"), "-o", str(tmp_path / "far-v.csv")]  # fmt: skip
+    result = run(main, far_args)
+    assert result.exit_code == 0, result.output
+    low, high = hystcomp.presets.paper_mpi().reachable_range()
+    beyond = np.count_nonzero((far < low) | (far > high))
+    counted = int(result.output.split("hystcomp: warning: ")[1].split(" of ")[0])
+    assert 0.9 * beyond <= counted <= t.size
+    assert f"{counted} clamped" in result.output
+    (tmp_path / "far-v.csv").unlink()
+    refused = run(main, [*far_args, "--strict"])
+    assert refused.exit_code == 2
+    assert "out of reach" in refused.output
+    assert not (tmp_path / "far-v.csv").exists()
     # a reference at another rate, a dynamics file as the model, a model as --dynamics:
     # exit 2, nothing written
     write_table(tmp_path / "slow.csv", {"t": 2 * t, "x": np.full(t.size, 10.0)})

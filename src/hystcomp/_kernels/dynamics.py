@@ -8,7 +8,7 @@ exact inverse of the creep bank. Its parameters and state are one packed
 float64 array, as the chain's (:mod:`hystcomp._kernels.chain`)::
 
     [N_FIR, N_CREEP, SCALE, DIRECT, LOW, HIGH, BIAS, h_0 .. h_{N_FIR-1}, a_1 .. a_n, c_1 .. c_n,
-     delay line (N_FIR samples, newest first), creep lag states (n)]
+     delay line (N_FIR samples, newest first), creep lag states (n), count of clamped outputs]
 
 The creep bank of the forward model is ``D_c[q] = (q + sum_i c_i lag_i) / SCALE`` with
 ``lag_i[k] = a_i lag_i[k-1] + (1 - a_i) q[k]`` and ``SCALE = 1 + sum_i c_i``. Its inverse
@@ -16,7 +16,9 @@ solves that equation for ``q[k]`` each sample (``DIRECT = 1 + sum_i c_i (1 - a_i
 root of any polynomial is computed, so creep poles a hair below 1 stay exact. The output
 is clamped to ``[LOW, HIGH]`` (the hysteresis model's displacement range), so that the
 hysteresis inverse downstream never takes a memory the actuator cannot follow; the creep
-lags follow the clamped output. Kernels trust
+lags follow the clamped output, and an output that the clamp moves by more than
+:data:`~hystcomp._kernels.chain.CLAMP_TOLERANCE` of the range is counted (the reference
+is out of reach there), as the chain counts its voltage clamp. Kernels trust
 their input. The FIR's output is ``BIAS + sum_j h_j u[k - j]`` (a gain other than 1 at
 0 Hz, about a rest point, is a scaling of the taps and a bias).
 """
@@ -26,6 +28,7 @@ from __future__ import annotations
 import math
 
 from hystcomp._kernels._jit import kernel, step_kernel
+from hystcomp._kernels.chain import CLAMP_TOLERANCE
 
 N_FIR, N_CREEP, SCALE, DIRECT, LOW, HIGH, BIAS = range(7)
 HEADER = 7
@@ -35,6 +38,11 @@ HEADER = 7
 def state_start(p):
     """Index of the first state slot (the newest sample of the delay line)."""
     return HEADER + int(p[N_FIR]) + 2 * int(p[N_CREEP])
+
+
+def clamped_slot(p) -> int:
+    """Index of the count of clamped outputs (the last slot)."""
+    return HEADER + 2 * int(p[N_FIR]) + 3 * int(p[N_CREEP])
 
 
 @step_kernel
@@ -61,6 +69,9 @@ def inverse_step(p, u):
     y = acc / p[DIRECT]
     if not math.isfinite(y):  # a huge finite reference overflowed: held downstream
         return math.nan
+    tol = CLAMP_TOLERANCE * (p[HIGH] - p[LOW])  # inf without a clamp: nothing counts
+    if y > p[HIGH] + tol or y < p[LOW] - tol:
+        p[lags + n_creep] += 1.0
     y = min(max(y, p[LOW]), p[HIGH])
     for i in range(n_creep):
         ai = p[a + i]
@@ -73,6 +84,16 @@ def inverse_run(p, u, out):
     """Run :func:`inverse_step` over every sample of ``u`` (state kept in ``p``)."""
     for k in range(u.size):
         out[k] = inverse_step(p, u[k])
+
+
+@kernel
+def inverse_run_cuts(p, u, out, cuts):
+    """:func:`inverse_run`, and ``cuts[k]`` True where the clamp counted sample ``k``."""
+    slot = HEADER + 2 * int(p[N_FIR]) + 3 * int(p[N_CREEP])
+    for k in range(u.size):
+        before = p[slot]
+        out[k] = inverse_step(p, u[k])
+        cuts[k] = p[slot] != before
 
 
 @kernel

@@ -13,6 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from hystcomp._kernels import dynamics as dk
+from hystcomp._kernels.chain import CLAMP_TOLERANCE
 from hystcomp.codegen.c99 import CTemplate, c_double, c_table
 
 
@@ -86,17 +87,42 @@ def add_dynamics(template: CTemplate, inverse) -> CTemplate:
         "        return s->last;",
         "    }",
     ]
+    tol = CLAMP_TOLERANCE * (high - low)  # the kernel's rule: a cut beyond a rounding counts
     if np.isfinite(low):
-        body += [f"    if (y < {c_double(low)}) {{", f"        y = {c_double(low)};", "    }"]
+        body += [
+            f"    if (y < {c_double(low)}) {{",
+            f"        if (y < {c_double(low - tol)}) {{",
+            "            s->clamped_count++;",
+            "            dyn_cut = 1;",
+            "        }",
+            f"        y = {c_double(low)};",
+            "    }",
+        ]
     if np.isfinite(high):
-        body += [f"    if (y > {c_double(high)}) {{", f"        y = {c_double(high)};", "    }"]
+        body += [
+            f"    if (y > {c_double(high)}) {{",
+            f"        if (y > {c_double(high + tol)}) {{",
+            "            s->clamped_count++;",
+            "            dyn_cut = 1;",
+            "        }",
+            f"        y = {c_double(high)};",
+            "    }",
+        ]
     if n_creep:
         body += [
             f"    for (j = 0; j < {n_creep}; j++) {{",
             "        s->dyn_lag[j] = {p}_dyn_a[j] * s->dyn_lag[j] + (1.0 - {p}_dyn_a[j]) * y;",
             "    }",
         ]
-    body += ["    x_ref = y;", "}", ""]
+    body += ["    x_ref = y;", "    dyn_counted = s->clamped_count;", "}", ""]
     template.reset_body.append("}")
+    # a sample out of reach counted by the filter's clamp is not counted again by the
+    # voltage range's (DynamicStepper.clamped_count)
+    template.locals += ["int dyn_cut = 0;", "unsigned long dyn_counted = 0;"]
+    template.after_body += [
+        "if (dyn_cut) {",
+        "    s->clamped_count = dyn_counted;",
+        "}",
+    ]
     template.step_body = body + template.step_body
     return template

@@ -9,6 +9,7 @@
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import numpy as np
@@ -17,6 +18,7 @@ from hystcomp._kernels import dynamics as dk
 from hystcomp._kernels._jit import step_function
 from hystcomp._validation import as_signal, check_int
 from hystcomp.errors import InvalidSignalError
+from hystcomp.models.compensator import CompensatorRun
 from hystcomp.models.system import Rebound, block, checked_step
 
 #: Frequency (Hz) at which a hysteresis compensator and the inverse of the dynamics are
@@ -118,7 +120,7 @@ class DynamicsInverse:
         self.output_range = (float(output_range[0]), float(output_range[1]))
         header = [taps.size, lags.size, 1.0 + weights.sum(), 1.0 + (weights * (1.0 - lags)).sum()]
         header += [*self.output_range, float(bias)]
-        state = np.full(taps.size + lags.size, self.rest)
+        state = np.r_[np.full(taps.size + lags.size, self.rest), 0.0]  # and the clamp count
         packed = np.concatenate([header, taps, lags, weights, state])
         packed.setflags(write=False)
         self._packed = packed
@@ -139,15 +141,20 @@ class DynamicsInverse:
         The reference is held at its last value beyond its end; the filter starts at rest
         at :attr:`rest` and is primed with the first :attr:`preview` samples.
         """
-        x = as_signal(x_ref, "x_ref")
-        s = self.stepper()
-        s.prime(x[: self.preview])
-        tail = np.full(min(self.preview, x.size), x[-1])
-        return s.step_block(np.concatenate([x[self.preview :], tail]))
+        return self.run(x_ref)[0]
 
     def stepper(self) -> DynamicsInverseStepper:
         """A streaming filter at rest."""
         return DynamicsInverseStepper(self._packed, self.preview)
+
+    def run(self, x_ref) -> tuple[np.ndarray, int]:
+        """:meth:`simulate`, and how many outputs the clamp to :attr:`output_range` cut
+        (the reference, with the dynamics inverted, is out of the model's reach there)."""
+        x = as_signal(x_ref, "x_ref")
+        s = self.stepper()
+        s.prime(x[: self.preview])
+        tail = np.full(min(self.preview, x.size), x[-1])
+        return s.step_block(np.concatenate([x[self.preview :], tail])), s.clamped_count
 
     def __repr__(self) -> str:
         return f"DynamicsInverse({self.taps.size} taps, preview={self.preview} samples)"
@@ -177,6 +184,14 @@ class DynamicsInverseStepper(Rebound):
         dk.inverse_run(self._p, u, out)
         return out
 
+    def step_block_cuts(self, x_ref) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`step_block`, and where the clamp to the displacement range counted."""
+        u = block(x_ref, "step_block")
+        out = np.empty_like(u)
+        cuts = np.empty(u.size, dtype=np.bool_)
+        dk.inverse_run_cuts(self._p, u, out, cuts)
+        return out, cuts
+
     def prime(self, x_ref) -> None:
         """Feed the first ``preview`` reference samples, whose outputs come before time 0."""
         u = block(x_ref, "prime")
@@ -191,6 +206,11 @@ class DynamicsInverseStepper(Rebound):
     def reset(self) -> None:
         """Back to rest."""
         self._p[:] = self._initial
+
+    @property
+    def clamped_count(self) -> int:
+        """Outputs that the clamp to the displacement range cut since the last reset."""
+        return int(self._p[dk.clamped_slot(self._p)])
 
     def copy(self) -> DynamicsInverseStepper:
         """An independent stepper in the same state."""
@@ -235,13 +255,19 @@ class DynamicCompensator:
         return self.hysteresis.simulate(self.dynamics_inverse.simulate(x_ref))
 
     def run(self, x_ref):
-        """Like :meth:`simulate`, and also count the samples the voltage range clamped.
+        """Like :meth:`simulate`, and also count the samples out of reach.
 
-        Returns the hysteresis compensator's ``CompensatorRun`` (see
-        :meth:`hystcomp.models.compensator.Compensator.run`) for the reference that the
-        inverse of the dynamics hands it.
+        Returns a ``CompensatorRun`` (see :meth:`hystcomp.models.compensator.Compensator.run`)
+        whose ``clamped`` counts the samples that either clamp cut (once each): the inverse
+        of the dynamics' clamp to the model's displacement range (a reference out of the
+        model's reach, or creep to undo beyond it) or the voltage range's.
         """
-        return self.hysteresis.run(self.dynamics_inverse.simulate(x_ref))
+        x = as_signal(x_ref, "x_ref")
+        s = self.stepper()
+        s.prime(x[: self.preview])
+        tail = np.full(min(self.preview, x.size), x[-1])
+        v = s.step_block(np.concatenate([x[self.preview :], tail]))
+        return CompensatorRun(v, s.clamped_count, s.nonfinite_count)
 
     def stepper(self) -> DynamicStepper:
         """Streaming: ``step(x_ref[k + preview])`` returns the voltage to apply at sample ``k``.
@@ -264,28 +290,65 @@ class DynamicStepper(Rebound):
     def __init__(self, dynamics, hysteresis):
         self._dyn = dynamics
         self._hyst = hysteresis
+        self._seen = np.array([float(dynamics.clamped_count)])
         self._bind()
 
     def _bind(self) -> None:
+        self.step = self._bound_step()  # type: ignore[method-assign]
+
+    def _bound_step(self):
+        """The step as a closure over both stages' states. A sample that the filter's clamp
+        counted (out of reach) is not counted again by the voltage range's: only an output
+        at an end of the filter's range can have been cut, and ``seen[0]`` holds the
+        filter's count when last looked at."""
         dyn_step, hyst_step = self._dyn.step, self._hyst.step
-        self.step = lambda x_ref: hyst_step(dyn_step(x_ref))  # type: ignore[method-assign]
+        dyn_p, hyst_p, seen = self._dyn._p, self._hyst._p, self._seen
+        cuts, counted = dk.clamped_slot(dyn_p), self._hyst._clamped_slot
+        low, high = float(dyn_p[dk.LOW]), float(dyn_p[dk.HIGH])
+
+        def step(x_ref):
+            r = dyn_step(x_ref)
+            if low < r < high:
+                return hyst_step(r)
+            kept = hyst_p[counted]
+            v = hyst_step(r)
+            if dyn_p[cuts] != seen[0]:
+                seen[0] = dyn_p[cuts]
+                hyst_p[counted] = kept
+            return v
+
+        return step
 
     def step(self, x_ref: float) -> float:
         """One reference sample (µm, :attr:`preview` ahead) -> the voltage to apply now (V)."""
-        return self._hyst.step(self._dyn.step(x_ref))
+        return self._bound_step()(x_ref)
 
     def step_block(self, x_ref) -> np.ndarray:
         """A block of reference samples -> voltages."""
-        return self._hyst.step_block(self._dyn.step_block(x_ref))
+        r, cut = self._dyn.step_block_cuts(x_ref)
+        if not cut.any():
+            return self._hyst.step_block(r)
+        self._seen[0] = self._dyn.clamped_count
+        hyst_p, counted = self._hyst._p, self._hyst._clamped_slot
+        out = np.empty_like(r)
+        edges = [0, *(np.flatnonzero(np.diff(cut)) + 1).tolist(), r.size]
+        for a, b in itertools.pairwise(edges):  # runs of cut and of uncut samples
+            kept = hyst_p[counted]
+            out[a:b] = self._hyst.step_block(r[a:b])
+            if cut[a]:  # out of reach, counted by the filter: not twice
+                hyst_p[counted] = kept
+        return out
 
     def prime(self, x_ref) -> None:
         """Feed the first ``preview`` reference samples to the filter (no voltage is output)."""
         self._dyn.prime(x_ref)
+        self._seen[0] = self._dyn.clamped_count
 
     def reset(self) -> None:
         """Back to rest."""
         self._dyn.reset()
         self._hyst.reset()
+        self._seen[0] = 0.0
 
     def copy(self) -> DynamicStepper:
         """An independent stepper in the same state."""
@@ -298,9 +361,10 @@ class DynamicStepper(Rebound):
 
     @property
     def clamped_count(self) -> int:
-        """Outputs the voltage range clamped since the last reset (the hysteresis stepper's
-        count: the filter's own clamp to the displacement range is not counted)."""
-        return self._hyst.clamped_count
+        """Samples since the last reset that a clamp cut, once each: the filter's, to the
+        model's displacement range (a reference out of reach), or the voltage range's (the
+        C export counts the same)."""
+        return self._dyn.clamped_count + self._hyst.clamped_count
 
     @property
     def last_output(self) -> float:

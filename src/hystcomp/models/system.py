@@ -242,6 +242,12 @@ class Stepper(Rebound):
         return int(self._p[self._start + self.kernels.nonfinite])
 
     @property
+    def _clamped_slot(self) -> int:
+        """Index in the state of :attr:`clamped_count` (for a stage in front that counts the
+        same sample first, :class:`~hystcomp.models.dynamic_compensator.DynamicStepper`)."""
+        return self._start + self.kernels.clamped
+
+    @property
     def clamped_count(self) -> int:
         """How many outputs the voltage range clamped since the last reset.
 
