@@ -211,6 +211,17 @@ def test_bad_parameters_are_refused():
         _stage(resonance_hz=12_000.0)
     with pytest.raises(InvalidParameterError, match="weights >= 0"):
         _stage(creep_weights=[0.01, -0.01, 0.0, 0.0])
+    # poles that double precision cannot resolve (a hand-edited file): refused, not a crash
+    with pytest.raises(InvalidParameterError, match=r"'resonance_hz' .* at least 1e-06"):
+        _stage(resonance_hz=1e-300)
+    for zeta in (1e-300, 1e6):
+        with pytest.raises(InvalidParameterError, match=r"'damping_ratio' .* 1e-06 \.\. 1000"):
+            _stage(damping_ratio=zeta)
+    for fn, zeta in ((0.02, 0.1), (630.0, 1e-6), (630.0, 1e3)):  # the ends work
+        v = hystcomp.presets.paper_mpi().inverse(
+            dynamics=_stage(resonance_hz=fn, damping_ratio=zeta)
+        )
+        assert np.isfinite(v.simulate(np.linspace(5.0, 30.0, 500))).all()
     with pytest.raises(InvalidParameterError, match="bandwidth_hz"):
         _stage().inverse(bandwidth_hz=10_000.0)
     with pytest.raises(InvalidTypeError, match="LinearDynamics"):

@@ -69,6 +69,10 @@ __all__ = [
 #: Default band on which the inverse is fitted, as a multiple of the resonance (capped
 #: at 0.4 fs); chosen on the step and 100/200 Hz figures of ``benchmarks/bench_dynamics.py``.
 BANDWIDTH_FACTOR = 1.0
+#: Slowest resonance, as a fraction of the sample rate, and the damping ratios accepted:
+#: beyond them the discrete poles are not resolved in double precision.
+MIN_RESONANCE = 1e-6
+DAMPING_RANGE = (1e-6, 1e3)
 
 
 class LinearDynamics:
@@ -136,6 +140,21 @@ class LinearDynamics:
                 f"The 'resonance_hz' parameter of {owner} must be below the Nyquist frequency "
                 f"({0.5 * model.sample_rate_:g} Hz). Got {model.resonance_hz_:g}; identify "
                 "from a record sampled faster."
+            )
+        if model.resonance_hz_ < MIN_RESONANCE * model.sample_rate_:
+            raise InvalidParameterError(
+                f"The 'resonance_hz' parameter of {owner} must be at least "
+                f"{MIN_RESONANCE:g} of the sample rate ({MIN_RESONANCE * model.sample_rate_:g} "
+                f"Hz at {model.sample_rate_:g} Hz): slower, the resonance's poles cannot be "
+                f"told from 1 in double precision. Got {model.resonance_hz_:g}; identify the "
+                "dynamics from a record (hystcomp identify --model dynamics)."
+            )
+        if not DAMPING_RANGE[0] <= model.damping_ratio_ <= DAMPING_RANGE[1]:
+            raise InvalidParameterError(
+                f"The 'damping_ratio' parameter of {owner} must be in {DAMPING_RANGE[0]:g} .. "
+                f"{DAMPING_RANGE[1]:g} (outside, the resonance's poles leave double "
+                f"precision). Got {model.damping_ratio_:g}; identify the dynamics from a "
+                "record (hystcomp identify --model dynamics)."
             )
         if np.size(creep_time_constants) == 0 and np.size(creep_weights) == 0:  # no creep
             taus = weights = np.zeros(0)
