@@ -172,3 +172,24 @@ def test_command_refuses_a_file_as_output_folder(tmp_path):
     assert result.exit_code == 2
     assert "is a file, not a folder" in result.stderr
     assert len(result.stderr.strip().splitlines()) == 1
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["--out", ""], "empty path"),
+        (["--out", "{tmp}/missing/deeper"], "parent folder '{tmp}/missing' does not exist"),
+        (["--periods", "1000000000"], "(--periods) makes the 1 Hz reference 2e+13 samples long"),
+    ],
+)
+def test_command_refuses_before_any_work(tmp_path, monkeypatch, args, message):
+    def no_work(*_, **__):
+        raise AssertionError("the run started")
+
+    monkeypatch.setattr(compare_module, "identify_models", no_work)
+    monkeypatch.chdir(tmp_path)
+    args = [a.replace("{tmp}", str(tmp_path)) for a in args]
+    result = CliRunner().invoke(main, ["compare", "--quick", *args])
+    assert result.exit_code == 2, result.output
+    assert message.replace("{tmp}", str(tmp_path)) in result.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == []  # nothing created

@@ -6,7 +6,6 @@ import contextlib
 import functools
 import gc
 import time
-from pathlib import Path
 from typing import Any
 
 import click
@@ -20,7 +19,7 @@ from hystcomp.cli import main
     "out_dir",
     default="compare-out",
     show_default=True,
-    type=click.Path(path_type=Path),
+    type=click.Path(),  # text: click would read an empty path as "."
     help="Folder for table1.csv, hysteresis.csv, the figures and report.md.",
 )
 @click.option(
@@ -33,7 +32,7 @@ from hystcomp.cli import main
     help="Periods of each tracking reference (the first is not measured). [default: 3, 2 with --quick]",
 )
 @click.option("--quick", is_flag=True, help="A short run: 2 periods, four Preisach sinusoids.")
-def compare(out_dir: Path, seed: int, periods: int | None, quick: bool) -> None:
+def compare(out_dir: str, seed: int, periods: int | None, quick: bool) -> None:
     """Identify the Preisach, PI and MPI models on the twin and compare the four methods.
 
     Runs the paper's identification signals on the simulated axis, identifies the models,

@@ -25,6 +25,7 @@ from hystcomp.experiment.baseline import LinearCompensator, linear_gain
 from hystcomp.experiment.references import FREQUENCIES, REFERENCE_FRACTION, triangle_reference
 from hystcomp.experiment.tracking import TrackingResult, check_compensator, run_tracking
 from hystcomp.identify.excitation import (
+    MAX_SAMPLES,
     PREISACH_AMPLITUDES,
     sinusoid_sequence,
     triangle_sequence,
@@ -101,6 +102,14 @@ class CompareConfig:
             raise InvalidTypeError(
                 f"The 'twin' parameter of {owner} must be a TwinParameters. "
                 f"Got {type(self.twin).__name__}."
+            )
+        # the slowest reference is the longest: refused now, not after the identification
+        longest = self.periods * self.twin.sample_rate / min(self.frequencies)
+        if longest > MAX_SAMPLES:
+            raise InvalidParameterError(
+                f"The 'periods' parameter of {owner} (--periods) makes the {min(self.frequencies):g} "
+                f"Hz reference {longest:.3g} samples long, more than {MAX_SAMPLES:.0e}. Got "
+                f"{self.periods}; use at most {int(MAX_SAMPLES * min(self.frequencies) / self.twin.sample_rate)}."
             )
 
     @classmethod

@@ -109,15 +109,26 @@ def format_table(comparison) -> str:
 
 
 def prepare_output_dir(out_dir) -> Path:
-    """Create ``out_dir`` if needed; refuse a path that exists and is not a folder."""
+    """Create ``out_dir`` if needed; refuse a path that exists and is not a folder, an
+    empty path, and a folder whose parent does not exist (as ``-o`` refuses a file's)."""
+    if not os.fspath(out_dir):
+        raise InvalidParameterError(
+            "The output folder is an empty path. Name a folder for the results "
+            "(--out compare-out, or --out . for this folder)."
+        )
     path = Path(os.fspath(out_dir))
     if path.exists() and not path.is_dir():
         raise InvalidParameterError(
             f"The output folder {str(path)!r} exists and is a file, not a folder. "
             "Choose another --out path or remove the file."
         )
+    if not path.parent.is_dir():
+        raise InvalidParameterError(
+            f"Cannot create the output folder {str(path)!r}: its parent folder "
+            f"{str(path.parent)!r} does not exist. Create it first or choose another --out."
+        )
     try:
-        path.mkdir(parents=True, exist_ok=True)
+        path.mkdir(exist_ok=True)
     except OSError as exc:
         raise InvalidParameterError(
             f"Cannot create the output folder {str(path)!r}: {exc.strerror}. Choose another path."
