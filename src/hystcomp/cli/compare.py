@@ -5,6 +5,7 @@ from __future__ import annotations
 import contextlib
 import functools
 import gc
+import os
 import time
 from typing import Any
 
@@ -47,6 +48,13 @@ def compare(out_dir: str, seed: int, periods: int | None, quick: bool) -> None:
     from hystcomp.experiment.compare import CompareConfig, run_comparison
 
     start = time.perf_counter()
+    parent = os.path.dirname(os.path.abspath(out_dir)) if out_dir else "."
+    if not os.path.isdir(parent):  # as every -o refuses a file's missing folder
+        raise click.BadParameter(
+            f"the folder {out_dir!r} cannot be made: its parent folder {parent!r} does not "
+            "exist. Create it first or choose another --out.",
+            param_hint="'--out'",
+        )
     changes: dict[str, Any] = (
         {"seed": seed} if periods is None else {"seed": seed, "periods": periods}
     )

@@ -109,8 +109,8 @@ def format_table(comparison) -> str:
 
 
 def prepare_output_dir(out_dir) -> Path:
-    """Create ``out_dir`` if needed; refuse a path that exists and is not a folder, an
-    empty path, and a folder whose parent does not exist (as ``-o`` refuses a file's)."""
+    """Create ``out_dir`` (and its parents) if needed; refuse a path that exists and is
+    not a folder, and an empty path."""
     if not os.fspath(out_dir):
         raise InvalidParameterError(
             "The output folder is an empty path. Name a folder for the results "
@@ -122,13 +122,8 @@ def prepare_output_dir(out_dir) -> Path:
             f"The output folder {str(path)!r} exists and is a file, not a folder. "
             "Choose another --out path or remove the file."
         )
-    if not path.parent.is_dir():
-        raise InvalidParameterError(
-            f"Cannot create the output folder {str(path)!r}: its parent folder "
-            f"{str(path.parent)!r} does not exist. Create it first or choose another --out."
-        )
     try:
-        path.mkdir(exist_ok=True)
+        path.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise InvalidParameterError(
             f"Cannot create the output folder {str(path)!r}: {exc.strerror}. Choose another path."
