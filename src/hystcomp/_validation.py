@@ -19,6 +19,9 @@ from hystcomp.errors import InvalidParameterError, InvalidSignalError, InvalidTy
 #: Far beyond any actuator, and small enough that no sum or product of such numbers in the
 #: models overflows to inf (which could turn into a NaN output).
 MAX_MAGNITUDE = 1e12
+#: Longest signal that the excitations and the comparison make (1.6 GB of t and v); a
+#: request beyond is a mistake.
+MAX_SIGNAL_SAMPLES = 10**8
 
 
 def check_int(value, name: str, owner: str, *, minimum: int = 1, maximum: int | None = None) -> int:

@@ -40,7 +40,7 @@ CASES = [
     ("missing column", "identify no_x.csv --model pi -o {out}.json", r"no column 'x' .*--columns x=NAME"),
     ("NaN in the input", "identify nan.csv --model pi -o {out}.json", r"'v' .*non-finite value \(nan\) in data row 2"),
     ("time not increasing", "identify backwards.csv --model pi -o {out}.json", r"'t' .*not strictly increasing: data row 3"),
-    ("too few samples", "identify one.csv --model pi -o {out}.json", r"1 samples; at least 2"),
+    ("too few samples", "identify one.csv --model pi -o {out}.json", r"has 1 sample; at least 2"),
     ("constant input", "identify flat.csv --model pi -o {out}.json", r"'v' .* is constant \(5\.0 V\).*sweeps"),
     ("operators <= 0", "identify rec.csv --model pi --operators 0 -o {out}.json", r"'--operators': must be between 1 and 256"),
     ("operators > 256", "identify rec.csv --model mpi --deadzones 1000 -o {out}.json", r"'--deadzones': must be between 1 and 256 .*cube"),
@@ -72,6 +72,10 @@ CASES = [
     ("holdout leaves too few", "identify rec.csv --model pi --holdout 0.99 -o {out}.json", r"fewer than the \d+ needed.*'holdout' .*0\.99, leaves the first 8 of 801 samples .*smaller fraction"),
     ("regularization too large", "identify rec.csv --model mpi --regularization 1e308 -o {out}.json", r"'--regularization': must be 'auto' or a number from 0 to 1e\+12; got '1e308'"),
     ("--columns not read", "compensate model.json ref.csv --columns v=2 -o {out}.csv", r"'--columns': v=2 names a column of voltage, which this command does not read .* --columns x=2"),
+    ("excite: period too long", "excite mpi --frequency 1e-300 -o {out}.csv", r"one period at 1e-300 Hz is 2e\+304 samples at 20000 Hz, more than 1e\+08\. Raise the frequency"),
+    ("excite dynamics: rate too high", "excite dynamics --fs 1e12 -o {out}.csv", r"\(--fs\) makes the 6\.2 s signal 6\.2e\+12 samples long, .* use at most"),
+    ("export-c: huge --fs", "export-c model.json -o {out}_c --fs 1e308", r"'--fs': must be a finite number of size at most 1e\+12"),
+    ("export-c onto a file", "export-c model.json -o rec.csv", r"'rec\.csv': it exists and is not a folder"),
     ("--columns not read (sim)", "simulate model.json rec.csv --columns t=1,x=3 -o {out}.csv", r"'--columns': x=3 .*reads t and v.* --columns v=3"),
 ]  # fmt: skip
 

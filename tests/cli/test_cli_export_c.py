@@ -88,7 +88,7 @@ def test_missing_model_file_exits_2(tmp_path):
 def test_output_folder_without_parent_exits_2(model_file, tmp_path):
     result = _export(model_file, "-o", tmp_path / "a" / "b")
     assert result.exit_code == 2
-    assert "must be an existing folder" in result.output
+    assert "is not an existing folder" in result.output
 
 
 def test_failure_leaves_existing_files_untouched(tmp_path):

@@ -201,8 +201,10 @@ def test_output_folder_is_made_only_if_its_parent_exists(tmp_path):
     comp = hystcomp.presets.paper_pi().inverse()
     h, c = export_c(comp, tmp_path / "new")
     assert (h.name, c.name) == ("hystcomp_compensator.h", "hystcomp_compensator.c")
-    with pytest.raises(InvalidParameterError, match="parent 'missing' must be an existing"):
+    with pytest.raises(InvalidParameterError, match="parent 'missing' is not an existing folder"):
         export_c(comp, "missing/new")
+    with pytest.raises(InvalidParameterError, match="exists and is not a folder"):
+        export_c(comp, h)  # a file where the folder should be
 
 
 # --- Preisach compensators (eqs. 1-10): the bounded memory, eq. (10) and the exact inverse ---

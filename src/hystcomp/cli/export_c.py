@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 import click
@@ -14,17 +13,6 @@ from hystcomp.cli._options import method_option, method_options, positive
 from hystcomp.codegen import DEFAULT_PREFIX, check_prefix, export_c
 from hystcomp.io.atomic import check_output_path
 from hystcomp.io.models import load_model
-
-
-def _rate(ctx, param, value):
-    """``--fs``: a finite rate > 0 (it divides the slew-rate limit and the period)."""
-    if not (math.isfinite(value) and value > 0):
-        raise click.BadParameter(
-            f"must be a finite number > 0 (Hz, the rate at which NAME_step is called); "
-            f"got {value!r}.",
-            param=param,
-        )
-    return value
 
 
 @main.command("export-c")
@@ -58,7 +46,7 @@ def _rate(ctx, param, value):
     default=paper.SAMPLE_RATE,
     show_default=True,
     metavar="HZ",
-    callback=_rate,
+    callback=positive("Hz, the rate at which NAME_step is called"),
     help="Sample rate at which NAME_step is called; sets the slew step per sample.",
 )
 @method_option

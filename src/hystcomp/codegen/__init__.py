@@ -124,11 +124,16 @@ def export_c(
     )
     directory = Path(directory)
     if not directory.is_dir():
-        if directory.exists() or not directory.parent.is_dir():
+        if directory.exists():
             raise InvalidParameterError(
-                f"Cannot write the C files into {str(directory)!r}: it is not a folder and "
-                f"cannot be made (its parent {str(directory.parent)!r} must be an existing "
-                "folder). Create it first or choose another output folder."
+                f"Cannot write the C files into {str(directory)!r}: it exists and is not a "
+                "folder. Choose an output folder (it is made if its parent exists)."
+            )
+        if not directory.parent.is_dir():
+            raise InvalidParameterError(
+                f"Cannot write the C files into {str(directory)!r}: its parent "
+                f"{str(directory.parent)!r} is not an existing folder. Create it first or "
+                "choose another output folder."
             )
         directory.mkdir()
     paths = (directory / f"{prefix}.h", directory / f"{prefix}.c")

@@ -13,14 +13,14 @@ import itertools
 import numpy as np
 
 from hystcomp import paper
-from hystcomp._validation import as_vector, check_range, check_real
+from hystcomp._validation import MAX_SIGNAL_SAMPLES, as_vector, check_range, check_real
 from hystcomp.errors import InvalidParameterError
 
 DEFAULT_SAMPLE_RATE = paper.SAMPLE_RATE  # Hz, the paper's rig (Section II)
 PI_AMPLITUDES = paper.PI_AMPLITUDES  # V, Section IV-A (ii)
 PREISACH_AMPLITUDES = paper.PREISACH_AMPLITUDES  # V, Section III-A (i)
 MIN_SAMPLES_PER_PERIOD = 4  # fewer cannot draw a triangle or a sinusoid
-MAX_SAMPLES = 10**8  # 1.6 GB of t and v; beyond that the request is a mistake
+MAX_SAMPLES = MAX_SIGNAL_SAMPLES  # the excitations never make a longer signal
 
 
 def _periods(owner, amplitudes, sample_rate, frequency, v_min):
@@ -34,6 +34,12 @@ def _periods(owner, amplitudes, sample_rate, frequency, v_min):
     v_min = check_real(v_min, "v_min", owner)
     sample_rate = check_real(sample_rate, "sample_rate", owner, positive=True)
     frequency = check_real(frequency, "frequency", owner, positive=True)
+    if sample_rate / frequency > MAX_SAMPLES:
+        raise InvalidParameterError(
+            f"{owner}: one period at {frequency:g} Hz is {sample_rate / frequency:.3g} samples "
+            f"at {sample_rate:g} Hz, more than {MAX_SAMPLES:.0e}. Raise the frequency or "
+            "lower the sample rate."
+        )
     n = round(sample_rate / frequency)
     if n < MIN_SAMPLES_PER_PERIOD:
         raise InvalidParameterError(

@@ -433,7 +433,8 @@ def read_table(
     n = next(iter(lengths.values()))
     if n < min_samples:
         raise DataFileError(
-            f"Data file {str(path)!r} has {n} samples; at least {min_samples} are needed."
+            f"Data file {str(path)!r} has {n} sample{'' if n == 1 else 's'}; at least "
+            f"{min_samples} are needed."
         )
     out["t"] = _time(path, out.get("t"), n, sample_rate)
     for arr in out.values():
