@@ -198,7 +198,7 @@ def test_the_most_extreme_accepted_inverse_stays_finite_and_in_range():
 def test_excitation_signals_validate_their_arguments():
     with pytest.raises(InvalidParameterError, match=r"2 samples per period .* at least 4"):
         triangle_sequence(sample_rate=2.0)
-    with pytest.raises(InvalidParameterError, match=r"more than 100000000"):
+    with pytest.raises(InvalidParameterError, match=r"more than 1e\+08"):
         sinusoid_sequence(sample_rate=1e9)
     with pytest.raises(InvalidParameterError, match=r"'amplitudes' .* >= 0 V"):
         triangle_sequence([10.0, -5.0])

@@ -106,7 +106,7 @@ EXTENDED = [
     ("reversed voltage range", "compensate model.json ref.csv --voltage-range 50 10 -o {out}.csv", r"LO < HI"),
     ("slew rate inf", "compensate model.json ref.csv --slew-rate inf -o {out}.csv", r"finite number"),
     ("reference = output", "compensate model.json ref.csv -o ref.csv", r"it is the input file 'ref\.csv'"),
-    ("excite: too many samples", "excite pi --fs 1e11 -o {out}.csv", r"more than 100000000"),
+    ("excite: too many samples", "excite pi --fs 1e11 -o {out}.csv", r"more than 1e\+08"),
     ("excite: too few per period", "excite pi --fs 2 -o {out}.csv", r"at least 4 are needed"),
     ("excite: reversed range", "excite mpi --voltage-range 10 5 -o {out}.csv", r"LO < HI"),
     ("unknown command", "nosuchcommand", r"No such command 'nosuchcommand'"),

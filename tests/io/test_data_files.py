@@ -86,7 +86,7 @@ def _csv(tmp_path, text, name="rec.csv"):
     [
         ("t,v,x\n0,0,1\n1,nan,2\n2,1,3\n", {}, r"'v'.*non-finite value \(nan\) in data row 2"),
         ("t,v,x\n0,0,1\n1,1,2\n1,2,3\n", {}, r"not strictly increasing: data row 3 has t = 1"),
-        ("t,v,x\n0,0,1\n", {}, r"1 samples; at least 2"),
+        ("t,v,x\n0,0,1\n", {}, r"has 1 sample; at least 2"),
         ("t,v,x\n0,0,1\n1,0,2\n2,0,3\n", {}, r"'v' of .* is constant \(0\.0 V\)"),
         ("t,v\n0,0\n1,1\n", {}, r"no column 'x' .*columns are t, v.*--columns x=NAME"),
         ("v,x\n0,1\n1,2\n", {}, r"no time column 't'.*--fs HZ"),

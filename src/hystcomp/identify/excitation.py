@@ -51,7 +51,7 @@ def _periods(owner, amplitudes, sample_rate, frequency, v_min):
         raise InvalidParameterError(
             f"{owner}: {amplitudes.size} periods of {n} samples ({sample_rate:g} Hz at "
             f"{frequency:g} Hz) make {n * amplitudes.size + 1} samples, more than "
-            f"{MAX_SAMPLES}. Lower the sample rate or raise the frequency."
+            f"{MAX_SAMPLES:.0e}. Lower the sample rate or raise the frequency."
         )
     return amplitudes, v_min, np.arange(n) / n
 
@@ -202,7 +202,7 @@ def _ramps(points, rate, sample_rate, owner) -> tuple[np.ndarray, np.ndarray]:
     if float(np.sum(np.abs(np.diff(points)))) / step > MAX_SAMPLES:
         raise InvalidParameterError(
             f"{owner}: a rate of {rate:g} V/s at {sample_rate:g} Hz makes more than "
-            f"{MAX_SAMPLES} samples. Raise the rate or lower the sample rate."
+            f"{MAX_SAMPLES:.0e} samples. Raise the rate or lower the sample rate."
         )
     pieces = []
     for lo, hi in itertools.pairwise(points):
