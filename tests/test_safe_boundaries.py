@@ -175,8 +175,11 @@ def test_inverse_refuses_partial_sums_too_close_to_zero_naming_the_index():
         model.inverse()
     assert err.value.index == 2
     tiny = hystcomp.PrandtlIshlinskii.from_parameters(thresholds=[0], weights=[1e-30])
-    with pytest.raises(NotInvertibleError, match=r"index 0"):
+    with pytest.raises(NotInvertibleError, match=r"the first weight w_0 = 1e-30 .*index 0"):
         tiny.inverse()
+    second = hystcomp.PrandtlIshlinskii.from_parameters(thresholds=[0, 1], weights=[1.0, -1.0])
+    with pytest.raises(NotInvertibleError, match=r"weights w_0 \+ w_1 = 0 .*index 1"):
+        second.inverse()
 
 
 def test_the_most_extreme_accepted_inverse_stays_finite_and_in_range():

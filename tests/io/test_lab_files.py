@@ -309,3 +309,24 @@ def test_the_unit_warning_asks_to_check_a_unit_the_user_gave_instead_of_suggesti
     assert "give --x-unit" not in given
     assert "give --x-unit nm" in x_unit_warning([0.0, 3.7e7], "rec.csv")
     assert x_unit_warning([0.0, 37.0], "rec.csv", "m") is None
+
+
+def test_files_that_are_not_npz_or_hold_nothing_are_named_so(tmp_path):
+    text = tmp_path / "text.npz"
+    text.write_text("t,v,x\n0,1,2\n")  # numpy would speak of pickled data and allow_pickle
+    single = tmp_path / "single.npz"
+    with single.open("wb") as file:
+        np.save(file, np.arange(5.0))
+    empty_npz, empty_mat = tmp_path / "empty.npz", tmp_path / "empty.mat"
+    np.savez(empty_npz)
+    scipy.io.savemat(empty_mat, {})
+    cases = [
+        (text, r"'.*text\.npz' is not a NumPy \.npz file: it is not a zip archive"),
+        (single, r"it holds a single \.npy array, not named arrays"),
+        (empty_npz, r"'.*empty\.npz' holds no columns"),
+        (empty_mat, r"'.*empty\.mat' holds no columns"),
+    ]
+    for path, message in cases:
+        with pytest.raises(DataFileError, match=message) as caught:
+            read_record(path)
+        assert "pickle" not in str(caught.value)

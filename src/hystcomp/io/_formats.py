@@ -106,6 +106,18 @@ def _read_npz(path: Path):
     """Names and arrays of an NPZ file (never unpickling)."""
     try:
         with path.open("rb") as file:  # our handle: closed whatever numpy does
+            if file.read(4) not in (b"PK\x03\x04", b"PK\x05\x06"):  # a zip, maybe empty
+                file.seek(0)
+                what = (
+                    "holds a single .npy array, not named arrays"
+                    if file.read(6) == b"\x93NUMPY"
+                    else "is not a zip archive, which an .npz file is"
+                )
+                raise DataFileError(
+                    f"Data file {str(path)!r} is not a NumPy .npz file: it {what}. Write it "
+                    "with numpy.savez (named arrays t, v, x)."
+                )
+            file.seek(0)
             _check_npz_headers(path, file, max_samples())
             loaded = np.load(file, allow_pickle=False)
             if not isinstance(loaded, np.lib.npyio.NpzFile):

@@ -246,6 +246,8 @@ def _pick(path: Path, raw: _Raw, key: str, spec, required: bool):
     if index is None:
         if not required and spec is None:
             return None, ""
+        if not names:
+            raise DataFileError(f"{where} holds no columns (no named arrays or variables).")
         raise DataFileError(
             f"{where} has no column {label!r} for {key!r} ({MEANINGS[key]}); its columns "
             f"are {', '.join(map(str, names))}. Name the right one, e.g. --columns {key}=NAME."

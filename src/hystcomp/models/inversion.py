@@ -36,7 +36,7 @@ def check_invertible(weights: np.ndarray, what: str) -> None:
     if not partial.min() > 0:  # also NaN; the index is looked for only on a refusal
         i = int(np.flatnonzero(~(partial > 0))[0])
         raise NotInvertibleError(
-            f"{what} is not invertible: the partial sum of weights w_0 + ... + w_{i} = "
+            f"{what} is not invertible: {_partial_sum(i)} = "
             f"{partial[i]:.6g} is not positive (index {i}). Eqs. 24-26 need every partial sum "
             f"> 0: identify the model with the invertibility constraint, or change weights[{i}].",
             index=i,
@@ -48,13 +48,24 @@ def check_invertible(weights: np.ndarray, what: str) -> None:
     if not gains.max() <= MAX_INVERSE_WEIGHT:
         i = int(np.flatnonzero(~(gains <= MAX_INVERSE_WEIGHT))[0])
         raise NotInvertibleError(
-            f"{what} is not invertible in floating point: the partial sum of weights "
-            f"w_0 + ... + w_{i} = {partial[i]:.6g} is so close to 0 that the inverse weight "
+            f"{what} is not invertible in floating point: {_partial_sum(i)} = "
+            f"{partial[i]:.6g} is so close to 0 that the inverse weight "
             f"w'_{i} of eq. 25 would be {gains[i]:.3g} in size (index {i}; at most "
             f"{MAX_INVERSE_WEIGHT:g}). Identify the model with the invertibility constraint, "
             f"or change weights[{i}].",
             index=i,
         )
+
+
+def _partial_sum(i: int) -> str:
+    """How the messages name the partial sum of the weights up to index ``i``."""
+    if i == 0:
+        return "the first weight w_0"
+    return (
+        "the partial sum of weights w_0 + w_1"
+        if i == 1
+        else (f"the partial sum of weights w_0 + ... + w_{i}")
+    )
 
 
 def invert_superposition(

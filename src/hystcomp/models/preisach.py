@@ -454,7 +454,7 @@ class Preisach(HysteresisModel):
                 raise InvalidParameterError(
                     f"This {owner} model's average slope X(v_max, v_min) / (v_max - v_min) = "
                     f"{rho:.6g} µm/V is not positive, so it gives no gain for eq. (10). "
-                    "Refit the model or pass rho= explicitly."
+                    "Refit the model (or, from Python, pass rho= to inverse)."
                 )
         else:
             rho = check_real(rho, "rho", f"{owner}.inverse", positive=True)
