@@ -96,6 +96,7 @@ def _csv(tmp_path, text, name="rec.csv"):
         ("t,v,x\n", {}, r"header but no data rows"),
         ("", {}, r"is empty"),
         ("t,v,x\n0,0,1\n1,1,2\n", {"columns": {"v": 7}}, r"3 columns; column 7 for 'v'"),
+        ("t,v,x\ns,V,furlong\n0,0,1\n1,1,2\n", {}, r"units row \(s, V, furlong\), but 'furlong'"),
     ],
 )
 def test_bad_files_are_refused_with_file_column_and_fix(tmp_path, text, kwargs, match):
@@ -103,6 +104,11 @@ def test_bad_files_are_refused_with_file_column_and_fix(tmp_path, text, kwargs, 
     with pytest.raises(DataFileError, match=match) as err:
         read_record(path, **kwargs)
     assert "rec.csv" in str(err.value)
+
+
+def test_a_title_line_above_the_header_is_no_units_row(tmp_path):
+    path = _csv(tmp_path, "run 3, stage x\nt,v,x\n0,0,1\n1,1,2\n2,0,3\n")
+    assert read_record(path).v.tolist() == [0.0, 1.0, 0.0]
 
 
 def test_headerless_text_without_column_names_says_how(tmp_path):

@@ -101,6 +101,20 @@ def _delimiter(line: str) -> str | None:
     return None
 
 
+def _unknown_units(rows: list[list[str]]) -> list[str]:
+    """The tokens of ``rows[1]`` that are no unit, if it reads as a units row under the
+    header ``rows[0]`` (the header names more of t, v, x than the row, and the row holds a
+    known unit); else []."""
+    header = [tok.strip(" \t\"'").lower() for tok in rows[0]]
+    below = [tok.strip(_STRIP) for tok in rows[1]]
+    named = sum(tok in ("t", "v", "x") for tok in header)
+    if named <= sum(tok.lower() in ("t", "v", "x") for tok in below):  # ("V" is a unit too)
+        return []
+    if not any(tok.lower() in _ALL_UNITS for tok in below):
+        return []
+    return [tok for tok in below if tok and tok.lower() not in _ALL_UNITS]
+
+
 def _is_units(tokens: list[str]) -> bool:
     return all(tok.strip(_STRIP).lower() in _ALL_UNITS or not tok.strip(_STRIP) for tok in tokens)
 
@@ -187,6 +201,13 @@ def _header(path: Path, above, delimiter, n: int):
     units = None
     if len(rows) == 2 and _is_units(rows[1]) and not _is_units(rows[0]):
         units = [tok.strip(_STRIP) for tok in rows[1]]
+    elif len(rows) == 2 and len(rows[0]) == n and _unknown_units(rows):
+        raise DataFileError(
+            f"Data file {str(path)!r} has a row below its header that looks like a units row "
+            f"({', '.join(rows[1])}), but {', '.join(map(repr, _unknown_units(rows)))} is not "
+            "a unit hystcomp knows. Write the units as s, V and µm (um, m, mm, nm), or "
+            "remove the row."
+        )
     names = [tok.strip(" \t\"'") for tok in (rows[0] if units is not None else rows[-1])]
     split = [_NAME_UNIT.fullmatch(name) for name in names]
     if any(split):  # "t [s]", "x (um)": the name and its unit
