@@ -265,7 +265,8 @@ def test_chunked_read_and_write_round_trip_across_chunks(tmp_path, rng, monkeypa
     for key in "tvx":
         np.testing.assert_array_equal(read_table(path)[key], table[key])
     path.write_text("\n".join([*lines[:1500], "1,2", *lines[1500:]]) + "\n")
-    with pytest.raises(DataFileError, match=r"not a table of numbers.*after data row"):
+    # the row counted in the file's data rows across chunks (1-based, as elsewhere)
+    with pytest.raises(DataFileError, match=r"numbers \(data row 1500 has 2 columns, not 4\)"):
         read_table(path)
 
 

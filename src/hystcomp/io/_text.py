@@ -347,10 +347,26 @@ def _parse(text: str, layout: Layout, where: str, before: int) -> np.ndarray:
 
 
 def _reason(exc: Exception, before: int) -> str:
+    """numpy's reason, its rows as the file's data rows (1-based, as the other messages
+    count them); ``before`` data rows came before this chunk."""
     text = str(exc).strip().splitlines()[0][:160] if str(exc).strip() else type(exc).__name__
-    if before:  # numpy counts the lines of the chunk: say which chunk
+    # numpy counts the chunk's data rows: from 0 in a conversion error, from 1 in a change
+    # of the column count (whose advice on `usecols`, a numpy argument, is dropped)
+    text = re.sub(
+        r"at row (\d+), column (\d+)\.?",
+        lambda m: f"in data row {before + int(m[1]) + 1}, column {m[2]}",
+        text,
+    )
+    text = re.sub(
+        r"the number of columns changed from (\d+) to (\d+) at row (\d+);.*",
+        lambda m: f"data row {before + int(m[3])} has {m[2]} columns, not {m[1]}",
+        text,
+    )
+    if before:  # any other row numbers: in the chunk after ``before`` data rows
         text = re.sub(
-            r"\b(row|line) (\d+)", lambda m: f"{m[1]} {m[2]} after data row {before}", text
+            r"(?<!data )\b(row|line) (\d+)",
+            lambda m: f"{m[1]} {m[2]} after data row {before}",
+            text,
         )
     return text
 
