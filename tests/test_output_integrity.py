@@ -304,3 +304,18 @@ def test_sigterm_to_a_running_command_exits_143_and_removes_temporaries(files):
     assert "Traceback" not in err
     assert out.read_text() == "old\n"
     assert _hidden(files) == []
+
+
+@pytest.mark.skipif(not Path("/proc/self/fd").is_dir(), reason="needs /proc")
+def test_a_pipe_named_through_proc_fd_is_refused_before_any_work():
+    """``-o /dev/stdout`` in a pipeline: a link to ``pipe:[...]``, which realpath cannot
+    follow; the check must still see a pipe, not a new file in /proc/self/fd."""
+    from hystcomp.io.atomic import check_output_path
+
+    read, write = os.pipe()
+    try:
+        with pytest.raises(OutputPathError, match=r"a device, a pipe or a socket"):
+            check_output_path(f"/proc/self/fd/{write}", what="model file")
+    finally:
+        os.close(read)
+        os.close(write)

@@ -55,7 +55,8 @@ def check_output_path(path: str | os.PathLike, *, inputs=(), what: str = "output
             f"e.g. {str(path / 'out')!r} with a suffix."
         )
     target = write_target(path)
-    if target.exists() and not target.is_file():
+    # (the path itself too: /dev/stdout names a pipe through a link realpath cannot follow)
+    if (target.exists() and not target.is_file()) or (path.exists() and not path.is_file()):
         raise OutputPathError(
             f"Cannot write the {what} {str(path)!r}: it is a device, a pipe or a socket, not "
             "a regular file, and replacing it would break whatever uses it. Choose a file."
