@@ -40,7 +40,8 @@ def state_start(p):
     return HEADER + int(p[N_FIR]) + 2 * int(p[N_CREEP])
 
 
-def clamped_slot(p) -> int:
+@kernel
+def clamped_slot(p):
     """Index of the count of clamped outputs (the last slot)."""
     return HEADER + 2 * int(p[N_FIR]) + 3 * int(p[N_CREEP])
 
@@ -89,7 +90,7 @@ def inverse_run(p, u, out):
 @kernel
 def inverse_run_cuts(p, u, out, cuts):
     """:func:`inverse_run`, and ``cuts[k]`` True where the clamp counted sample ``k``."""
-    slot = HEADER + 2 * int(p[N_FIR]) + 3 * int(p[N_CREEP])
+    slot = clamped_slot(p)
     for k in range(u.size):
         before = p[slot]
         out[k] = inverse_step(p, u[k])

@@ -19,13 +19,12 @@ from collections.abc import Callable
 
 import numpy as np
 
-from hystcomp._validation import check_int, check_real
+from hystcomp._validation import MAX_SIGNAL_SAMPLES, check_int, check_real
 from hystcomp.errors import InvalidParameterError, InvalidTypeError
 from hystcomp.experiment.baseline import LinearCompensator, linear_gain
 from hystcomp.experiment.references import FREQUENCIES, REFERENCE_FRACTION, triangle_reference
 from hystcomp.experiment.tracking import TrackingResult, check_compensator, run_tracking
 from hystcomp.identify.excitation import (
-    MAX_SAMPLES,
     PREISACH_AMPLITUDES,
     sinusoid_sequence,
     triangle_sequence,
@@ -105,11 +104,11 @@ class CompareConfig:
             )
         # the slowest reference is the longest: refused now, not after the identification
         longest = self.periods * self.twin.sample_rate / min(self.frequencies)
-        if longest > MAX_SAMPLES:
+        if longest > MAX_SIGNAL_SAMPLES:
             raise InvalidParameterError(
                 f"The 'periods' parameter of {owner} (--periods) makes the {min(self.frequencies):g} "
-                f"Hz reference {longest:.3g} samples long, more than {MAX_SAMPLES:.0e}. Got "
-                f"{self.periods}; use at most {int(MAX_SAMPLES * min(self.frequencies) / self.twin.sample_rate)}."
+                f"Hz reference {longest:.3g} samples long, more than {MAX_SIGNAL_SAMPLES:.0e}. Got "
+                f"{self.periods}; use at most {int(MAX_SIGNAL_SAMPLES * min(self.frequencies) / self.twin.sample_rate)}."
             )
 
     @classmethod

@@ -48,8 +48,7 @@ from hystcomp._lti import (
     resonance_response,
     resonance_zoh,
 )
-from hystcomp._validation import MAX_SIGNAL_SAMPLES as MAX_SAMPLES
-from hystcomp._validation import as_signal_pair, check_real
+from hystcomp._validation import MAX_SIGNAL_SAMPLES, as_signal_pair, check_real
 from hystcomp.errors import IdentificationError, InvalidParameterError
 
 
@@ -103,11 +102,11 @@ def dynamics_excitation(
     fs = check_real(sample_rate, "sample_rate", owner, positive=True)
     amplitude = check_real(amplitude, "amplitude", owner, positive=True)
     seconds = REST + HOLD + PERIODS * PERIOD
-    if seconds * fs > MAX_SAMPLES:
+    if seconds * fs > MAX_SIGNAL_SAMPLES:
         raise InvalidParameterError(
             f"The 'sample_rate' parameter of {owner} (--fs) makes the {seconds:g} s signal "
-            f"{seconds * fs:.3g} samples long, more than {MAX_SAMPLES:.0e}. Got {fs:g} Hz; use "
-            f"at most {MAX_SAMPLES / seconds:g} Hz."
+            f"{seconds * fs:.3g} samples long, more than {MAX_SIGNAL_SAMPLES:.0e}. Got {fs:g} Hz; use "
+            f"at most {MAX_SIGNAL_SAMPLES / seconds:g} Hz."
         )
     lo, hi = voltage_range
     bias = lo + BIAS_FRACTION * (hi - lo)

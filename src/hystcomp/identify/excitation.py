@@ -20,7 +20,6 @@ DEFAULT_SAMPLE_RATE = paper.SAMPLE_RATE  # Hz, the paper's rig (Section II)
 PI_AMPLITUDES = paper.PI_AMPLITUDES  # V, Section IV-A (ii)
 PREISACH_AMPLITUDES = paper.PREISACH_AMPLITUDES  # V, Section III-A (i)
 MIN_SAMPLES_PER_PERIOD = 4  # fewer cannot draw a triangle or a sinusoid
-MAX_SAMPLES = MAX_SIGNAL_SAMPLES  # the excitations never make a longer signal
 
 
 def _periods(owner, amplitudes, sample_rate, frequency, v_min):
@@ -34,10 +33,10 @@ def _periods(owner, amplitudes, sample_rate, frequency, v_min):
     v_min = check_real(v_min, "v_min", owner)
     sample_rate = check_real(sample_rate, "sample_rate", owner, positive=True)
     frequency = check_real(frequency, "frequency", owner, positive=True)
-    if sample_rate / frequency > MAX_SAMPLES:
+    if sample_rate / frequency > MAX_SIGNAL_SAMPLES:
         raise InvalidParameterError(
             f"{owner}: one period at {frequency:g} Hz is {sample_rate / frequency:.3g} samples "
-            f"at {sample_rate:g} Hz, more than {MAX_SAMPLES:.0e}. Raise the frequency or "
+            f"at {sample_rate:g} Hz, more than {MAX_SIGNAL_SAMPLES:.0e}. Raise the frequency or "
             "lower the sample rate."
         )
     n = round(sample_rate / frequency)
@@ -47,11 +46,11 @@ def _periods(owner, amplitudes, sample_rate, frequency, v_min):
             f"{frequency:g} Hz; at least {MIN_SAMPLES_PER_PERIOD} are needed. Raise the sample "
             "rate or lower the frequency."
         )
-    if n * amplitudes.size + 1 > MAX_SAMPLES:
+    if n * amplitudes.size + 1 > MAX_SIGNAL_SAMPLES:
         raise InvalidParameterError(
             f"{owner}: {amplitudes.size} periods of {n} samples ({sample_rate:g} Hz at "
             f"{frequency:g} Hz) make {n * amplitudes.size + 1} samples, more than "
-            f"{MAX_SAMPLES:.0e}. Lower the sample rate or raise the frequency."
+            f"{MAX_SIGNAL_SAMPLES:.0e}. Lower the sample rate or raise the frequency."
         )
     return amplitudes, v_min, np.arange(n) / n
 
@@ -199,10 +198,10 @@ def _ramps(points, rate, sample_rate, owner) -> tuple[np.ndarray, np.ndarray]:
     rate = check_real(rate, "rate", owner, positive=True)
     sample_rate = check_real(sample_rate, "sample_rate", owner, positive=True)
     step = rate / sample_rate
-    if float(np.sum(np.abs(np.diff(points)))) / step > MAX_SAMPLES:
+    if float(np.sum(np.abs(np.diff(points)))) / step > MAX_SIGNAL_SAMPLES:
         raise InvalidParameterError(
             f"{owner}: a rate of {rate:g} V/s at {sample_rate:g} Hz makes more than "
-            f"{MAX_SAMPLES:.0e} samples. Raise the rate or lower the sample rate."
+            f"{MAX_SIGNAL_SAMPLES:.0e} samples. Raise the rate or lower the sample rate."
         )
     pieces = []
     for lo, hi in itertools.pairwise(points):

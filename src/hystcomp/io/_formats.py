@@ -119,10 +119,7 @@ def _read_npz(path: Path):
                 )
             file.seek(0)
             _check_npz_headers(path, file, max_samples())
-            loaded = np.load(file, allow_pickle=False)
-            if not isinstance(loaded, np.lib.npyio.NpzFile):
-                raise TypeError("it holds a single .npy array, not named arrays")
-            with loaded as npz:
+            with np.load(file, allow_pickle=False) as npz:
                 arrays = {name: npz[name] for name in npz.files}
     except (MemoryError, DataFileError):
         raise

@@ -85,6 +85,15 @@ def _resonance_hz(a, sample_rate: float) -> float:
     return float(np.sqrt(np.abs(s[0] * s[1]))) / (2.0 * np.pi)
 
 
+def _run_ahead(stepper, x_ref, preview: int) -> np.ndarray:
+    """``stepper``'s outputs for a known reference, aligned with it: primed with its first
+    ``preview`` samples, and the reference held at its last value past its end."""
+    x = as_signal(x_ref, "x_ref")
+    stepper.prime(x[:preview])
+    tail = np.full(min(preview, x.size), x[-1])
+    return stepper.step_block(np.concatenate([x[preview:], tail]))
+
+
 class DynamicsInverse:
     """The inverse of :class:`~hystcomp.LinearDynamics`: reference (µm) in, the input ``D`` needs out.
 
@@ -141,20 +150,11 @@ class DynamicsInverse:
         The reference is held at its last value beyond its end; the filter starts at rest
         at :attr:`rest` and is primed with the first :attr:`preview` samples.
         """
-        return self.run(x_ref)[0]
+        return _run_ahead(self.stepper(), x_ref, self.preview)
 
     def stepper(self) -> DynamicsInverseStepper:
         """A streaming filter at rest."""
         return DynamicsInverseStepper(self._packed, self.preview)
-
-    def run(self, x_ref) -> tuple[np.ndarray, int]:
-        """:meth:`simulate`, and how many outputs the clamp to :attr:`output_range` cut
-        (the reference, with the dynamics inverted, is out of the model's reach there)."""
-        x = as_signal(x_ref, "x_ref")
-        s = self.stepper()
-        s.prime(x[: self.preview])
-        tail = np.full(min(self.preview, x.size), x[-1])
-        return s.step_block(np.concatenate([x[self.preview :], tail])), s.clamped_count
 
     def __repr__(self) -> str:
         return f"DynamicsInverse({self.taps.size} taps, preview={self.preview} samples)"
@@ -210,7 +210,7 @@ class DynamicsInverseStepper(Rebound):
     @property
     def clamped_count(self) -> int:
         """Outputs that the clamp to the displacement range cut since the last reset."""
-        return int(self._p[dk.clamped_slot(self._p)])
+        return int(self._p[dk.clamped_slot.py_func(self._p)])
 
     def copy(self) -> DynamicsInverseStepper:
         """An independent stepper in the same state."""
@@ -262,11 +262,8 @@ class DynamicCompensator:
         of the dynamics' clamp to the model's displacement range (a reference out of the
         model's reach, or creep to undo beyond it) or the voltage range's.
         """
-        x = as_signal(x_ref, "x_ref")
         s = self.stepper()
-        s.prime(x[: self.preview])
-        tail = np.full(min(self.preview, x.size), x[-1])
-        v = s.step_block(np.concatenate([x[self.preview :], tail]))
+        v = _run_ahead(s, x_ref, self.preview)
         return CompensatorRun(v, s.clamped_count, s.nonfinite_count)
 
     def stepper(self) -> DynamicStepper:
@@ -303,7 +300,7 @@ class DynamicStepper(Rebound):
         filter's count when last looked at."""
         dyn_step, hyst_step = self._dyn.step, self._hyst.step
         dyn_p, hyst_p, seen = self._dyn._p, self._hyst._p, self._seen
-        cuts, counted = dk.clamped_slot(dyn_p), self._hyst._clamped_slot
+        cuts, counted = dk.clamped_slot.py_func(dyn_p), self._hyst._clamped_slot
         low, high = float(dyn_p[dk.LOW]), float(dyn_p[dk.HIGH])
 
         def step(x_ref):
