@@ -319,7 +319,7 @@ if __name__ == "__main__":
             for f in FAST_FREQUENCIES:
                 cells = [best_floor(stage_dyn, c.reference_amplitude, f, d) for d in FALL_BACKS]
                 print(
-                    f"{stage}: {f:g} Hz, least rms (µm) for a fall-back of "
+                    f"{stage}: {f:g} Hz, least rms (µm), step response turning back by at most "
                     + ", ".join(f"{d:g}: {e:.3f}" for d, e in zip(FALL_BACKS, cells, strict=True))
                     + f"; hystcomp's FIR {fir_floor(stage_dyn, c.reference_amplitude, f):.3f}"
                     + f" (MPI's 1 Hz rms {base:.3f})"
