@@ -270,11 +270,14 @@ def test_a_signal_in_a_write_exits_128_plus_its_number_and_cleans_up(files, sig,
 
     monkeypatch.setattr("hystcomp.cli.compensate.write_table", signalled_write)
     previous = signal.signal(signal.SIGTERM, not_the_command)
+    # Ctrl-C as in a terminal: a run started in the background inherits SIGINT ignored
+    previous_int = signal.signal(signal.SIGINT, signal.default_int_handler)
     try:
         result = run("compensate", files / "m.json", files / "ref.csv", "-o", out)
         assert signal.getsignal(signal.SIGTERM) is not_the_command  # restored after the command
     finally:
         signal.signal(signal.SIGTERM, previous)
+        signal.signal(signal.SIGINT, previous_int)
     assert result.exit_code == code, result.output
     assert out.read_text() == "old\n"
     assert _hidden(files) == []
