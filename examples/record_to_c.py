@@ -72,7 +72,7 @@ def run_c(folder: Path, reference: np.ndarray) -> np.ndarray:
     if cc is None:
         raise SystemExit("record_to_c: no C compiler 'cc' on this machine")
     (folder / "driver.c").write_text(DRIVER)
-    program = folder / "drive"
+    program = folder.resolve() / "drive"  # cc runs in the folder: a relative path would nest
     build = [cc, *FLAGS, "-o", str(program), "stage.c", "driver.c", "-lm"]
     subprocess.run(build, cwd=folder, check=True)
     text = "\n".join(f"{x:.17g}" for x in reference)
