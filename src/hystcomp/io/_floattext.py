@@ -112,23 +112,26 @@ def _digits(a, dst):
     hi = u_int if u_fr > 0.0 or closed else u_int - 1
     if lo > hi:
         return -1
-    j = 0  # remove digits while the interval still holds a multiple of ten
-    q_lo, q_hi = lo, hi
+    # remove digits while the interval still holds a multiple of ten; every integer here is
+    # positive, and unsigned division by a constant compiles to a multiply and a shift
+    j = 0
+    q_lo, q_hi = np.uint64(lo), np.uint64(hi)
+    ten = np.uint64(10)
     while True:
-        up, down = (q_lo + 9) // 10, q_hi // 10
+        up, down = (q_lo + np.uint64(9)) // ten, q_hi // ten
         if up > down:
             break
         q_lo, q_hi = up, down
         j += 1
     div = _POW10[j]
-    q = c_int // div
+    q = np.int64(np.uint64(c_int) // np.uint64(div))
     rem = float(c_int - q * div) + c_fr
     half_div = 0.5 * float(div)
     if rem > half_div or (rem == half_div and q % 2 == 1):
         q += 1
     if not exact and abs(rem - half_div) < _EPS * float(div):
         return -1
-    q = min(max(q, q_lo), q_hi)
+    q = min(max(q, np.int64(q_lo)), np.int64(q_hi))
     n = 1
     while n < 19 and q >= _POW10[n]:
         n += 1
@@ -163,20 +166,40 @@ def _digits(a, dst):
     return pos + 2
 
 
+#: "00", "01", ..., "99": the digits are written two at a time.
+_PAIRS = np.frombuffer("".join(f"{i:02d}" for i in range(100)).encode(), dtype=np.uint8).copy()
+
+
+@_kernel
+def _fill(dst, end, u, count):
+    """The last ``count`` digits of ``u`` (uint64) into ``dst[end - count:end]``."""
+    pos = end
+    while count >= 2:
+        r = u % np.uint64(100)
+        u //= np.uint64(100)
+        pos -= 2
+        dst[pos] = _PAIRS[2 * r]
+        dst[pos + 1] = _PAIRS[2 * r + 1]
+        count -= 2
+    if count:
+        dst[pos - 1] = 48 + u % np.uint64(10)
+
+
 @_kernel
 def _put(dst, start, q, n, dot):
     """The ``n`` digits of ``q`` at ``dst[start:]``, a point before digit ``dot`` if
     ``0 < dot < n``; the end position."""
-    end = start + n + (1 if 0 < dot < n else 0)
-    pos = end - 1
-    for i in range(n - 1, -1, -1):
-        dst[pos] = 48 + q % 10
-        q //= 10
-        pos -= 1
-        if i == dot:
-            dst[pos] = 46
-            pos -= 1
-    return end
+    u = np.uint64(q)
+    if 0 < dot < n:
+        low = n - dot
+        div = np.uint64(_POW10[low])
+        end = start + n + 1
+        _fill(dst, end, u % div, low)
+        dst[end - low - 1] = 46
+        _fill(dst, end - low - 1, u // div, dot)
+        return end
+    _fill(dst, start + n, u, n)
+    return start + n
 
 
 @_kernel
