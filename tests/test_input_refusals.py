@@ -49,6 +49,8 @@ TAMPERED = [
     ("preisach", "grid_size", "x"),
     ("preisach-table", "grid_size", 9),
     ("preisach-table", "everett", "polynomial"),
+    ("preisach", "fit_method", "zzz"),
+    ("preisach", "fit_method", None),
     ("pi", "n_operators", 15),
     ("pi", "n_operators", 16.0),
     ("pi", "margin", "0.001"),

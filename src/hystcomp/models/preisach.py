@@ -23,7 +23,7 @@ from hystcomp._validation import (
 )
 from hystcomp.errors import InvalidParameterError, InvalidTypeError
 from hystcomp.identify.compensation import compensation_error
-from hystcomp.identify.preisach import identify_preisach
+from hystcomp.identify.preisach import FIT_METHODS, identify_preisach
 from hystcomp.identify.scoring import transient_end
 from hystcomp.models.base import DEFAULT_VOLTAGE_RANGE, HysteresisModel, slew_to_step
 from hystcomp.models.compensator import Compensator
@@ -298,6 +298,11 @@ class Preisach(HysteresisModel):
         owner = type(self).__name__
         check_options(self.degree, self.everett, self.grid_size, self.zero_diagonal, owner)
         check_int(self.max_extrema, "max_extrema", owner, minimum=3, maximum=pk.MAX_DEPTH)
+        if not isinstance(self.fit_method, str) or self.fit_method not in FIT_METHODS:
+            raise InvalidParameterError(
+                f"The 'fit_method' parameter of {owner} must be one of "
+                f"{', '.join(map(repr, FIT_METHODS))}. Got {self.fit_method!r} instead."
+            )
 
     def parameters(self) -> dict:
         """The learned parameters as plain Python values (``theta`` or ``table``)."""
