@@ -83,6 +83,18 @@ def test_a_holdout_beyond_the_fitted_range_is_a_warning():
     assert "hystcomp: warning" not in result.warnings[0]  # the command line adds the prefix
 
 
+def test_metres_read_as_micrometres_are_a_warning():
+    """A record in m read as µm fits (it is clean, only tiny), but a reference in µm would
+    then be out of reach at every sample: the result says so, as the command line does."""
+    rec = _loops(2.0)
+    metres = Record(rec.t, rec.v, rec.x * 1e-6, source="metres.csv")
+    result = identify_record(metres, "pi", operators=4)
+    assert result.warnings[0].startswith("the displacement in metres.csv spans ")
+    assert "looks like metres read as µm; if it is, give --x-unit m" in result.warnings[0]
+    assert identify_record(metres, "pi", operators=4, unit_check=False).warnings == []
+    assert identify_record(rec, "pi", operators=4).warnings == []
+
+
 def test_a_record_without_hysteresis_warns_that_a_line_does_as_well():
     rec = _loops(2.0)
     line = Record(rec.t, rec.v, 0.3 * rec.v, source="line")  # a straight line tracks exactly

@@ -269,6 +269,7 @@ def identify(
         transient=transient,
         holdout=holdout,
         progress=progress(f"identifying the {LABELS[kind]} model", quiet).ticking(),
+        unit_check=False,  # checked above, before the fit, and silenced by --quiet
     )
     for line in result.lines:
         click.echo(line)

@@ -24,6 +24,7 @@ from hystcomp import paper
 from hystcomp.errors import IdentificationError, InvalidParameterError, InvalidTypeError
 from hystcomp.identify.compensation import compensation_error
 from hystcomp.identify.scoring import error_report, holdout_report, transient_end
+from hystcomp.io.records import x_unit_warning
 from hystcomp.models.dynamics import LinearDynamics
 from hystcomp.models.mpi import ModifiedPrandtlIshlinskii
 from hystcomp.models.pi import PrandtlIshlinskii
@@ -276,6 +277,7 @@ def identify_record(
     transient: float | None = None,
     holdout: float | None = None,
     progress=None,
+    unit_check: bool = True,
     **options,
 ) -> IdentificationResult:
     """Fit a hysteresis model to a measured record and score it.
@@ -305,6 +307,10 @@ def identify_record(
         Fraction of the record, strictly between 0 and 1, held out at its end.
     progress : context manager, optional
         Entered around the fit, e.g. ``hystcomp._progress.Progress(...).ticking()``.
+    unit_check : bool, default True
+        Warn if the displacement's span looks like metres or nanometres read as µm
+        (:func:`hystcomp.io.records.x_unit_warning`); ``hystcomp identify`` checks before
+        the fit instead.
     **options
         ``operators``, ``deadzones``, ``regularization``, ``degree``, ``fit``,
         ``everett``, ``grid``, ``constraints``: see :func:`build_estimator`.
@@ -448,6 +454,9 @@ def identify_record(
         f"({tracking['ratio']:.2g}x)"
     )
     warnings = []
+    unit = x_unit_warning(record.x, str(record.source)) if unit_check else None
+    if unit is not None:  # the compensator would then clamp a reference in µm throughout
+        warnings.append(unit)
     if not tracking["ratio"] < 1.0:
         warnings.append(
             f"the {label} compensator is predicted to track no better than a straight line "
