@@ -131,6 +131,23 @@ def check_thresholds(value, name: str, owner: str) -> np.ndarray:
     return r
 
 
+def check_reachable_state(state: np.ndarray, thresholds: np.ndarray, owner: str) -> None:
+    """Play states that some input history leaves: neighbouring plays differ by no more than
+    their thresholds do, ``|y_(i+1) - y_i| <= r_(i+1) - r_i``. Eq. (26) inverts only such a
+    state; another one makes the inverse wrong until the input has swept it away."""
+    gap = np.abs(np.diff(state)) - np.diff(thresholds)
+    slack = 1e-9 * max(1.0, float(np.abs(state).max()), float(thresholds[-1]))
+    if gap.size and gap.max() > slack:
+        i = int(np.argmax(gap))
+        raise InvalidParameterError(
+            f"The 'initial_state' parameter of {owner} is not a state the plays can reach: "
+            f"entries {i} and {i + 1} differ by {abs(float(state[i + 1] - state[i])):.6g} V, "
+            f"more than their thresholds ({float(thresholds[i + 1] - thresholds[i]):.6g} V). "
+            "Neighbouring plays may differ by at most the difference of their thresholds; "
+            "leave the state out for eq. 18's zero start."
+        )
+
+
 def as_path(value, name: str, owner: str) -> Path:
     """Return ``value`` (a str or path-like) as a Path, or raise a message that names it."""
     try:

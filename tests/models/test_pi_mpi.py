@@ -220,3 +220,24 @@ def test_stepper_method_and_bound_step_agree(rng):
     twin = a.copy()  # a copy binds its own state
     assert twin.step(1.0) == a.step(1.0)
     assert twin.step(30.0) == a.step(30.0)
+
+
+@pytest.mark.parametrize(
+    ("cls", "extra"),
+    [
+        (hystcomp.PrandtlIshlinskii, {}),
+        (
+            hystcomp.ModifiedPrandtlIshlinskii,
+            {"deadzone_thresholds": [0.0, 20.0], "deadzone_weights": [1.0, -0.3]},
+        ),
+    ],
+)
+def test_a_play_state_no_input_can_leave_is_refused(cls, extra):
+    """Eq. 26 inverts only reachable states: neighbours differ by at most their thresholds."""
+    r = np.array([0.0, 10.0, 20.0])
+    plays = {"thresholds": r, "weights": [1.0, 0.5, 0.5], **extra}
+    model = cls.from_parameters(**plays, initial_state=5.0 + r)  # descended to 5 V: on the bound
+    v = np.r_[np.linspace(5.0, 60.0, 50), np.linspace(60.0, 30.0, 30)]
+    np.testing.assert_allclose(model.inverse().simulate(model.simulate(v)), v, atol=1e-9)
+    with pytest.raises(InvalidParameterError, match=r"'initial_state'.*entries 1 and 2"):
+        cls.from_parameters(**plays, initial_state=[0.0, 0.0, 10.5])

@@ -15,7 +15,14 @@ import numpy as np
 from hystcomp import paper
 from hystcomp._hyperparameters import check_constraints, check_margin, check_operator_count
 from hystcomp._kernels import chain
-from hystcomp._validation import as_vector, check_int, check_range, check_real, check_thresholds
+from hystcomp._validation import (
+    as_vector,
+    check_int,
+    check_range,
+    check_reachable_state,
+    check_real,
+    check_thresholds,
+)
 from hystcomp.identify.compensation import CV_FOLDS, tracking_scorer
 from hystcomp.identify.pi import fit_pi, paper_thresholds
 from hystcomp.identify.scoring import error_report
@@ -62,13 +69,14 @@ class PrandtlIshlinskii(HysteresisModel):
         ``"physical"``: the weights beyond the first are also non-negative, so the loops
         widen with amplitude and the inverse has no steep slopes, and every part of the
         input range weighs the same in the fit (deviations from the paper, see
-        :mod:`hystcomp.identify.pi`); ``"paper"``: the partial-sum constraints of eq. (12)
-        only, over every sample alike.
+        :mod:`hystcomp.identify.pi`); ``"paper"``: eq. (12) with only the partial sums of
+        the weights kept positive, over every sample alike.
 
     Attributes
     ----------
     thresholds_ : ndarray
-        Play thresholds ``0 = r_0 < ... < r_n`` in V (eq. 16 when identified).
+        Play thresholds ``0 = r_0 < ... < r_n`` in V (identified: eq. 16 with
+        ``constraints="paper"``, over half the input span with the physical default).
     weights_ : ndarray
         Play weights in µm/V.
     initial_state_ : ndarray
@@ -232,7 +240,9 @@ class PrandtlIshlinskii(HysteresisModel):
             zeros.setflags(write=False)
             self.initial_state_ = zeros
         else:
-            self.initial_state_ = as_vector(initial_state, "initial_state", owner, length=r.size)
+            y = as_vector(initial_state, "initial_state", owner, length=r.size)
+            check_reachable_state(y, r, owner)
+            self.initial_state_ = y
 
     def _set_offsets(self, owner: str, voltage_range, input_offset, output_offset) -> None:
         """Validate and set ``voltage_range_``, ``input_offset_`` and ``output_offset_``."""
