@@ -16,7 +16,8 @@ from hystcomp.errors import InvalidParameterError, InvalidTypeError
 #: Default relative invertibility margin of the PI/MPI fits.
 DEFAULT_MARGIN = 1e-3
 
-#: The constraint sets of the PI/MPI fits: the default, and eq. (12)/(19) as printed.
+#: The constraint sets of the fits: the default, and the paper's (eqs. 12/19 with the
+#: partial sums of the play weights positive; eq. 5 fitted free).
 CONSTRAINTS = ("physical", "paper")
 
 #: Highest degree of the Everett polynomial (eq. 5 is degree 3).
@@ -59,8 +60,9 @@ def check_constraints(constraints, owner: str) -> str:
     if constraints not in CONSTRAINTS:
         raise InvalidParameterError(
             f"The 'constraints' parameter of {owner} must be one of {CONSTRAINTS} "
-            f"('physical': non-negative play weights, the default; 'paper': the partial-sum "
-            f"constraints of eqs. 12/19 only). Got {constraints!r} instead."
+            f"('physical', the default: non-negative play weights beyond the first, and for a "
+            f"Preisach model X(v, v) = 0; 'paper': only what the paper's fits keep, the "
+            f"partial sums of the play weights positive). Got {constraints!r} instead."
         )
     return constraints
 

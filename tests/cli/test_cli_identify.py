@@ -212,6 +212,26 @@ def test_preisach_through_every_command(tmp_path):
     assert np.abs(model.simulate(v4) - x_ref)[1000:].max() < 1e-6
 
 
+def test_constraints_paper_is_the_papers_preisach_fit_of_eq_5(tmp_path):
+    """Eq. 6 as printed (X(v, v) != 0) is recovered by the paper's fit, coefficient by
+    coefficient; the default holds X(v, v) = 0 and so cannot be."""
+    true = presets.paper_preisach()
+    assert run("excite", "preisach", "-o", tmp_path / "v.csv", "--fs", "500").exit_code == 0
+    v = read_table(tmp_path / "v.csv", ("v",))["v"]
+    write_table(
+        tmp_path / "rec.csv", {"t": np.arange(v.size) / 500.0, "v": v, "x": true.simulate(v)}
+    )
+    args = ["identify", tmp_path / "rec.csv", "--model", "preisach", "--degree", "3"]
+    args += ["--fit", "reversal-curves"]
+    assert run(*args, "--constraints", "paper", "-o", tmp_path / "paper.json").exit_code == 0
+    assert run(*args, "-o", tmp_path / "physical.json").exit_code == 0
+    printed = hystcomp.load_model(tmp_path / "paper.json")
+    np.testing.assert_allclose(printed.theta_, true.theta_, rtol=1e-3, atol=1e-9)
+    held = hystcomp.load_model(tmp_path / "physical.json")
+    assert abs(float(held.everett_function(120.0, 120.0))) < 1e-9
+    assert abs(float(printed.everett_function(120.0, 120.0))) > 1e-3
+
+
 def test_compensate_method_is_for_preisach_models_only(tmp_path):
     hystcomp.save_model(presets.paper_mpi(), tmp_path / "m.json")
     write_table(tmp_path / "ref.csv", {"t": np.arange(10) / 100.0, "x": np.linspace(1, 9, 10)})

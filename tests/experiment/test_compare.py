@@ -151,6 +151,11 @@ def test_real_quick_comparison():
         assert max(rms["pi"], rms["mpi"]) < rms["uncompensated"] / 1.4
         if f < 50:  # the asymmetric model beats the symmetric one (the paper's point)
             assert rms["mpi"] < rms["pi"]
+    # Table I's Preisach fit holds X(v, v) = 0 (eq. 2); the report's "as printed" one does not
+    assert set(c.paper_fit) == {"preisach", "pi", "mpi"}
+    printed = compare_module.paper_fits(c.record_pi, c.record_preisach, c.config)["preisach"]
+    assert c.models["preisach"].fit_report_["diagonal_max_um"] < 1e-9
+    assert printed.fit_report_["diagonal_max_um"] > 1e-3
 
 
 def test_command_writes_the_files_and_prints_the_table(tmp_path, monkeypatch):

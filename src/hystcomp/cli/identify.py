@@ -106,7 +106,8 @@ def _regularization(ctx, param, value):
     help="How the preisach model is fitted [least-squares]: least-squares fits the model's "
     "output over any record that sweeps the range, with a non-negative Preisach density; "
     "reversal-curves fits X to first-order descending curves (the record of `hystcomp excite "
-    "preisach`), with --everett polynomial the paper's fit of eq. 5 (Section III-A); auto takes "
+    "preisach`), with --everett polynomial and --constraints paper the paper's fit of eq. 5 "
+    "(Section III-A); auto takes "
     "the reversal curves when the record has them from 8 or more maxima, else least squares.",
 )
 @click.option(
@@ -138,8 +139,10 @@ def _regularization(ctx, param, value):
     help="pi, mpi: 'physical' [default]: play weights beyond the first are non-negative, so "
     "the loops widen with amplitude and the inverse has no steep slopes, and the play "
     "thresholds span half the input range, where plays can move (pi: and every part of the "
-    "input range weighs the same in the fit); 'paper': eq. 16's thresholds and only the "
-    "partial-sum constraints of eq. 12 / eq. 19 as printed.",
+    "input range weighs the same in the fit); 'paper': eq. 16's thresholds, eq. 12 / eq. 19 "
+    "with only the invertibility constraints (every partial sum of the weights positive). "
+    "preisach: 'physical' [default] holds X(v, v) = 0, as eq. 2 implies; 'paper' fits eq. 5's "
+    "coefficients free (with --fit reversal-curves --everett polynomial).",
 )
 @columns_option
 @fs_option
@@ -210,7 +213,8 @@ def identify(
     PI and MPI: constrained least squares (eqs. 16-19) with invertible weights; the
     start-up transient, the input range (bipolar too) and a displacement offset are handled.
     Preisach: least squares over any record with a tabulated Everett function by default;
-    --fit reversal-curves --everett polynomial is the paper's fit (Section III-A, eq. 5). dynamics (beyond the paper): creep and first resonance from the answer to
+    --fit reversal-curves --everett polynomial --constraints paper is the paper's fit (Section
+    III-A, eq. 5). dynamics (beyond the paper): creep and first resonance from the answer to
     'hystcomp excite dynamics', for compensate/export-c --dynamics; --plot draws its Bode plot.
     By default the play weights beyond the first are non-negative (--constraints physical);
     --constraints paper --regularization 0 is eq. 19 as printed.

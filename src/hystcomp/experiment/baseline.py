@@ -4,7 +4,7 @@
 origin, ``k = sum(v x) / sum(v^2)``, rather than the end-point gain ``x_max / v_max``: it
 uses every sample (one end-point sample carries its noise and any overshoot), and it is the
 same criterion and the same record as the identification of the models it is compared with
-(eq. 19). The end-point gain is available for comparison.
+(the least squares of eqs. 12 and 19). The end-point gain is available for comparison.
 """
 
 from __future__ import annotations

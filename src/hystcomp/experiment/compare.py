@@ -142,7 +142,7 @@ class Comparison:
         ``preisach_exact[frequency]``: the Preisach model's exact inverse in place of the
         inverse multiplicative structure (empty if the Preisach model has no exact inverse).
     paper_fit : dict
-        ``paper_fit[kind]`` for ``"pi"``, ``"mpi"``: the lowest frequency tracked with the
+        ``paper_fit[kind]`` for each model kind: the lowest frequency tracked with the
         paper's own fit (:func:`paper_fits`), for the report (empty with a custom
         ``identify``).
     seconds : float
@@ -174,14 +174,17 @@ def identify_models(
     its compensator. PI and MPI use the library's defaults: physical constraints
     (non-negative play weights beyond the first) and, for MPI, the regularisation whose
     compensator is predicted to track best (:mod:`hystcomp.identify.compensation`);
-    :func:`paper_fits` gives eq. 12 and eq. 19 as printed for the report.
+    The Preisach fit is the paper's with ``X(v, v) = 0`` imposed, as eq. 2 implies (fitted
+    free, the cubic's ``X(v, v)`` makes the output step at every reversal).
+    :func:`paper_fits` gives eqs. 5, 12 and 19 as printed for the report.
     """
     config = CompareConfig() if config is None else config
     pi = PrandtlIshlinskii(n_operators=config.n_operators)
     mpi = ModifiedPrandtlIshlinskii(n_operators=config.n_operators, n_deadzones=config.n_deadzones)
+    # the paper's fit (Section III-A), not the library's default, with X(v, v) = 0 (eq. 2)
     preisach = Preisach(
         degree=config.preisach_degree, everett="polynomial", fit_method="reversal-curves"
-    )  # the paper's fit (Section III-A), not the library's default
+    )
     return {
         "preisach": preisach.fit(record_preisach.v, record_preisach.x),
         "pi": pi.fit(record_pi.v, record_pi.x),
@@ -189,10 +192,17 @@ def identify_models(
     }
 
 
-def paper_fits(record_pi: Record, config: CompareConfig) -> dict:
-    """PI and MPI fitted exactly as printed: eq. 12 and eq. 19, partial-sum constraints only,
-    no regularisation (``constraints="paper"``, ``regularization=0``)."""
+def paper_fits(record_pi: Record, record_preisach: Record, config: CompareConfig) -> dict:
+    """The three models fitted exactly as printed: eq. 5 fitted free to the reversal curves
+    (``zero_diagonal=False``); eq. 12 and eq. 19 with the partial-sum constraints only, no
+    regularisation (``constraints="paper"``, ``regularization=0``)."""
     return {
+        "preisach": Preisach(
+            degree=config.preisach_degree,
+            everett="polynomial",
+            fit_method="reversal-curves",
+            zero_diagonal=False,
+        ).fit(record_preisach.v, record_preisach.x),
         "pi": PrandtlIshlinskii(n_operators=config.n_operators, constraints="paper").fit(
             record_pi.v, record_pi.x
         ),
@@ -317,7 +327,7 @@ def run_comparison(
     if identify is identify_models:
         low = min(config.frequencies)
         _, x_ref = triangle_reference(amplitude, low, periods=config.periods, sample_rate=fs)
-        for kind, model in paper_fits(record_pi, config).items():
+        for kind, model in paper_fits(record_pi, record_preisach, config).items():
             paper_fit[kind] = run_tracking(
                 model.inverse(), twin, x_ref, frequency=low, method=f"{kind} (paper's fit)"
             )

@@ -6,8 +6,8 @@
   range, in percent; over the whole loop, and over the top quarter of the range, the
   paper's "saturation zone" (Fig. 9 and its text).
 
-The caller passes whole periods (the paper's runs discard nothing but we drop the first
-period, where the axis leaves its rest state; see :mod:`hystcomp.experiment.tracking`).
+The caller passes whole periods (the paper does not say which periods it measures; we drop
+the first, where the axis leaves its rest state; see :mod:`hystcomp.experiment.tracking`).
 """
 
 from __future__ import annotations

@@ -131,7 +131,8 @@ class MPIFit:
     Attributes
     ----------
     thresholds, weights, initial_state : ndarray
-        The plays of ``H``: V (eq. 16), µm/V, V.
+        The plays of ``H``: V (eq. 16, or over half the input span with the physical
+        constraints), µm/V, V.
     inverse_deadzone_thresholds : ndarray
         ``r'_S`` of eq. (17), in µm of ``x - x_0``.
     inverse_deadzone_weights : ndarray
@@ -238,7 +239,7 @@ def fit_mpi(
         docstring); 0 is eq. (19) as printed.
     constraints : {"physical", "paper"}, default "physical"
         ``"physical"``: also ``w_i >= 0`` for the plays beyond the first; ``"paper"``:
-        the partial-sum constraints of eq. (19) only.
+        eq. (19) with only the partial sums of the weights kept positive (invertibility).
     initial_memory : {"virgin", "descended"}, default "virgin"
         The plays' state at the first sample
         (:func:`~hystcomp.identify.pi.initial_play_states`): eq. (18)'s ``"virgin"``

@@ -21,6 +21,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from hystcomp import paper
+from hystcomp._hyperparameters import check_constraints
 from hystcomp.errors import IdentificationError, InvalidParameterError, InvalidTypeError
 from hystcomp.identify.compensation import compensation_error
 from hystcomp.identify.scoring import error_report, holdout_report, transient_end
@@ -48,7 +49,7 @@ LABELS = {"pi": "PI", "mpi": "MPI", "preisach": "Preisach", "dynamics": "dynamic
 SIZE_OPTIONS = {
     "pi": ("operators", "constraints"),
     "mpi": ("operators", "deadzones", "regularization", "constraints"),
-    "preisach": ("degree", "fit", "everett", "grid"),
+    "preisach": ("degree", "fit", "everett", "grid", "constraints"),
     "dynamics": (),
 }
 
@@ -104,7 +105,9 @@ def build_estimator(
     grid : int, optional
         Nodes per axis of a Preisach Everett table.
     constraints : {'physical', 'paper'}, optional
-        Weight constraints of PI and MPI (eqs. 12, 19).
+        PI and MPI: the weight constraints (eqs. 12, 19). Preisach: ``'paper'`` fits eq. 5's
+        coefficients free, as Section III-A does (``zero_diagonal=False``), where
+        ``'physical'`` (the default) holds ``X(v, v) = 0`` as eq. 2 implies.
 
     Returns
     -------
@@ -152,7 +155,11 @@ def build_estimator(
         params["degree"] = degree
     if kind == "preisach":
         params.update(_everett_params(fit, everett, degree, grid))
-    if constraints is not None:
+        if constraints is not None:
+            params["zero_diagonal"] = (
+                check_constraints(constraints, "build_estimator") == "physical"
+            )
+    elif constraints is not None:
         params["constraints"] = constraints
     return cls(**params)
 

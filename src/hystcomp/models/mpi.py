@@ -60,7 +60,7 @@ class ModifiedPrandtlIshlinskii(PrandtlIshlinskii):
         ``"physical"``: play weights beyond the first are non-negative, ``S`` stays
         monotone, and the plays start virgin (eq. 18) or descended, whichever is predicted
         to track best, as the regularisation (see :mod:`hystcomp.identify.mpi`);
-        ``"paper"``: the partial-sum constraints of eq. (19) only, from eq. (18)'s virgin
+        ``"paper"``: eq. (19) with only its partial sums kept positive, from eq. (18)'s virgin
         start. ``constraints="paper", regularization=0`` is the paper's fit exactly.
 
     Attributes
