@@ -24,7 +24,6 @@ import numpy as np
 
 from hystcomp._hyperparameters import check_options
 from hystcomp._kernels import preisach as pk
-from hystcomp._kernels.reversals import turning_points
 from hystcomp._validation import as_signal, check_range, check_real
 from hystcomp.errors import (
     IdentificationError,
@@ -32,7 +31,7 @@ from hystcomp.errors import (
     InvalidSignalError,
 )
 from hystcomp.identify.preisach_lsq import MAX_LSQ_GRID, fit_preisach_lsq
-from hystcomp.identify.scoring import check_response
+from hystcomp.identify.scoring import check_response, default_tolerance, turning_indices
 
 N_BINS = 200  # X samples per full-range curve: each curve is averaged in bins of span / N_BINS
 FIT_METHODS = ("auto", "reversal-curves", "least-squares")
@@ -85,19 +84,6 @@ class PreisachFit(NamedTuple):
     report: dict
 
 
-def input_noise(v: np.ndarray) -> float:
-    """Robust estimate of white noise on ``v`` (V) from the MAD of second differences."""
-    if v.size < 4:
-        return 0.0
-    d2 = np.diff(v, 2)
-    return float(1.4826 * np.median(np.abs(d2 - np.median(d2))) / np.sqrt(6.0))
-
-
-def default_tolerance(v: np.ndarray) -> float:
-    """Dead band of the turning-point search: ``max(1e-3 * span, 8 * noise)`` in V."""
-    return max(1e-3 * float(np.ptp(v)), 8.0 * input_noise(v))
-
-
 def _x_at_turning_point(v, x, start, peak):
     """``x_alpha``: a quadratic fit of x against v on the last 1 % of the rise, taken at alpha.
 
@@ -145,9 +131,8 @@ def find_reversal_curves(v, x, *, tolerance=None) -> list[ReversalCurve]:
         if tolerance is None
         else check_real(tolerance, "tolerance", "find_reversal_curves", positive=True)
     )
-    idx = np.empty(v.size, dtype=np.int64)
-    count, first_is_max = turning_points(v, tol, idx)
-    idx = idx[:count]
+    idx, first_is_max = turning_indices(v, tol)
+    count = idx.size
     v_min = float(v.min())
     curves = []
     # maxima sit at odd positions when the first extremum is a minimum, else at even ones

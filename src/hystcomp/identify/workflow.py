@@ -24,7 +24,12 @@ from hystcomp import paper
 from hystcomp._hyperparameters import check_constraints
 from hystcomp.errors import IdentificationError, InvalidParameterError, InvalidTypeError
 from hystcomp.identify.compensation import compensation_error
-from hystcomp.identify.scoring import error_report, holdout_report, transient_end
+from hystcomp.identify.scoring import (
+    coverage_warning,
+    error_report,
+    holdout_report,
+    transient_end,
+)
 from hystcomp.io.records import x_unit_warning
 from hystcomp.models.dynamics import LinearDynamics
 from hystcomp.models.mpi import ModifiedPrandtlIshlinskii
@@ -471,6 +476,9 @@ def identify_record(
             "rms); record a signal with turning points across the range (hystcomp excite "
             "rich) or try another model."
         )
+    coverage = coverage_warning(v, start)
+    if coverage is not None:
+        warnings.append(coverage)
     if held is not None:
         lines.append(
             f"  hold-out:  last {held['n_holdout']} samples ({100 * holdout:g} %): model rms "
