@@ -27,7 +27,9 @@ Run alone with ``python benchmarks/bench_accuracy.py`` (about two minutes; print
 the Preisach cubic from reversal curves, which only the sinusoids have: ``n/a`` elsewhere);
 ``--preisach`` prints the comparison of the Preisach fits; ``--rho`` the rank correlations;
 ``--limit`` the best MPI tracking of any size and regularisation on the quasi-static
-hysteresis of the twin and the Bouc-Wen stage (:func:`family_limit`).
+hysteresis of the twin and the Bouc-Wen stage (:func:`family_limit`); ``--coverage`` the
+estimated and measured tracking from records that lack what a reference does, with the
+coverage warning of ``hystcomp identify`` (:func:`coverage`).
 """
 
 from __future__ import annotations
@@ -148,6 +150,55 @@ def criterion_rank_correlation(actuators=ACTUATORS, excitations=EXCITATIONS) -> 
                     float(measured[mpi][np.argmin(values[mpi])] - measured[mpi].min())
                 )
     return out
+
+
+def thin_record(kind: str, sample_rate: float) -> np.ndarray:
+    """Records that may lack what a reference does (:func:`coverage`): ``walk``, a random
+    walk (Brownian, 30 s, its steps held 0.1 s, seeded) scaled to the range; ``drift``, the
+    same walk on a descent three times its span, so that it crosses the range once; ``loop``, one
+    2 s triangle over the range; ``stairs``, a staircase up and down in 10 % steps."""
+    fs = sample_rate
+    if kind in ("walk", "drift"):
+        hold = round(0.1 * fs)
+        steps = np.repeat(np.random.default_rng(5).normal(0.0, 1.0, 300), hold)
+        walk = np.cumsum(steps) / hold
+        if kind == "drift":  # the same walk on a descent over the range: it crosses once
+            walk += np.linspace(3.0 * np.ptp(walk), 0.0, walk.size)
+        return V_MAX * (walk - walk.min()) / np.ptp(walk)
+    if kind == "loop":
+        up = np.linspace(0.0, V_MAX, round(fs))
+        return np.r_[up, up[::-1]]
+    if kind == "stairs":
+        levels = np.r_[np.linspace(0.0, 1.0, 11), np.linspace(1.0, 0.0, 11)[1:]]
+        return np.repeat(V_MAX * levels, round(0.5 * fs))
+    raise ValueError(f"unknown record {kind!r}")
+
+
+def coverage(actuators=ACTUATORS, sample_rate=5e3) -> list[tuple]:
+    """``[(actuator, record, method, estimated, measured, warned)]``: the tracking that
+    ``hystcomp identify`` estimates from the record (its ratio to the straight line's),
+    the one measured (``Bench.ratio``), and whether the record draws the coverage warning
+    (:func:`hystcomp.identify.scoring.coverage_warning`), for the panel's excitations and
+    the records of :func:`thin_record`."""
+    from hystcomp.identify.compensation import compensation_error
+    from hystcomp.identify.scoring import coverage_warning, transient_end
+
+    rows = []
+    for name in actuators:
+        bench = Bench(name, sample_rate=sample_rate)
+        for kind in (*EXCITATIONS, "walk", "drift", "loop", "stairs"):
+            if kind in EXCITATIONS:
+                v, x = bench.record(kind)
+            else:
+                v = thin_record(kind, sample_rate)
+                x = bench.act.run(v)
+            start = transient_end(v)
+            warned = coverage_warning(v, start) is not None
+            for method, est in estimators().items():
+                model = est.fit(v[start:], x[start:]) if method == "Preisach" else est.fit(v, x)
+                estimate = compensation_error(model, v, x, start=start)["ratio"]
+                rows.append((name, kind, method, estimate, bench.ratio(model), warned))
+    return rows
 
 
 def family_limit(actuators=("twin", "boucwen"), grid=(0.0, 1e-3, 1e-2, 1e-1, 1.0)) -> dict:
@@ -271,6 +322,17 @@ if __name__ == "__main__":
             print(
                 f"{name} quasi-static, from {label}: best MPI {ratio:.3f} ({n} operators, "
                 f"regularization {value:g})"
+            )
+    if "--coverage" in sys.argv:
+        rows = coverage()
+        for row in rows:
+            print("{} {} {}: estimated {:.3f}, measured {:.3f}, warned {}".format(*row))
+        for warned in (True, False):
+            over = np.array([m / e for *_, e, m, w in rows if w == warned])
+            print(
+                f"{'warned' if warned else 'not warned'}: measured / estimated, median "
+                f"{np.median(over):.2f}, {over.min():.2f} .. {over.max():.2f}, above 2 in "
+                f"{np.sum(over > 2)} of {over.size} cells"
             )
     if "--rho" in sys.argv:
         for crit, (rhos, regrets) in criterion_rank_correlation().items():
