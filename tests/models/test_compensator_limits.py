@@ -170,6 +170,23 @@ def test_cli_strict_refuses_and_writes_nothing(tmp_path):
     assert out.read_text() == "old\n"
 
 
+def test_cli_names_the_ends_that_a_swing_leaves_when_loops_do_not_close(tmp_path):
+    """The paper's PI model starts virgin at 0 µm, but after a swing over 0..120 V it comes
+    back to 0 V above that: a reference down to 0 µm after a swing is out of reach, though
+    inside the model's extremes. The message names the ends after the swing."""
+    model = presets.paper_pi()
+    x_lo, x_hi = model.reachable_range()
+    swung = model.simulate(np.array([0.0, 120.0, 0.0]))[-1]
+    assert swung > x_lo + 0.5
+    x_ref = np.r_[np.linspace(0.0, 0.9 * x_hi, 200), np.linspace(0.9 * x_hi, x_lo, 200)]
+    model_file, ref, out = _files(tmp_path, model, x_ref)
+    args = ["compensate", str(model_file), str(ref), "-o", str(out), "--strict"]
+    result = CliRunner().invoke(main, args)
+    assert result.exit_code == 2
+    assert f"the model reaches {x_lo:.4g} .. {x_hi:.4g} µm, but after a swing" in result.stderr
+    assert f"shift or scale the reference into {swung:.4g} .. {x_hi:.4g} µm" in result.stderr
+
+
 @pytest.mark.parametrize("strict", [False, True])
 def test_cli_reachable_reference_gives_no_warning(tmp_path, strict):
     model = presets.paper_mpi()

@@ -134,17 +134,17 @@ def compensate(
     v = result.v
     lo, hi = compensator.voltage_range
     if result.clamped:
-        x_lo, x_hi = model.reachable_range(voltage_range=(lo, hi))
+        reach, (d_lo, d_hi) = _reach(model, lo, hi)
         x = table["x"]
         what = (
             f"{result.clamped} of {v.size} samples ({100 * result.clamped_share:.3g} %) are "
             f"out of reach and clamped to {lo:.4g} .. {hi:.4g} V: the reference spans "
-            f"{x.min():.4g} .. {x.max():.4g} µm, the model reaches {x_lo:.4g} .. {x_hi:.4g} µm"
+            f"{x.min():.4g} .. {x.max():.4g} µm, {reach}"
         )
         if strict:
             raise InvalidSignalError(
                 f"{what}. Nothing written (--strict); shift or scale the reference into "
-                "the reachable range, or drop --strict to accept the clamp."
+                f"{d_lo:.4g} .. {d_hi:.4g} µm, or drop --strict to accept the clamp."
             )
         click.echo(f"hystcomp: warning: {what}.", err=True)
     written = progress(f"writing {output}", quiet)
@@ -158,3 +158,19 @@ def compensate(
             f"  with the inverse of the dynamics of {dynamics_file}: "
             f"{compensator.preview} samples of look-ahead in the reference"
         )
+
+
+def _reach(model, lo: float, hi: float) -> tuple[str, tuple[float, float]]:
+    """What the model reaches with ``lo .. hi`` V, in words, and the displacements at the
+    ends once it has swung over the whole range (where a model whose loops do not close at
+    the ends no longer reaches its initial extremes)."""
+    x_lo, x_hi = model.reachable_range(voltage_range=(lo, hi))
+    swung = model.simulate(np.array([lo, hi, lo, hi]))
+    d_lo, d_hi = float(swung[2]), float(swung[3])
+    text = f"the model reaches {x_lo:.4g} .. {x_hi:.4g} µm"
+    if f"{d_lo:.4g} {d_hi:.4g}" != f"{x_lo:.4g} {x_hi:.4g}":
+        text += (
+            f", but after a swing over the whole range only {d_lo:.4g} .. {d_hi:.4g} µm "
+            "(its loops do not close at the ends)"
+        )
+    return text, (d_lo, d_hi)
