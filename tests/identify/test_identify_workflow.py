@@ -176,6 +176,25 @@ def test_dynamics_from_a_record_with_its_report_lines():
     assert result.lines[0] == "linear dynamics (creep and first resonance) from stage"
     assert result.lines[2].startswith(f"  resonance: {result.model.resonance_hz_:.5g} Hz, ")
     assert len(result.lines) == 6
+    assert result.warnings == []
+
+
+def test_dynamics_without_a_resonance_are_a_warning():
+    """A stage whose dynamics are a first-order lag (1.5 ms) has no resonance to find: the
+    fit's damping ratio hits its bound, and the report says so rather than offering the
+    inverse as if it fitted."""
+    t, v = dynamics_excitation()
+    fs = 20_000.0
+    a = np.exp(-1.0 / (0.0015 * fs))
+    x = np.empty_like(v)
+    state = v[0]
+    for k, u in enumerate(v):  # x[k] = a x[k-1] + (1 - a) v[k]
+        state = a * state + (1.0 - a) * u
+        x[k] = 0.3 * state
+    result = identify_dynamics_record(Record(t, v, x, source="lag"))
+    (warning,) = result.warnings
+    assert "finds no resonance in it (the damping ratio is at its bound, 2)" in warning
+    assert "compare compensate with and without --dynamics" in warning
 
 
 @pytest.mark.parametrize("kind", ["mpi", "pi", "preisach", "rich"])

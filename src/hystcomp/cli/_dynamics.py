@@ -17,6 +17,8 @@ def identify_dynamics(rec, output: str, plot: str | None) -> None:
     result = identify_dynamics_record(rec)
     for line in result.lines:
         click.echo(line)
+    for warning in result.warnings:
+        click.echo(f"hystcomp: warning: {warning}", err=True)
     model = result.model
     text = model_text(model)
     outputs = [output] if plot is None else [output, plot]

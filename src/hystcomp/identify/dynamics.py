@@ -74,6 +74,8 @@ FIT_FROM_HZ = 20.0
 RINGING_DECAYS = 4.0
 #: Samples of the step response (log-spaced in time) on which the creep is fitted.
 CREEP_SAMPLES = 2000
+#: Largest damping ratio the fit considers: a resonance damped beyond it is not one.
+MAX_DAMPING = 2.0
 
 
 def dynamics_excitation(
@@ -258,7 +260,7 @@ def _fit_resonance(measured, lines, fs, lags, weights, guess):
         ratio = np.abs(g).max() / np.abs(g[0])
         guess = (peak, min(0.7, max(1e-3, 0.5 / ratio)))
     theta0 = np.log(np.asarray(guess, dtype=np.float64))
-    bounds = (np.log([1.0, 1e-4]), np.log([0.45 * fs, 2.0]))
+    bounds = (np.log([1.0, 1e-4]), np.log([0.45 * fs, MAX_DAMPING]))
     theta0 = np.clip(theta0, bounds[0] + 1e-9, bounds[1] - 1e-9)
     result = least_squares(residual, theta0, bounds=bounds, x_scale=1.0)
     fn, zeta = np.exp(result.x)

@@ -24,6 +24,7 @@ from hystcomp import paper
 from hystcomp._hyperparameters import check_constraints
 from hystcomp.errors import IdentificationError, InvalidParameterError, InvalidTypeError
 from hystcomp.identify.compensation import compensation_error
+from hystcomp.identify.dynamics import MAX_DAMPING
 from hystcomp.identify.scoring import (
     coverage_warning,
     error_report,
@@ -520,11 +521,23 @@ class DynamicsResult:
         Where the record came from.
     lines : list of str
         The report, one line each, as ``hystcomp identify --model dynamics`` prints it.
+    warnings : list of str
+        Each a sentence (without the command line's ``hystcomp: warning:`` prefix): when
+        the model follows the record too poorly for its inverse to be trusted.
     """
 
     model: LinearDynamics
     source: str
     lines: list[str] = field(repr=False)
+    warnings: list[str] = field(default_factory=list)
+
+
+#: Least share of the frequency response the dynamics must explain to be used without a
+#: warning: a linear stage gives more than 97 %, the twins' hysteresis around the bias 87
+#: and 91 %; a stage whose hysteresis changes with the rate, or that has no resonance in
+#: the band, much less (62 % on a Bouc-Wen stage whose loop widens with rate, where the
+#: inverse made 1 Hz tracking 2 to 3 times worse).
+MIN_DYNAMICS_FIT = 80.0
 
 
 def identify_dynamics_record(record) -> DynamicsResult:
@@ -575,7 +588,22 @@ def identify_dynamics_record(record) -> DynamicsResult:
         f"  step:      rms error {report['step_rms_um']:.4g} µm on a step of "
         f"{report['step_height_um']:.4g} µm"
     )
-    return DynamicsResult(model=model, source=str(record.source), lines=lines)
+    warnings = []
+    resonance = model.damping_ratio_ < 0.99 * MAX_DAMPING
+    if report["fit_percent"] < MIN_DYNAMICS_FIT or not resonance:
+        found = (
+            ""
+            if resonance
+            else f" and finds no resonance in it (the damping ratio is at its bound, {MAX_DAMPING:g})"
+        )
+        warnings.append(
+            f"the model explains {report['fit_percent']:.3g} % of the frequency response "
+            f"from {lo:.4g} to {hi:.4g} Hz{found}; stages with one resonance give "
+            f"{MIN_DYNAMICS_FIT:g} % and more. Its inverse may make tracking worse (a "
+            "hysteresis that changes with the rate, or more than one mode, does this): "
+            "compare compensate with and without --dynamics on a test reference first."
+        )
+    return DynamicsResult(model=model, source=str(record.source), lines=lines, warnings=warnings)
 
 
 def _verdict(improvement: float) -> str:
