@@ -228,7 +228,9 @@ def test_record_validates_its_columns():
 def test_read_table_checks_its_own_arguments(tmp_path):
     path = tmp_path / "r.csv"
     path.write_text("t,v,x\n0,0,0\n1,1,1\n")
-    with pytest.raises(InvalidParameterError, match=r"'keys' parameter of read_table"):
+    with pytest.raises(
+        InvalidParameterError, match=r"'keys' and 'optional' parameters of read_table"
+    ):
         read_table(path, ("y",))
     with pytest.raises(InvalidParameterError, match=r"'min_samples'"):
         read_table(path, min_samples=0)

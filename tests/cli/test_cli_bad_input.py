@@ -76,7 +76,6 @@ CASES = [
     ("excite dynamics: rate too high", "excite dynamics --fs 1e12 -o {out}.csv", r"\(--fs\) makes the 6\.2 s signal 6\.2e\+12 samples long, .* use at most"),
     ("export-c: huge --fs", "export-c model.json -o {out}_c --fs 1e308", r"'--fs': must be a finite number of size at most 1e\+12"),
     ("export-c onto a file", "export-c model.json -o rec.csv", r"'rec\.csv': it exists and is not a folder"),
-    ("--columns not read (sim)", "simulate model.json rec.csv --columns t=1,x=3 -o {out}.csv", r"'--columns': x=3 .*reads t and v.* --columns v=3"),
 ]  # fmt: skip
 
 EXTENDED = [

@@ -13,7 +13,7 @@ from click.testing import CliRunner
 import hystcomp
 from hystcomp import presets
 from hystcomp.cli import main
-from hystcomp.identify.excitation import triangle_sequence
+from hystcomp.identify.excitation import excitation_signal, triangle_sequence
 from hystcomp.identify.scoring import holdout_report
 from hystcomp.io.records import read_record, read_table, write_table
 from hystcomp.plant import Twin
@@ -91,6 +91,29 @@ def test_identify_simulate_compensate_round_trip(tmp_path, kind, operators, tole
     out = read_table(tmp_path / "v2.csv", ("v",))
     tracking = np.abs(true.simulate(out["v"]) - x_ref).max()
     assert tracking < tolerance * 25.0
+
+
+def test_simulate_on_a_record_with_x_reports_the_error_against_it(tmp_path):
+    """A record of another experiment validates a model: simulate prints the model's error
+    against its measured x (after the start-up transient) beside a straight line's."""
+    true = presets.paper_mpi()
+    model = presets.paper_pi()
+    _, v = excitation_signal("rich", sample_rate=500.0)
+    t = np.arange(v.size) / 500.0
+    write_table(tmp_path / "rec.csv", {"t": t, "v": v, "x": true.simulate(v)})
+    hystcomp.save_model(model, tmp_path / "m.json")
+    result = run("simulate", tmp_path / "m.json", tmp_path / "rec.csv", "-o", tmp_path / "s.csv")
+    assert result.exit_code == 0, result.output
+    err = model.simulate(v) - true.simulate(v)  # the record starts at 0 V: no transient
+    rms = float(np.sqrt(np.mean(err**2)))
+    assert f"against the measured x of {tmp_path / 'rec.csv'}: model rms {rms:.4g} µm" in (
+        result.output
+    )
+    assert f"max {np.abs(err).max():.4g} µm; a straight line fitted to it: rms" in result.output
+    write_table(tmp_path / "v.csv", {"t": t, "v": v})
+    result = run("simulate", tmp_path / "m.json", tmp_path / "v.csv", "-o", tmp_path / "s2.csv")
+    assert result.exit_code == 0
+    assert "against the measured x" not in result.output
 
 
 @pytest.mark.parametrize("kind", ["pi", "mpi"])

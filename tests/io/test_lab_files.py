@@ -332,3 +332,14 @@ def test_files_that_are_not_npz_or_hold_nothing_are_named_so(tmp_path):
         with pytest.raises(DataFileError, match=message) as caught:
             read_record(path)
         assert "pickle" not in str(caught.value)
+
+
+def test_optional_columns_are_read_when_present(tmp_path, record):
+    path = tmp_path / "rec.csv"
+    write_table(path, record)
+    table = read_table(path, ("v",), optional=("x",))
+    np.testing.assert_array_equal(table["x"], read_table(path)["x"])
+    write_table(tmp_path / "v.csv", {"t": record["t"], "v": record["v"]})
+    assert set(read_table(tmp_path / "v.csv", ("v",), optional=("x",))) == {"t", "v"}
+    with pytest.raises(InvalidParameterError, match="'keys' and 'optional'"):
+        read_table(path, ("v",), optional=("v",))

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import click
+import numpy as np
 
 from hystcomp.cli import main
 from hystcomp.cli._options import (
@@ -29,7 +30,9 @@ from hystcomp.io.records import read_table, write_table
 def simulate(model_file, input_file, output, columns, sample_rate, quiet):
     """Run the model in MODEL.json on the voltage in INPUT (columns t, v).
 
-    Writes t (s), v (V) and the modelled displacement x (µm).
+    Writes t (s), v (V) and the modelled displacement x (µm). If INPUT also holds a
+    measured displacement x (a record the model was not fitted on, say), prints how far the
+    model is from it, beside a straight line fitted to that record: a validation.
     """
     check_data_output(output, inputs=(model_file, input_file), what="result file")
     model = load_model(model_file)
@@ -42,7 +45,8 @@ def simulate(model_file, input_file, output, columns, sample_rate, quiet):
     table = read_table(
         input_file,
         ("v",),
-        **read_options(columns, sample_rate, None, quiet, input_file, reads=("v",)),
+        optional=("x",),
+        **read_options(columns, sample_rate, None, quiet, input_file, reads=("v", "x")),
     )
     v = table["v"]
     lo, hi = getattr(model, "voltage_range_", (-float("inf"), float("inf")))
@@ -57,3 +61,25 @@ def simulate(model_file, input_file, output, columns, sample_rate, quiet):
     written = progress(f"writing {output}", quiet)
     write_table(output, {"t": table["t"], "v": v, "x": x}, progress=written)
     click.echo(f"wrote {output}: {x.size} samples, x from {x.min():.4g} to {x.max():.4g} µm")
+    if "x" in table:
+        click.echo(_validation(v, table["x"], x, input_file))
+
+
+def _validation(v, measured, x, source) -> str:
+    """One line: the model's error against the measured displacement of ``source``, after
+    its start-up transient (where the model's memory and the stage's may differ), beside
+    a straight line fitted to that record."""
+    from hystcomp.identify.scoring import error_report, straight_line, transient_end
+
+    start = transient_end(v)
+    if start >= v.size - 1:
+        start = 0
+    model = error_report(measured, x, start)
+    a, b = straight_line(v[start:], measured[start:])
+    line = float(np.sqrt(np.mean((a * v[start:] + b - measured[start:]) ** 2)))
+    after = f" from sample {start + 1} (after the start-up transient)" if start else ""
+    return (
+        f"  against the measured x of {source}{after}: model rms {model['rms_error_um']:.4g} "
+        f"µm, max {model['max_error_um']:.4g} µm; a straight line fitted to it: rms "
+        f"{line:.4g} µm"
+    )

@@ -359,6 +359,7 @@ def read_table(
     min_samples=2,
     x_unit=None,
     progress=None,
+    optional=(),
 ):
     """Read time and the columns ``keys`` from a data file, validated.
 
@@ -383,12 +384,15 @@ def read_table(
         the file's units row, else µm.
     progress : callable, optional
         Called with the fraction read so far (0..1), for a progress line.
+    optional : sequence of str
+        Columns read too when the file has them (by name, or named in ``columns``), among
+        ``"v"`` and ``"x"`` and not in ``keys``.
 
     Returns
     -------
     dict of str to ndarray
-        ``"t"`` and each of ``keys``: read-only, finite, equally long; ``t`` strictly
-        increasing.
+        ``"t"``, each of ``keys`` and each of ``optional`` that the file has: read-only,
+        finite, equally long; ``t`` strictly increasing.
 
     Raises
     ------
@@ -397,10 +401,12 @@ def read_table(
     """
     path = as_path(path, "path", "read_table")
     keys = tuple(keys) if not isinstance(keys, str) else (keys,)
-    if not keys or any(key not in ("v", "x") for key in keys) or len(set(keys)) < len(keys):
+    optional = tuple(optional) if not isinstance(optional, str) else (optional,)
+    both = keys + optional
+    if not keys or any(key not in ("v", "x") for key in both) or len(set(both)) < len(both):
         raise InvalidParameterError(
-            f"The 'keys' parameter of read_table must name 'v' and/or 'x' once each. "
-            f"Got {keys!r} instead."
+            f"The 'keys' and 'optional' parameters of read_table must name 'v' and/or 'x' "
+            f"once each, 'keys' at least one. Got keys={keys!r}, optional={optional!r}."
         )
     min_samples = check_int(min_samples, "min_samples", "read_table", minimum=1)
     columns = _check_columns(columns)
@@ -412,13 +418,13 @@ def read_table(
             f"Got {x_unit!r} instead."
         )
     try:
-        raw = _raw(path, columns, keys, progress)
+        raw = _raw(path, columns, both, progress)
     finally:
         if progress is not None:
             progress(1.0)  # done, or failed: either way the progress line goes
     out = {}
-    for key in ("t", *keys):
-        index, label = _pick(path, raw, key, columns.get(key), key != "t")
+    for key in ("t", *both):
+        index, label = _pick(path, raw, key, columns.get(key), key in keys)
         if index is not None:
             arr = _as_column(raw.arrays[index], path, key, label)
             factor = _units(path, raw, key, index, x_unit)
@@ -441,7 +447,7 @@ def read_table(
     out["t"] = _time(path, out.get("t"), n, sample_rate)
     for arr in out.values():
         arr.setflags(write=False)
-    return {"t": out["t"], **{key: out[key] for key in keys}}
+    return {"t": out["t"], **{key: out[key] for key in both if key in out}}
 
 
 def x_unit_warning(x, source: str, given: str | None = None) -> str | None:
