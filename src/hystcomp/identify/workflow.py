@@ -463,7 +463,7 @@ def identify_record(
     )
     lines.append(
         f"  compensation (estimated): tracking rms {tracking['tracking_rms_um']:.4g} µm, "
-        f"straight line v = x/k_lin {tracking['baseline_rms_um']:.4g} µm "
+        f"straight line v = (x - b)/a {tracking['baseline_rms_um']:.4g} µm "
         f"({tracking['ratio']:.2g}x)"
     )
     warnings = []
