@@ -95,6 +95,7 @@ def _reference(model, rng, n=20_000):
     ref[rng.choice(n, size=12, replace=False)] = np.nan
     ref[[n // 7, n // 3]] = [np.inf, -np.inf]
     ref[[n // 5, n // 2]] = [1.7e308, -1.7e308]
+    ref[[n // 9, n // 4]] = [1e200, -1e160]  # beyond the plays' input limit, no overflow
     return ref
 
 

@@ -218,3 +218,20 @@ def test_identify_refuses_a_voltage_range_wider_than_the_record(tmp_path):
     comp = hystcomp.load_model(tmp_path / "m.json").inverse()
     assert comp.simulate([1e3]).max() == 100.0
     assert "refused, not capped" in " ".join(run("identify", "--help").output.split())
+
+
+@pytest.mark.parametrize("make", [presets.paper_pi, presets.paper_mpi, _offset_pi])
+@pytest.mark.parametrize("huge", [1e151, 1e308, -1e308])
+def test_a_reference_near_the_float_range_is_held_like_nan(make, huge):
+    """Such a sample is held and counted as non-finite, and the plays stay where they were:
+    what follows is what follows a NaN (before, the plays moved to it while the output was
+    held, and the compensator no longer followed what the amplifier had been given)."""
+    comp = make().inverse()  # (batch runs refuse such references; a stepper holds them)
+    lo, hi = comp.voltage_range
+    x = make().simulate(np.linspace(lo, 0.6 * hi + 0.4 * lo, 50))
+    with_huge, with_nan = comp.stepper(), comp.stepper()
+    v_huge = with_huge.step_block(np.r_[x, huge, x[::-1]])
+    v_nan = with_nan.step_block(np.r_[x, np.nan, x[::-1]])
+    np.testing.assert_array_equal(v_huge, v_nan)
+    assert with_huge.nonfinite_count == 1
+    assert with_huge.clamped_count == with_nan.clamped_count

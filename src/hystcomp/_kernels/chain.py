@@ -57,6 +57,10 @@ HEADER = 8
 CLAMP_TOLERANCE = 1e-9
 # Samples per stage pass in a batch run: the block and the parameters stay in L1 cache.
 BLOCK = 256
+#: Largest input of the plays that moves them: beyond it (a reference near the float range,
+#: where the weighted sum would overflow) the sample is held like a non-finite one, and the
+#: plays stay where they are, so that they keep following what the amplifier was given.
+PLAY_INPUT_LIMIT = 1e150
 # pack_chain pads the plays to a multiple of this count (the vector loop's step on AVX2).
 PLAY_MULTIPLE = 8
 
@@ -200,8 +204,9 @@ def chain_parts(p):
 def chain_blocks(p, u, out, work):
     """Run every sample of ``u`` through packed chain ``p`` into ``out``; state kept in ``p``.
 
-    A non-finite sample, or one whose result overflows, holds the last output and
-    increments the non-finite counter; the plays advance only on a finite input. An output
+    A non-finite sample, or one whose result overflows or that reaches the plays beyond
+    :data:`PLAY_INPUT_LIMIT`, holds the last output and increments the non-finite counter;
+    the plays advance only on the samples that are not held. An output
     that the clamp moves by more than :data:`CLAMP_TOLERANCE` of the range increments the
     clamped counter. Samples go through in blocks of :data:`BLOCK`, stage by stage: the stateless dead-zone
     stages as passes over the block, the plays and the output limits sample by sample.
@@ -239,8 +244,10 @@ def chain_blocks(p, u, out, work):
                 z[k] = ub[k] - in_offset
         if play_r.size > 0:
             for k in range(ub.size):
-                if abs(z[k]) < np.inf:  # finite (input and dead-zones): the plays advance
+                if abs(z[k]) < PLAY_INPUT_LIMIT:  # the plays advance
                     z[k] = play_step(z[k], play_r, play_w, plays)
+                else:  # NaN, +-inf or near the float range: held below, plays unmoved
+                    z[k] = np.inf
         zb = z
         if post_r.size > 0:
             zb = work[: ub.size]

@@ -45,7 +45,7 @@ def chain_template(compensator) -> CTemplate:
         ]
         template.step_body += [
             "",
-            "if (!isfinite(z)) { /* overflow on a huge finite x_ref: hold, plays unmoved */",
+            f"if (!(fabs(z) < {c_double(ck.PLAY_INPUT_LIMIT)})) {{ /* huge x_ref: hold, plays unmoved */",
             "    s->nonfinite_count++;",
             "    return s->last;",
             "}",
