@@ -584,3 +584,60 @@ def test_a_model_is_refused_with_the_call_that_exports_its_compensator():
 
     with pytest.raises(InvalidTypeError, match=r"model\.inverse\(\)"):
         generate_c(hystcomp.presets.paper_pi())
+
+
+PRIMED_DRIVER = """
+#include "{p}.h"
+
+void run_primed(const double *x_ref, double *v, long n, long preview)
+{
+    {p}_state s;
+    long k;
+    {p}_init(&s);
+    for (k = 0; k < preview; k++) {
+        {p}_prime(&s, x_ref[k]);
+    }
+    for (k = preview; k < n; k++) {
+        v[k - preview] = {p}_step(&s, x_ref[k]);
+    }
+}
+"""
+
+
+@needs_cc
+@pytest.mark.parametrize("slewing", [False, True])
+@pytest.mark.parametrize("name", ["paper_mpi_dynamics", "preisach_exact_dynamics"])
+def test_c_primed_on_the_look_ahead_is_the_batch_run(name, slewing, identified_preisach, tmp_path):
+    """NAME_prime feeds the look-ahead to the filter alone, as the stepper's prime(): then
+    NAME_step gives the batch run (the reference known ahead) from its first sample, slew
+    limit included, for a reference that starts away from rest."""
+    _, model = _counting_compensators(identified_preisach)[name]
+    dyn = hystcomp.LinearDynamics.from_parameters(
+        sample_rate=20_000.0,
+        resonance_hz=700.0,
+        damping_ratio=0.1,
+        creep_time_constants=[0.004, 0.4],
+        creep_weights=[0.01, 0.01],
+    )
+    options = {"slew_rate": 2e5, "sample_rate": 20_000.0} if slewing else {}
+    if model.kind == "preisach":
+        options["method"] = "exact"
+    comp = model.inverse(dynamics=dyn, **options)
+    low, high = model.reachable_range()
+    t = np.arange(6000) / 20_000.0
+    x = low + (high - low) * (0.5 + 0.3 * np.sin(2 * np.pi * 30.0 * t))
+    d = comp.preview
+    export_c(comp, tmp_path, prefix="comp")
+    (tmp_path / "driver.c").write_text(PRIMED_DRIVER.replace("{p}", "comp"))
+    lib = tmp_path / "libcomp.so"
+    cmd = [CC, *STRICT, "-shared", "-fPIC", "-o", str(lib), "comp.c", "driver.c", "-lm"]
+    build = subprocess.run(cmd, cwd=tmp_path, capture_output=True, text=True, check=False)
+    assert build.returncode == 0, build.stderr
+    run = ctypes.CDLL(str(lib)).run_primed
+    run.argtypes = [ctypes.c_void_p, ctypes.c_void_p, ctypes.c_long, ctypes.c_long]
+    ahead = np.ascontiguousarray(np.r_[x, np.full(d, x[-1])])
+    v = np.empty(x.size)
+    run(ahead.ctypes.data, v.ctypes.data, ahead.size, d)
+    batch = comp.simulate(x)
+    np.testing.assert_allclose(v, batch, rtol=0, atol=1e-9)
+    assert abs(batch[0] - comp.stepper().last_output) > 5.0  # it starts away from rest

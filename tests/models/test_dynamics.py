@@ -266,6 +266,15 @@ def test_stepper_equals_batch(compensator):
     np.testing.assert_allclose(
         s.step_block(np.r_[x[d:], np.full(d, x[-1])]), batch, rtol=0, atol=1e-9
     )
+    # the generated C has no prime: it starts `preview` samples early, applying those
+    # outputs (docs/c-export.md); the slew limit holds throughout, and once it no longer
+    # binds on the start (a few samples here) the voltages are the batch run's
+    s.reset()
+    stepped = s.step_block(np.r_[x, np.full(d, x[-1])])
+    assert np.abs(np.diff(np.r_[compensator.stepper().last_output, stepped])).max() <= (
+        compensator.max_step * (1 + 1e-12)
+    )
+    np.testing.assert_allclose(stepped[d + 5 :], batch[5:], rtol=0, atol=1e-9)
 
 
 def test_output_clamped_and_slew_limited(compensator):

@@ -210,7 +210,8 @@ def __getattr__(name: str):
             type=click.Choice(INVERSE_METHODS),
             default=None,
             help="Preisach models only: the inverse multiplicative structure (eq. 10) or the "
-            "exact inverse [multiplicative].",
+            "exact inverse [multiplicative; exact with --dynamics, as eq. 10's one-sample lag "
+            "overshoots a fast rise, a minor loop that the dynamics cannot undo].",
         )
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 

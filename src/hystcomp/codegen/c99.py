@@ -148,6 +148,10 @@ class CTemplate:
     ``clamped_count``, as the chain kernel counts it; a template with a rule of its own (the
     Preisach compensators count a reference out of reach) sets it False and counts in its
     ``after_body``.
+
+    ``public`` are further functions of the interface, each ``(comment lines, definition)``:
+    the header declares them after ``NAME_step``, with the comment, and the source defines
+    them last.
     """
 
     kind: str
@@ -165,6 +169,7 @@ class CTemplate:
     functions: list[str] = field(default_factory=list)
     hold_on_overflow: bool = True
     count_clamped: bool = True
+    public: list[tuple[list[str], str]] = field(default_factory=list)
 
 
 def check_prefix(prefix: str) -> str:
@@ -269,6 +274,11 @@ def render(
             "   voltage range. A non-finite x_ref (NaN, +-inf) holds the last output. */",
             f"double {p}_step({p}_state *s, double x_ref);",
             "",
+            *(
+                line
+                for comment_lines, definition in template.public
+                for line in (*comment_lines, definition.split("\n", 1)[0] + ";", "")
+            ),
             "#ifdef __cplusplus",
             "}",
             "#endif",
@@ -324,6 +334,7 @@ def render(
             "    return v;",
             "}",
             "",
+            *(f"{definition}\n" for _, definition in template.public),
         ]
     )
     header, source_text = header.replace("{p}", p), source_text.replace("{p}", p)

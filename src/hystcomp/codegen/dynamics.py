@@ -16,6 +16,14 @@ from hystcomp._kernels import dynamics as dk
 from hystcomp._kernels.chain import CLAMP_TOLERANCE
 from hystcomp.codegen.c99 import CTemplate, c_double, c_table
 
+#: ``NAME_prime``: the filter alone, as ``DynamicStepper.prime`` (``{p}`` the prefix).
+PRIME = """void {p}_prime({p}_state *s, double x_ref)
+{
+    if (isfinite(x_ref)) {
+        (void){p}_dyn_filter(s, &x_ref);
+    }
+}"""
+
 
 def add_dynamics(template: CTemplate, inverse) -> CTemplate:
     """``template`` with the inverse filter ``inverse`` (a DynamicsInverse) before its step."""
@@ -33,6 +41,7 @@ def add_dynamics(template: CTemplate, inverse) -> CTemplate:
         ),
         f"  PREVIEW: call NAME_step with the reference {inverse.preview} samples ahead of the",
         "  sample its voltage is for (fed the reference of now, the stage lags it by that).",
+        f"  Call NAME_prime on the first {inverse.preview} reference samples first, then NAME_step.",
     ]
     template.state_fields += [f"double dyn_line[{n_fir}]; /* reference delay line, um */"]
     template.tables.append(c_table("{p}_dyn_h", taps, "FIR taps: resonance inverse, non-negative"))
@@ -44,17 +53,19 @@ def add_dynamics(template: CTemplate, inverse) -> CTemplate:
         f"        s->dyn_line[j] = {rest};",
         "    }",
     ]
+    # the filter, one function for NAME_step and NAME_prime: x_ref in, filtered in place;
+    # -1 if the result overflowed (held), 1 if the clamp cut it (counted), else 0
     body = [
-        "",
-        f"/* inverse of the linear dynamics; x_ref is {inverse.preview} samples ahead */",
+        "static int {p}_dyn_filter({p}_state *s, double *x)",
         "{",
         "    int j;",
+        "    int cut = 0;",
         f"    double w = {c_double(p[dk.BIAS])};",
         "    double y;",
         f"    for (j = {n_fir - 1}; j > 0; j--) {{",
         "        s->dyn_line[j] = s->dyn_line[j - 1];",
         "    }",
-        "    s->dyn_line[0] = x_ref;",
+        "    s->dyn_line[0] = *x;",
         f"    for (j = 0; j < {n_fir}; j++) {{",
         "        w += {p}_dyn_h[j] * s->dyn_line[j];",
         "    }",
@@ -82,47 +93,59 @@ def add_dynamics(template: CTemplate, inverse) -> CTemplate:
     else:
         body.append(f"    y = w * {c_double(p[dk.SCALE])} / {c_double(p[dk.DIRECT])};")
     body += [
-        "    if (!isfinite(y)) { /* a huge finite x_ref overflowed: hold the output */",
-        "        s->nonfinite_count++;",
-        "        return s->last;",
+        "    if (!isfinite(y)) { /* a huge finite x_ref overflowed */",
+        "        return -1;",
         "    }",
     ]
     tol = CLAMP_TOLERANCE * (high - low)  # the kernel's rule: a cut beyond a rounding counts
-    if np.isfinite(low):
-        body += [
-            f"    if (y < {c_double(low)}) {{",
-            f"        if (y < {c_double(low - tol)}) {{",
-            "            s->clamped_count++;",
-            "            dyn_cut = 1;",
-            "        }",
-            f"        y = {c_double(low)};",
-            "    }",
-        ]
-    if np.isfinite(high):
-        body += [
-            f"    if (y > {c_double(high)}) {{",
-            f"        if (y > {c_double(high + tol)}) {{",
-            "            s->clamped_count++;",
-            "            dyn_cut = 1;",
-            "        }",
-            f"        y = {c_double(high)};",
-            "    }",
-        ]
+    for limit, beyond, edge in ((low, "<", low - tol), (high, ">", high + tol)):
+        if np.isfinite(limit):
+            body += [
+                f"    if (y {beyond} {c_double(limit)}) {{",
+                f"        if (y {beyond} {c_double(edge)}) {{",
+                "            s->clamped_count++;",
+                "            cut = 1;",
+                "        }",
+                f"        y = {c_double(limit)};",
+                "    }",
+            ]
     if n_creep:
         body += [
             f"    for (j = 0; j < {n_creep}; j++) {{",
             "        s->dyn_lag[j] = {p}_dyn_a[j] * s->dyn_lag[j] + (1.0 - {p}_dyn_a[j]) * y;",
             "    }",
         ]
-    body += ["    x_ref = y;", "    dyn_counted = s->clamped_count;", "}", ""]
+    body += ["    *x = y;", "    return cut;", "}"]
+    template.functions.append("\n".join(body))
     template.reset_body.append("}")
+    template.public.append(
+        (
+            [
+                f"/* Feed the first {inverse.preview} reference samples (the look-ahead) to the inverse of",
+                "   the dynamics, one per call, before the first {p}_step; no voltage is",
+                "   output, as the stepper's prime() in Python. A non-finite x_ref is skipped. */",
+            ],
+            PRIME,
+        )
+    )
     # a sample out of reach counted by the filter's clamp is not counted again by the
     # voltage range's (DynamicStepper.clamped_count)
-    template.locals += ["int dyn_cut = 0;", "unsigned long dyn_counted = 0;"]
+    template.locals += ["int dyn_cut;", "unsigned long dyn_counted;"]
+    step = [
+        "",
+        f"/* inverse of the linear dynamics; x_ref is {inverse.preview} samples ahead */",
+        "dyn_cut = {p}_dyn_filter(s, &x_ref);",
+        "if (dyn_cut < 0) { /* a huge finite x_ref overflowed: hold the output */",
+        "    s->nonfinite_count++;",
+        "    return s->last;",
+        "}",
+        "dyn_counted = s->clamped_count;",
+        "",
+    ]
     template.after_body += [
         "if (dyn_cut) {",
         "    s->clamped_count = dyn_counted;",
         "}",
     ]
-    template.step_body = body + template.step_body
+    template.step_body = step + template.step_body
     return template
