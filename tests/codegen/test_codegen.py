@@ -641,3 +641,13 @@ def test_c_primed_on_the_look_ahead_is_the_batch_run(name, slewing, identified_p
     batch = comp.simulate(x)
     np.testing.assert_allclose(v, batch, rtol=0, atol=1e-9)
     assert abs(batch[0] - comp.stepper().last_output) > 5.0  # it starts away from rest
+
+
+@needs_cc
+@pytest.mark.parametrize("flag", ["-ffast-math", "-ffinite-math-only"])
+def test_a_build_that_would_drop_the_nan_test_stops(flag, tmp_path):
+    export_c(hystcomp.presets.paper_mpi().inverse(), tmp_path, prefix="comp")
+    cmd = [CC, *STRICT, flag, "-c", "comp.c"]
+    build = subprocess.run(cmd, cwd=tmp_path, capture_output=True, text=True, check=False)
+    assert build.returncode != 0
+    assert "without -ffast-math or -ffinite-math-only" in build.stderr
