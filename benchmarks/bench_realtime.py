@@ -10,7 +10,8 @@
   same loop can do (target: at most 1.5x its time). The same C with plain ``cc -O3`` (no
   fast-math, the generic x86-64 instruction set) is given beside it, labelled, for
   information: it is not a like-for-like reference.
-* The same compensator exported with ``hystcomp export-c`` and compiled with ``cc -O3``.
+* The same compensator exported with ``hystcomp export-c`` and compiled with the reference's
+  flags (:data:`C_MATCHED`).
 * Streaming: the cost of one ``Stepper.step`` call from a Python loop (target < 300 ns) and
   of ``step_block`` per sample.
 * First use: the cost of the first call in a fresh process, with an empty and with a warm
