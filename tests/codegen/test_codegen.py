@@ -511,6 +511,29 @@ unsigned long count_clamped(const double *x_ref, double *v, long n)
 """
 
 
+def _creeping():
+    """Dynamics with a 700 Hz resonance and two creep modes."""
+    return hystcomp.LinearDynamics.from_parameters(
+        sample_rate=20_000.0,
+        resonance_hz=700.0,
+        damping_ratio=0.1,
+        creep_time_constants=[0.004, 0.4],
+        creep_weights=[0.01, 0.01],
+    )
+
+
+def _library(comp, folder, driver, entry):
+    """``comp`` exported to ``folder`` with ``driver`` (``{p}`` for the prefix), built with
+    the strict flags into a shared library: its function ``entry``."""
+    export_c(comp, folder, prefix="comp")
+    (folder / "driver.c").write_text(driver.replace("{p}", "comp"))
+    lib = folder / "libcomp.so"
+    cmd = [CC, *STRICT, "-shared", "-fPIC", "-o", str(lib), "comp.c", "driver.c", "-lm"]
+    build = subprocess.run(cmd, cwd=folder, capture_output=True, text=True, check=False)
+    assert build.returncode == 0, build.stderr
+    return getattr(ctypes.CDLL(str(lib)), entry)
+
+
 def _counting_compensators(identified):
     """Every template's compensator (one with the inverse of the dynamics in front), each
     beside the model it inverts."""
@@ -520,13 +543,7 @@ def _counting_compensators(identified):
     dynamics = hystcomp.LinearDynamics.from_parameters(
         sample_rate=20_000.0, resonance_hz=700.0, damping_ratio=0.1
     )
-    creeping = hystcomp.LinearDynamics.from_parameters(
-        sample_rate=20_000.0,
-        resonance_hz=700.0,
-        damping_ratio=0.1,
-        creep_time_constants=[0.004, 0.4],
-        creep_weights=[0.01, 0.01],
-    )
+    creeping = _creeping()
     table, quartic = identified["table"], identified["quartic_bipolar"]
     return {
         "bipolar_pi": (pi.inverse(), pi),
@@ -552,13 +569,7 @@ def _counting_compensators(identified):
 )
 def test_c_counts_clamped_outputs_as_python(name, identified_preisach, tmp_path, rng):
     comp, model = _counting_compensators(identified_preisach)[name]
-    export_c(comp, tmp_path, prefix="comp")
-    (tmp_path / "driver.c").write_text(COUNT_DRIVER.replace("{p}", "comp"))
-    lib = tmp_path / "libcomp.so"
-    cmd = [CC, *STRICT, "-shared", "-fPIC", "-o", str(lib), "comp.c", "driver.c", "-lm"]
-    build = subprocess.run(cmd, cwd=tmp_path, capture_output=True, text=True, check=False)
-    assert build.returncode == 0, build.stderr
-    count = ctypes.CDLL(str(lib)).count_clamped
+    count = _library(comp, tmp_path, COUNT_DRIVER, "count_clamped")
     count.restype = ctypes.c_ulong
     count.argtypes = [ctypes.c_void_p, ctypes.c_void_p, ctypes.c_long]
     # a reference that leaves the reachable range at both ends, with a few NaNs
@@ -612,28 +623,15 @@ def test_c_primed_on_the_look_ahead_is_the_batch_run(name, slewing, identified_p
     NAME_step gives the batch run (the reference known ahead) from its first sample, slew
     limit included, for a reference that starts away from rest."""
     _, model = _counting_compensators(identified_preisach)[name]
-    dyn = hystcomp.LinearDynamics.from_parameters(
-        sample_rate=20_000.0,
-        resonance_hz=700.0,
-        damping_ratio=0.1,
-        creep_time_constants=[0.004, 0.4],
-        creep_weights=[0.01, 0.01],
-    )
     options = {"slew_rate": 2e5, "sample_rate": 20_000.0} if slewing else {}
     if model.kind == "preisach":
         options["method"] = "exact"
-    comp = model.inverse(dynamics=dyn, **options)
+    comp = model.inverse(dynamics=_creeping(), **options)
     low, high = model.reachable_range()
     t = np.arange(6000) / 20_000.0
     x = low + (high - low) * (0.5 + 0.3 * np.sin(2 * np.pi * 30.0 * t))
     d = comp.preview
-    export_c(comp, tmp_path, prefix="comp")
-    (tmp_path / "driver.c").write_text(PRIMED_DRIVER.replace("{p}", "comp"))
-    lib = tmp_path / "libcomp.so"
-    cmd = [CC, *STRICT, "-shared", "-fPIC", "-o", str(lib), "comp.c", "driver.c", "-lm"]
-    build = subprocess.run(cmd, cwd=tmp_path, capture_output=True, text=True, check=False)
-    assert build.returncode == 0, build.stderr
-    run = ctypes.CDLL(str(lib)).run_primed
+    run = _library(comp, tmp_path, PRIMED_DRIVER, "run_primed")
     run.argtypes = [ctypes.c_void_p, ctypes.c_void_p, ctypes.c_long, ctypes.c_long]
     ahead = np.ascontiguousarray(np.r_[x, np.full(d, x[-1])])
     v = np.empty(x.size)
