@@ -192,7 +192,7 @@ def coverage_warning(v, start: int = 0) -> str | None:
             return (
                 f"after its start-up transient the record never {verb} over more than "
                 f"{100 * swing / span:.0f} % of its input range: the model's {noun} branches "
-                "over more are fitted on nothing, and a reference that swings further may "
+                "beyond that are fitted on nothing, and a reference that swings further may "
                 f"track far worse than estimated. Record swings across the whole range in "
                 f"both directions ({what})."
             )
