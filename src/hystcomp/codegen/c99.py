@@ -292,8 +292,10 @@ def render(
         f'#error "{p}.h and {p}.c come from different exports: export them again together"',
         "#endif",
         "#if defined(__FAST_MATH__) || (defined(__FINITE_MATH_ONLY__) && __FINITE_MATH_ONLY__)",
-        f'#error "build {p}.c without -ffast-math or -ffinite-math-only: they remove the '
-        'tests that hold the output on a non-finite reference"',
+        (
+            f'#error "build {p}.c without -ffast-math or -ffinite-math-only: they remove the '
+            'tests that hold the output on a non-finite reference"'
+        ),
         "#endif",
     ]
     local_lines = [f"    {line}" for line in template.locals]
