@@ -223,3 +223,18 @@ def test_a_record_that_drifts_across_the_range_once_is_a_warning():
     once = Record(np.arange(loop.size) / FS, loop, presets.paper_mpi().simulate(loop))
     warning = identify_record(once, "pi", operators=8).warnings[-1]
     assert warning.startswith("the record turns back only at the ends of its input range")
+
+
+def test_the_coverage_warning_ignores_dither_and_a_start_mid_range():
+    """Reversals smaller than 5 % of the span are no minor loops (a dithered single loop
+    still warns), and a record that starts mid-range is judged from the swings it makes,
+    not from where its start-up transient ends (the paper's triangles after a ramp from
+    40 V do not warn)."""
+    rng = np.random.default_rng(2)
+    loop = np.r_[np.linspace(0.0, 120.0, 4000), np.linspace(120.0, 0.0, 4000)]
+    dithered = loop + 2.0 * np.sin(np.arange(loop.size) / 3.0) + rng.normal(0.0, 0.2, loop.size)
+    assert coverage_warning(dithered).startswith("the record turns back only at the ends")
+    levels = [40.0, 120.0, 0.0, 60.0, 40.0, 120.0, 0.0]  # its one full rise wipes a loop out
+    started_mid = np.interp(np.linspace(0, 6, 7000), np.arange(7), levels)
+    assert transient_end(started_mid) < np.argmax(started_mid)  # on the rise, before the top
+    assert coverage_warning(started_mid, transient_end(started_mid)) is None

@@ -117,7 +117,8 @@ def turning_indices(v: np.ndarray, tolerance: float) -> tuple[np.ndarray, bool]:
 #: A record that never rises (or never falls) over this share of its input span leaves the
 #: model's branches of that direction over the wider part to the fit's guess.
 MIN_SWING = 0.75
-#: Turning points within this share of the span from an end of the range count as the end's.
+#: Turning points within this share of the span from an end of the range count as the end's,
+#: and reversals smaller than it are not minor loops (dither, noise, a filter's ripple).
 END_ZONE = 0.05
 
 
@@ -131,15 +132,18 @@ def largest_swings(levels) -> tuple[float, float]:
     --------
     >>> largest_swings([0.0, 60.0, 50.0, 100.0, 90.0])
     (100.0, 10.0)
+    >>> largest_swings([89.0, 90.0, 0.0, 50.0, 40.0, 90.0])  # starts just below its top
+    (90.0, 90.0)
     """
     stack: list[float] = []
     rise = fall = 0.0
     for level in levels:
-        while len(stack) >= 3 and abs(level - stack[-1]) >= abs(stack[-2] - stack[-1]):
-            del stack[-2:]
-        if stack:
+        while stack:  # the swing from each stored extremum that the level reaches past
             rise = max(rise, level - stack[-1])
             fall = max(fall, stack[-1] - level)
+            if len(stack) < 3 or abs(level - stack[-1]) < abs(stack[-2] - stack[-1]):
+                break
+            del stack[-2:]
         stack.append(float(level))
     return rise, fall
 
@@ -182,9 +186,14 @@ def coverage_warning(v, start: int = 0) -> str | None:
     span = float(np.ptp(v)) if v.size else 0.0
     if span <= 0.0:
         return None
-    idx, _ = turning_indices(v, default_tolerance(v))
+    idx, _ = turning_indices(v, END_ZONE * span)
     levels = v[idx]
     what = "hystcomp excite rich, or the paper's triangles of hystcomp excite mpi"
+    if start:
+        what += (
+            f"; the first {start} samples are left out as a start-up transient, until the "
+            "input first reaches an end of its range: --transient changes that"
+        )
     for swing, verb, noun in zip(
         largest_swings(levels), ("rises", "falls"), ("rising", "falling"), strict=True
     ):
