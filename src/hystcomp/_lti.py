@@ -75,22 +75,35 @@ def creep_lags(time_constants, sample_rate: float) -> np.ndarray:
     return np.exp(-1.0 / (sample_rate * np.asarray(time_constants, dtype=np.float64)))
 
 
-def frequency_response(frequencies, sample_rate, resonance_hz, damping_ratio, lags, weights):
-    """``D(exp(j 2 pi f Ts))`` of the model (see :mod:`hystcomp.models.dynamics`)."""
+def frequency_response(
+    frequencies, sample_rate, resonance_hz, damping_ratio, lags, weights, delay: int = 0
+):
+    """``D(exp(j 2 pi f Ts))`` of the model (see :mod:`hystcomp.models.dynamics`), with
+    ``delay`` samples of latency beyond the sample-and-hold's one."""
     f = np.asarray(frequencies, dtype=np.float64)
     z1 = np.exp(-2j * np.pi * f / sample_rate)  # z^-1
     b, a = resonance_zoh(resonance_hz, damping_ratio, sample_rate)
-    return creep_response(lags, weights, z1) * resonance_response(b, a, z1)
+    return creep_response(lags, weights, z1) * resonance_response(b, a, z1) * z1**delay
 
 
-def output(u, rest, sample_rate, resonance_hz, damping_ratio, lags, weights) -> np.ndarray:
-    """``D[u]`` from rest at ``rest``: the creep bank, then the resonance."""
+def output(
+    u, rest, sample_rate, resonance_hz, damping_ratio, lags, weights, delay: int = 0
+) -> np.ndarray:
+    """``D[u]`` from rest at ``rest``: the creep bank, then the resonance, ``delay`` samples
+    late (-1: a sample early, the sample-and-hold's own delay taken off)."""
     q = np.ascontiguousarray(u, dtype=np.float64) - rest
+    if delay < 0:  # the answer to u[k + 1] is known at k: hold the input one sample more
+        q = np.r_[q, q[-1:]]
     creep = q.copy()
     for a, c in zip(lags, weights, strict=True):
         creep += c * lag(a, q)
     creep /= 1.0 + float(np.sum(weights))
-    return rest + resonance(resonance_zoh(resonance_hz, damping_ratio, sample_rate), creep)
+    out = resonance(resonance_zoh(resonance_hz, damping_ratio, sample_rate), creep)
+    if delay < 0:
+        out = out[1:]
+    elif delay > 0:
+        out = np.r_[np.zeros(min(delay, out.size)), out[: out.size - delay]]
+    return rest + out
 
 
 def lag(a: float, u) -> np.ndarray:

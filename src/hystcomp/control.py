@@ -183,11 +183,28 @@ def _linear_dynamics(dyn, dt: float) -> DiscreteSystem:
     A[n:, n:] = a_res
     b_col = np.r_[1.0 - lags, b_res[:, 0] * d_creep]
     c_row = np.r_[np.zeros(n), c_res[0]]
-    d = 0.0
+    delay = dyn.delay_samples_
+    if delay < 0:  # the answer of the same sample: the output after this sample's update
+        return DiscreteSystem(
+            state=np.zeros(n + 2),
+            update=lambda s, u: A @ s + b_col * float(np.ravel(u)[0]),
+            output=lambda s, u: float(c_row @ (A @ s + b_col * float(np.ravel(u)[0]))),
+            inputs=("v",),
+            outputs=("x",),
+        )
+    # the latency: the last `delay` outputs in a line after the states, the oldest out
+    m = n + 2
+
+    def update(s, u):
+        out = np.empty_like(s)
+        out[:m] = A @ s[:m] + b_col * float(np.ravel(u)[0])
+        out[m:] = np.r_[c_row @ s[:m], s[m:-1]] if delay else s[m:]
+        return out
+
     return DiscreteSystem(
-        state=np.zeros(n + 2),
-        update=lambda s, u: A @ s + b_col * float(np.ravel(u)[0]),
-        output=lambda s, u: float(c_row @ s) + d * float(np.ravel(u)[0]),
+        state=np.zeros(m + delay),
+        update=update,
+        output=lambda s, u: float(s[-1] if delay else c_row @ s),
         inputs=("v",),
         outputs=("x",),
     )

@@ -511,14 +511,15 @@ unsigned long count_clamped(const double *x_ref, double *v, long n)
 """
 
 
-def _creeping():
-    """Dynamics with a 700 Hz resonance and two creep modes."""
+def _creeping(delay=0):
+    """Dynamics with a 700 Hz resonance, two creep modes and ``delay`` samples of latency."""
     return hystcomp.LinearDynamics.from_parameters(
         sample_rate=20_000.0,
         resonance_hz=700.0,
         damping_ratio=0.1,
         creep_time_constants=[0.004, 0.4],
         creep_weights=[0.01, 0.01],
+        delay_samples=delay,
     )
 
 
@@ -616,17 +617,19 @@ void run_primed(const double *x_ref, double *v, long n, long preview)
 
 
 @needs_cc
-@pytest.mark.parametrize("slewing", [False, True])
+@pytest.mark.parametrize(("slewing", "delay"), [(False, 0), (True, 0), (True, 3)])
 @pytest.mark.parametrize("name", ["paper_mpi_dynamics", "preisach_exact_dynamics"])
-def test_c_primed_on_the_look_ahead_is_the_batch_run(name, slewing, identified_preisach, tmp_path):
+def test_c_primed_on_the_look_ahead_is_the_batch_run(
+    name, slewing, delay, identified_preisach, tmp_path
+):
     """NAME_prime feeds the look-ahead to the filter alone, as the stepper's prime(): then
     NAME_step gives the batch run (the reference known ahead) from its first sample, slew
-    limit included, for a reference that starts away from rest."""
+    limit included, for a reference that starts away from rest (and a rig's latency)."""
     _, model = _counting_compensators(identified_preisach)[name]
     options = {"slew_rate": 2e5, "sample_rate": 20_000.0} if slewing else {}
     if model.kind == "preisach":
         options["method"] = "exact"
-    comp = model.inverse(dynamics=_creeping(), **options)
+    comp = model.inverse(dynamics=_creeping(delay), **options)
     low, high = model.reachable_range()
     t = np.arange(6000) / 20_000.0
     x = low + (high - low) * (0.5 + 0.3 * np.sin(2 * np.pi * 30.0 * t))

@@ -179,6 +179,17 @@ def test_dynamics_from_a_record_with_its_report_lines():
     assert result.warnings == []
 
 
+def test_dynamics_report_a_rig_s_latency():
+    true = LinearDynamics.from_parameters(
+        sample_rate=20_000.0, resonance_hz=780.0, damping_ratio=0.05, delay_samples=3
+    )
+    t, v = dynamics_excitation()
+    result = identify_dynamics_record(Record(t, v, 0.3 * true.simulate(v), source="late"))
+    assert result.model.delay_samples_ == 3
+    assert "  latency:   +3 samples beside the sample-and-hold's one (+150 µs)" in result.lines[3]
+    assert result.warnings == []
+
+
 def test_dynamics_without_a_resonance_are_a_warning():
     """A stage whose dynamics are a first-order lag (1.5 ms) has no resonance to find: the
     fit's damping ratio hits its bound, and the report says so rather than offering the

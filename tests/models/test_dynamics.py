@@ -194,6 +194,48 @@ def test_matching_leaves_its_centre_in_place_and_scales_about_it():
     assert gain < 0.995  # so that the two cases differ
 
 
+@pytest.mark.parametrize("delay", [-1, 1, 3, 17])
+def test_a_rig_s_latency_is_identified_and_looked_ahead_by_the_inverse(delay):
+    """A record whose displacement answers `delay` samples later than the sample-and-hold
+    (converters, filters; -1: in the same sample): the fit finds the latency and the
+    resonance as without it, and the inverse looks that much further ahead, so that the
+    stage still follows a 100 Hz sine in band. Before, one sample of latency made the fit
+    fail ("the step of the record gives no displacement")."""
+    _, v = dynamics_excitation()
+    x_ref = 3.0 + 5.0 * np.sin(2 * np.pi * 100.0 * np.arange(round(0.5 * FS)) / FS)
+    inner = slice(2000, -100)
+    true = _stage(delay_samples=delay)
+    x = 0.3 * true.simulate(v, initial=0.0) + 0.003 * np.random.default_rng(5).normal(size=v.size)
+    fit = LinearDynamics().fit(v, x, FS)
+    assert fit.delay_samples_ == delay
+    assert fit.resonance_hz_ == pytest.approx(780.0, rel=0.005)
+    inverse = fit.inverse(rest=3.0)
+    assert inverse.preview == _stage().inverse().preview + delay
+    back = true.simulate(inverse.simulate(x_ref), initial=3.0)
+    # (a latency of 3 samples left in would cost 0.47 µm here)
+    assert np.abs(back - x_ref)[inner].max() < 0.015 * 5.0
+    # the inverse of the true model: the latency inverted exactly
+    exact = {d: _stage(delay_samples=d) for d in (0, delay)}
+    errors = [
+        np.abs(m.simulate(m.inverse(rest=3.0).simulate(x_ref), initial=3.0) - x_ref)[inner]
+        for m in exact.values()
+    ]
+    np.testing.assert_allclose(errors[1], errors[0], atol=1e-4)
+
+
+def test_latency_in_simulate_and_the_frequency_response():
+    plain, late = _stage(), _stage(delay_samples=4)
+    u = np.r_[np.zeros(10), np.ones(200)]
+    np.testing.assert_array_equal(late.simulate(u), np.r_[np.zeros(4), plain.simulate(u)[:-4]])
+    early = _stage(delay_samples=-1).simulate(u)
+    np.testing.assert_allclose(early[:-1], plain.simulate(u)[1:], rtol=0, atol=1e-15)
+    f = np.array([10.0, 780.0, 3000.0])
+    shift = np.exp(-2j * np.pi * f * 4 / FS)
+    np.testing.assert_allclose(late.frequency_response(f), plain.frequency_response(f) * shift)
+    with pytest.raises(InvalidParameterError, match=r"'delay_samples'.*<= 32"):
+        _stage(delay_samples=33)
+
+
 def test_model_file_round_trip(identified, tmp_path):
     _, fit = identified
     hystcomp.save_model(fit, tmp_path / "dyn.json")
@@ -204,6 +246,10 @@ def test_model_file_round_trip(identified, tmp_path):
     f = np.array([0.0, 10.0, 780.0, 3000.0])
     np.testing.assert_array_equal(back.frequency_response(f), fit.frequency_response(f))
     assert back.fit_report_ == fit.fit_report_
+    # a file written before the latency existed reads as none
+    del doc["parameters"]["delay_samples"]
+    (tmp_path / "old.json").write_text(json.dumps(doc))
+    assert hystcomp.load_model(tmp_path / "old.json").delay_samples_ == 0
 
 
 def test_bad_parameters_are_refused():

@@ -76,6 +76,9 @@ RINGING_DECAYS = 4.0
 CREEP_SAMPLES = 2000
 #: Largest damping ratio the fit considers: a resonance damped beyond it is not one.
 MAX_DAMPING = 2.0
+#: Latencies (whole samples beyond the sample-and-hold's one) that the fit tries and a
+#: model may have: the inverse looks that far ahead, on top of the FIR's own look-ahead.
+DELAY_RANGE = (-1, 32)
 
 
 def dynamics_excitation(
@@ -189,15 +192,17 @@ def fit_dynamics(v, x, sample_rate: float) -> DynamicsFit:
     taus = creep_grid(hold)
     lags = np.exp(-1.0 / (fs * taus))
     x0 = float(np.mean(x[max(0, step - round(0.1 * fs)) : step]))
-    rise = x[step:multisine] - x0
+    # the rig's latency first: the lines, each advanced by d samples, fit best at the right d
     measured = _frf(v, x, multisine, n_period, periods, bins)
-    fn, zeta = _fit_resonance(measured, lines, fs, np.zeros(0), np.zeros(0), guess=None)
+    delay, (fn, zeta) = _fit_delay(measured, lines, fs)
+    advance = np.exp(2j * np.pi * lines * delay / fs)
+    rise = x[step + delay : multisine] - x0  # the answer to the step, from its own start
     weights, step_fit = _fit_creep(rise, fn, zeta, fs, lags)
     # the step's creep goes on through the multisine: take it out and fit again
     ramp = np.r_[np.zeros(step), np.ones(v.size - step)]
-    drift = step_fit * output(ramp, 0.0, fs, fn, zeta, lags, weights)
-    measured = _frf(v, x - drift, multisine, n_period, periods, bins)
-    fn, zeta = _fit_resonance(measured, lines, fs, lags, weights, guess=(fn, zeta))
+    drift = step_fit * output(ramp, 0.0, fs, fn, zeta, lags, weights, delay)
+    measured = _frf(v, x - drift, multisine, n_period, periods, bins) * advance
+    fn, zeta, _ = _fit_resonance(measured, lines, fs, lags, weights, guess=(fn, zeta))
     weights, step_fit = _fit_creep(rise, fn, zeta, fs, lags)
     parameters = {
         "sample_rate": fs,
@@ -205,6 +210,7 @@ def fit_dynamics(v, x, sample_rate: float) -> DynamicsFit:
         "damping_ratio": zeta,
         "creep_time_constants": taus.tolist(),
         "creep_weights": weights.tolist(),
+        "delay_samples": delay,
     }
     return DynamicsFit(parameters, _report(parameters, lags, measured, lines, rise, step_fit))
 
@@ -239,8 +245,65 @@ def _frf(v, x, start, n_period, periods, bins) -> np.ndarray:
     return np.fft.rfft(xx)[bins] / np.fft.rfft(vv)[bins]
 
 
+def _fit_delay(measured, lines, fs) -> tuple[int, tuple[float, float]]:
+    """``(d, (f_n, zeta))``: the latency in whole samples (in :data:`DELAY_RANGE`) whose
+    removal lets the resonance fit the lines best, and that fit.
+
+    A latency adds a phase that grows with frequency, which the free complex gain of
+    :func:`_fit_resonance` cannot take up, and leaves the magnitude as it is. So the
+    resonance is first fitted to the magnitude alone, the slope of the phase left over
+    gives the latency, and the complex fits at it, at its neighbours and at the rig's usual
+    0 decide.
+    """
+    from scipy.optimize import least_squares
+
+    use = lines >= FIT_FROM_HZ
+    f, g = lines[use], measured[use]
+    z1 = np.exp(-2j * np.pi * f / fs)
+
+    def at(fn, zeta):
+        b, a = resonance_zoh(fn, zeta, fs)
+        return resonance_response(b, a, z1)
+
+    def residual(theta):
+        r = np.log(np.abs(g)) - np.log(np.abs(at(*np.exp(theta))))
+        return r - r.mean()
+
+    theta0, bounds = _start(f, g, fs, None)
+    fn, zeta = np.exp(least_squares(residual, theta0, bounds=bounds).x)
+    left = np.angle(g / at(fn, zeta))
+    # lines close enough that the largest latency turns the phase by less than pi between them
+    close = np.r_[True, np.diff(f) < fs / (2.0 * (DELAY_RANGE[1] + 1))]
+    close = np.cumprod(close).astype(bool)
+    slope = np.polyfit(f[close], np.unwrap(left[close]), 1)[0] if close.sum() > 2 else 0.0
+    guess = int(np.clip(round(-slope * fs / (2.0 * np.pi)), *DELAY_RANGE))
+    z = np.exp(2j * np.pi * lines / fs)  # one sample of advance at each line
+    none = np.zeros(0)
+    fits = {
+        d: _fit_resonance(measured * z**d, lines, fs, none, none, guess=None)
+        for d in sorted({0, guess - 1, guess, guess + 1})
+        if DELAY_RANGE[0] <= d <= DELAY_RANGE[1]
+    }
+    d = min(fits, key=lambda k: fits[k][2])
+    return d, fits[d][:2]
+
+
+def _start(f, g, fs, guess):
+    """Start and bounds of the resonance fits, in logs: the peak of the lines, and a damping
+    ratio from its height, unless a ``guess`` is given."""
+    if guess is None:
+        peak = f[np.argmax(np.abs(g))]
+        ratio = np.abs(g).max() / np.abs(g[0])
+        guess = (peak, min(0.7, max(1e-3, 0.5 / ratio)))
+    bounds = (np.log([1.0, 1e-4]), np.log([0.45 * fs, MAX_DAMPING]))
+    return np.clip(
+        np.log(np.asarray(guess, dtype=np.float64)), bounds[0] + 1e-9, bounds[1] - 1e-9
+    ), bounds
+
+
 def _fit_resonance(measured, lines, fs, lags, weights, guess):
-    """``(f_n, zeta)`` of the resonance, the local gain eliminated (relative complex error)."""
+    """``(f_n, zeta, cost)`` of the resonance, the local gain eliminated (relative complex
+    error; ``cost`` its half sum of squares)."""
     from scipy.optimize import least_squares
 
     use = lines >= FIT_FROM_HZ
@@ -255,16 +318,10 @@ def _fit_resonance(measured, lines, fs, lags, weights, guess):
         r = (gain * m - g) / np.abs(g)
         return np.r_[r.real, r.imag]
 
-    if guess is None:
-        peak = f[np.argmax(np.abs(g))]
-        ratio = np.abs(g).max() / np.abs(g[0])
-        guess = (peak, min(0.7, max(1e-3, 0.5 / ratio)))
-    theta0 = np.log(np.asarray(guess, dtype=np.float64))
-    bounds = (np.log([1.0, 1e-4]), np.log([0.45 * fs, MAX_DAMPING]))
-    theta0 = np.clip(theta0, bounds[0] + 1e-9, bounds[1] - 1e-9)
+    theta0, bounds = _start(f, g, fs, guess)
     result = least_squares(residual, theta0, bounds=bounds, x_scale=1.0)
     fn, zeta = np.exp(result.x)
-    return float(fn), float(zeta)
+    return float(fn), float(zeta), float(result.cost)
 
 
 def _fit_creep(rise, fn, zeta, fs, lags):

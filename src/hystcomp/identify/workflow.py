@@ -575,6 +575,13 @@ def identify_dynamics_record(record) -> DynamicsResult:
     lines.append(
         f"  resonance: {model.resonance_hz_:.5g} Hz, damping ratio {model.damping_ratio_:.3g}"
     )
+    delay = model.delay_samples_
+    if delay:  # the rig's latency, beyond the sample-and-hold's one sample
+        lines.append(
+            f"  latency:   {delay:+d} sample{'s' if abs(delay) > 1 else ''} beside the "
+            f"sample-and-hold's one ({1e6 * delay / record.sample_rate:+.4g} µs); the inverse "
+            "looks that much further ahead"
+        )
     lines.append(
         f"  creep:     {100 * model.creep_fraction(0.0):.3g} % of the final displacement, "
         f"{100 * model.creep_fraction(1.0):.3g} % of it after 1 s "

@@ -7,13 +7,15 @@ inverse of ``D`` in series: ``v = H^-1[D^-1[x_ref]]``.
 
 The model, in discrete time at the sample rate ``fs`` (``Ts = 1/fs``)::
 
-    D(z) = C(z) R(z)
+    D(z) = z^-d C(z) R(z)
     C(z) = (1 + sum_i c_i (1 - a_i) / (1 - a_i z^-1)) / (1 + sum_i c_i),  a_i = exp(-Ts/tau_i)
     R(z) = ZOH{ wn^2 / (s^2 + 2 zeta wn s + wn^2) } = (b1 z + b2) / (z^2 + a1 z + a2)
 
 ``C`` is a bank of first-order creep modes with log-spaced time constants ``tau_i`` and
 weights ``c_i >= 0`` (creep rising roughly as ``log t`` over the decades they span), ``R``
-the first resonance, discretised with a zero-order hold (exactly as a sampled rig sees it).
+the first resonance, discretised with a zero-order hold (exactly as a sampled rig sees it),
+``d`` the rig's latency in whole samples beyond the hold's one (converters, filters; -1
+for a record whose displacement answers the voltage of the same sample).
 Both have unit gain at steady state, ``D(1) = 1``, so the hysteresis model keeps its static
 map: the creep weights say how far the displacement still moves after a step, as a fraction
 of where it settles.
@@ -32,7 +34,8 @@ The inverse (:meth:`LinearDynamics.inverse`) is stable whatever was identified:
   inverse overshoots a step by 10 % and rings). The price is an in-band error growing as
   ``f^4`` (1.5 % at 200 Hz for a 630 Hz, zeta 0.1 resonance at 20 kHz).
 
-The FIR part is non-causal by a fixed number of samples (:attr:`~hystcomp.models.dynamic_compensator.DynamicsInverse.preview`):
+The FIR part is non-causal by a fixed number of samples (:attr:`~hystcomp.models.dynamic_compensator.DynamicsInverse.preview`,
+the latency ``d`` included: its inverse is a look-ahead of ``d`` samples):
 a batch run of a known reference takes those samples from the future; a streaming stepper
 takes the reference that many samples ahead (or, fed the reference of *now*, its output
 lags the reference by ``preview`` samples).
@@ -45,9 +48,9 @@ from typing import Any, ClassVar
 import numpy as np
 
 from hystcomp import _lti
-from hystcomp._validation import as_signal, as_vector, check_real
+from hystcomp._validation import as_signal, as_vector, check_int, check_real
 from hystcomp.errors import InvalidParameterError, InvalidTypeError, NotFittedError
-from hystcomp.identify.dynamics import fit_dynamics
+from hystcomp.identify.dynamics import DELAY_RANGE, fit_dynamics
 from hystcomp.models.dynamic_compensator import (
     MATCH_HZ,
     DynamicCompensator,
@@ -112,12 +115,14 @@ class LinearDynamics:
         "damping_ratio",
         "creep_time_constants",
         "creep_weights",
+        "delay_samples",
     )
     sample_rate_: float
     resonance_hz_: float
     damping_ratio_: float
     creep_time_constants_: np.ndarray
     creep_weights_: np.ndarray
+    delay_samples_: int
 
     @classmethod
     def from_parameters(
@@ -128,8 +133,12 @@ class LinearDynamics:
         damping_ratio,
         creep_time_constants=(),
         creep_weights=(),
+        delay_samples=0,
     ) -> LinearDynamics:
-        """A model from its parameters (units as in the class attributes), validated."""
+        """A model from its parameters (units as in the class attributes), validated.
+
+        ``delay_samples`` (0 by default, and in model files written before it existed) is
+        the latency in whole samples beyond the sample-and-hold's one."""
         owner = cls.__name__
         model = cls()
         model.sample_rate_ = check_real(sample_rate, "sample_rate", owner, positive=True)
@@ -170,6 +179,9 @@ class LinearDynamics:
             )
         model.creep_time_constants_ = taus
         model.creep_weights_ = weights
+        model.delay_samples_ = check_int(
+            delay_samples, "delay_samples", owner, minimum=DELAY_RANGE[0], maximum=DELAY_RANGE[1]
+        )
         return model
 
     def fit(self, v, x, sample_rate: float) -> LinearDynamics:
@@ -214,6 +226,7 @@ class LinearDynamics:
             self.damping_ratio_,
             self.creep_lags,
             self.creep_weights_,
+            self.delay_samples_,
         )
 
     def simulate(self, u, *, initial: float | None = None) -> np.ndarray:
@@ -229,6 +242,7 @@ class LinearDynamics:
             self.damping_ratio_,
             self.creep_lags,
             self.creep_weights_,
+            self.delay_samples_,
         )
 
     def creep_fraction(self, seconds: float) -> float:
@@ -303,6 +317,9 @@ class LinearDynamics:
                 f"The 'rest' parameter of {owner} must lie in 'output_range' ({low:g} .. "
                 f"{high:g} µm). Got {rest:g}."
             )
+        preview += self.delay_samples_  # the latency's inverse: a look-ahead
+        if preview < 0:  # a record that answers early, and a FIR that looks ahead 0
+            taps, preview = np.r_[np.zeros(-preview), taps], 0
         return DynamicsInverse(
             gain * taps,
             self.creep_lags,
@@ -339,6 +356,7 @@ class LinearDynamics:
             "damping_ratio": self.damping_ratio_,
             "creep_time_constants": self.creep_time_constants_.tolist(),
             "creep_weights": self.creep_weights_.tolist(),
+            "delay_samples": self.delay_samples_,
         }
 
     def get_params(self) -> dict[str, Any]:
