@@ -249,3 +249,11 @@ def test_the_coverage_warning_ignores_dither_and_a_start_mid_range():
     started_mid = np.interp(np.linspace(0, 6, 7000), np.arange(7), levels)
     assert transient_end(started_mid) < np.argmax(started_mid)  # on the rise, before the top
     assert coverage_warning(started_mid, transient_end(started_mid)) is None
+
+
+def test_an_unknown_option_or_progress_is_refused_by_name():
+    rec = _loops(1.0)
+    with pytest.raises(InvalidParameterError, match="n_operators is called 'operators' here"):
+        identify_record(rec, "pi", n_operators=4)
+    with pytest.raises(InvalidTypeError, match="'progress' argument of identify_record"):
+        identify_record(rec, "pi", progress=5)

@@ -367,6 +367,21 @@ def identify_record(
                 f"got {type(record).__name__}. Read a file with hystcomp.io.records.read_record or "
                 "build a Record from arrays."
             )
+    known = sorted({name for names in SIZE_OPTIONS.values() for name in names})
+    unknown = sorted(set(options) - set(known))
+    if unknown:
+        names = {"n_operators": "operators", "n_deadzones": "deadzones", "grid_size": "grid"}
+        names["fit_method"] = "fit"
+        hint = "; ".join(f"{k} is called {names[k]!r} here" for k in unknown if k in names)
+        raise InvalidParameterError(
+            f"{_OWNER} got an unknown option {unknown[0]!r}; its options are "
+            f"{', '.join(known)} (hystcomp identify's names)" + (f": {hint}." if hint else ".")
+        )
+    if progress is not None and not hasattr(progress, "__enter__"):
+        raise InvalidTypeError(
+            f"The 'progress' argument of {_OWNER} must be a context manager (entered while the "
+            f"model is fitted) or None; got {type(progress).__name__}."
+        )
     if isinstance(model, str):
         model = build_estimator(model, voltage_range=voltage_range, **options)
     elif options or voltage_range is not None:
