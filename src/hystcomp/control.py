@@ -216,6 +216,8 @@ def _dynamic_compensator(obj, dt: float) -> DiscreteSystem:
     As the compensator's stepper, its input is the reference ``preview`` samples ahead
     (:attr:`~hystcomp.models.dynamic_compensator.DynamicCompensator.preview`).
     """
+    if obj.sample_rate is not None:
+        _check_rate(dt, obj.sample_rate, "the dynamics'", "identify them at the loop's rate")
     stepper = obj.stepper()
     dyn, hyst = stepper._dyn, stepper._hyst
     n_dyn, start = dyn._p.size, hyst._start

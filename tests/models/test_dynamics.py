@@ -608,3 +608,22 @@ def test_a_record_whose_displacement_does_not_move_is_refused_with_the_reason():
     _, v = dynamics_excitation(sample_rate=20_000.0, voltage_range=(0.0, 120.0))
     with pytest.raises(IdentificationError, match="does not move"):
         LinearDynamics().fit(v, np.full_like(v, 3.0), 20_000.0)
+
+
+def test_the_compensator_runs_at_the_dynamics_rate():
+    """Discrete-time dynamics run at their own rate only: inverse(dynamics=...) takes it
+    (before, it kept 20 kHz, and a slew limit at 10 kHz was silently halved), refuses
+    another, and to_control checks dt against it."""
+    slow = _stage(sample_rate=10_000.0)
+    model = hystcomp.presets.paper_mpi()
+    assert model.inverse(dynamics=slow, slew_rate=1000.0).max_step == pytest.approx(0.1)
+    assert model.inverse(slew_rate=1000.0).max_step == pytest.approx(0.05)
+    preisach = hystcomp.presets.paper_preisach()
+    assert preisach.inverse(dynamics=slow, slew_rate=1000.0).max_step == pytest.approx(0.1)
+    with pytest.raises(InvalidParameterError, match="differs from the sample rate of its"):
+        model.inverse(dynamics=slow, sample_rate=20_000.0)
+    if importlib.util.find_spec("control") is not None:
+        from hystcomp.control import to_control
+
+        with pytest.raises(InvalidParameterError, match="the dynamics' sample time"):
+            to_control(model.inverse(dynamics=slow), 5e-5)

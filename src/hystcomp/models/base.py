@@ -92,6 +92,23 @@ def slew_to_step(slew_rate, sample_rate, owner) -> float:
     return slew_rate / sample_rate
 
 
+def compensator_rate(sample_rate, dynamics, owner) -> float:
+    """The sample rate (Hz) a compensator runs at: ``sample_rate``, else that of
+    ``dynamics`` (a discrete-time model, which runs at its own rate only), else the
+    twin's 20 kHz; a ``sample_rate`` other than the dynamics' is refused."""
+    own = getattr(dynamics, "sample_rate_", None)
+    if sample_rate is None:
+        return paper.SAMPLE_RATE if own is None else float(own)
+    sample_rate = check_real(sample_rate, "sample_rate", owner, positive=True)
+    if own is not None and abs(sample_rate - own) > 1e-9 * own:
+        raise InvalidParameterError(
+            f"The 'sample_rate' parameter of {owner} ({sample_rate:g} Hz) differs from the "
+            f"sample rate of its 'dynamics' ({own:g} Hz), which run at that rate only. Leave "
+            "sample_rate out, or identify the dynamics at the compensator's rate."
+        )
+    return sample_rate
+
+
 def fit_voltage_range(voltage_range, v, owner) -> tuple[float, float]:
     """The ``voltage_range`` hyperparameter, or the data's ``(min v, max v)`` if it is None."""
     if voltage_range is None:

@@ -234,13 +234,16 @@ class DynamicCompensator:
         The inverse of the dynamics.
     preview : int
         Samples by which :meth:`stepper` takes its reference ahead (see :meth:`stepper`).
+    sample_rate : float or None
+        Hz: that of the dynamics, the only rate it runs at (None if not given).
     kind, voltage_range, max_step
         Those of :attr:`hysteresis`.
     """
 
-    def __init__(self, hysteresis, dynamics_inverse: DynamicsInverse):
+    def __init__(self, hysteresis, dynamics_inverse: DynamicsInverse, sample_rate=None):
         self.hysteresis = hysteresis
         self.dynamics_inverse = dynamics_inverse
+        self.sample_rate = sample_rate
         self.kind = hysteresis.kind
         self.voltage_range = hysteresis.voltage_range
         self.max_step = hysteresis.max_step

@@ -442,4 +442,4 @@ def with_dynamics(
         match_hz=match_hz,
         match_centre=rest if closes else 0.5 * (rest + top),
     )
-    return DynamicCompensator(compensator, inverse)
+    return DynamicCompensator(compensator, inverse, sample_rate=dynamics.sample_rate_)

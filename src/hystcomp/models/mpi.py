@@ -246,7 +246,7 @@ class ModifiedPrandtlIshlinskii(PrandtlIshlinskii):
         check_invertible(self.deadzone_weights_, f"The saturation operator S of this {owner} model")
 
     def inverse(
-        self, *, slew_rate=None, sample_rate=paper.SAMPLE_RATE, voltage_range=None, dynamics=None
+        self, *, slew_rate=None, sample_rate=None, voltage_range=None, dynamics=None
     ) -> Compensator | DynamicCompensator:
         """The analytic inverse MPI, eq. (23): ``v = v_0 + H^-1[S^-1[x - x_0]]``, clamped.
 

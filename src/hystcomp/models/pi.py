@@ -29,6 +29,7 @@ from hystcomp.identify.scoring import error_report
 from hystcomp.models.base import (
     DEFAULT_VOLTAGE_RANGE,
     HysteresisModel,
+    compensator_rate,
     fit_voltage_range,
     slew_to_step,
 )
@@ -283,7 +284,7 @@ class PrandtlIshlinskii(HysteresisModel):
         )
 
     def inverse(
-        self, *, slew_rate=None, sample_rate=paper.SAMPLE_RATE, voltage_range=None, dynamics=None
+        self, *, slew_rate=None, sample_rate=None, voltage_range=None, dynamics=None
     ) -> Compensator | DynamicCompensator:
         """The analytic inverse PI (eqs. 24-26) as a compensator clamped to the voltage range.
 
@@ -291,8 +292,10 @@ class PrandtlIshlinskii(HysteresisModel):
         ----------
         slew_rate : float, optional
             Largest output slew rate in V/s (none by default).
-        sample_rate : float, default 20000
-            Sample rate in Hz at which the compensator runs; sets the per-sample slew step.
+        sample_rate : float, optional
+            Sample rate in Hz at which the compensator runs; sets the per-sample slew step
+            (by default that of ``dynamics``, else 20000; another than the dynamics' is
+            refused).
         voltage_range : (float, float), optional
             A narrower output clamp in V, inside ``voltage_range_`` (never wider).
         dynamics : LinearDynamics, optional
@@ -310,6 +313,7 @@ class PrandtlIshlinskii(HysteresisModel):
         self._check_invertible()
         # the chain x -> (x - x_0) -> [S^-1 dead-zones] -> inverse plays (eqs. 24-26) -> + v_0
         owner = type(self).__name__
+        sample_rate = compensator_rate(sample_rate, dynamics, f"{owner}.inverse")
         max_step = slew_to_step(slew_rate, sample_rate, owner)
         lo, hi = self._clamp_range(voltage_range, f"{owner}.inverse")
         saturation = self._saturation()

@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from hystcomp import paper
 from hystcomp._hyperparameters import MAX_DEGREE, check_options
 from hystcomp._kernels import preisach as pk
 from hystcomp._validation import (
@@ -25,7 +24,12 @@ from hystcomp.errors import InvalidParameterError, InvalidTypeError
 from hystcomp.identify.compensation import compensation_error
 from hystcomp.identify.preisach import FIT_METHODS, identify_preisach
 from hystcomp.identify.scoring import transient_end
-from hystcomp.models.base import DEFAULT_VOLTAGE_RANGE, HysteresisModel, slew_to_step
+from hystcomp.models.base import (
+    DEFAULT_VOLTAGE_RANGE,
+    HysteresisModel,
+    compensator_rate,
+    slew_to_step,
+)
 from hystcomp.models.compensator import Compensator
 from hystcomp.models.dynamic_compensator import DynamicCompensator
 from hystcomp.models.dynamics import with_dynamics
@@ -394,7 +398,7 @@ class Preisach(HysteresisModel):
         method=None,
         rho=None,
         slew_rate=None,
-        sample_rate=paper.SAMPLE_RATE,
+        sample_rate=None,
         voltage_range=None,
         dynamics=None,
     ) -> PreisachCompensator | DynamicCompensator:
@@ -421,8 +425,10 @@ class Preisach(HysteresisModel):
             Gain in µm/V for ``"multiplicative"``; default :meth:`default_rho`.
         slew_rate : float, optional
             Largest output slew rate in V/s (none by default).
-        sample_rate : float, default 20000
-            Sample rate in Hz at which the compensator runs; sets the per-sample slew step.
+        sample_rate : float, optional
+            Sample rate in Hz at which the compensator runs; sets the per-sample slew step
+            (by default that of ``dynamics``, else 20000; another than the dynamics' is
+            refused).
         voltage_range : (float, float), optional
             A narrower output clamp in V, inside ``voltage_range_`` (never wider).
         dynamics : LinearDynamics, optional
@@ -438,7 +444,7 @@ class Preisach(HysteresisModel):
                 method=method,
                 rho=rho,
                 slew_rate=slew_rate,
-                sample_rate=sample_rate,
+                sample_rate=compensator_rate(sample_rate, dynamics, "Preisach.inverse"),
                 voltage_range=voltage_range,
             )
             return with_dynamics(self, compensator, dynamics)
@@ -450,7 +456,7 @@ class Preisach(HysteresisModel):
                 f"The 'method' parameter of {owner}.inverse must be 'multiplicative' (eq. 10) "
                 f"or 'exact'. Got {method!r} instead."
             )
-        max_step = slew_to_step(slew_rate, sample_rate, owner)
+        max_step = slew_to_step(slew_rate, compensator_rate(sample_rate, None, owner), owner)
         if method == "exact":
             if rho is not None:
                 raise InvalidParameterError(
