@@ -104,3 +104,19 @@ def test_grid_search_chooses_hyperparameters_through_the_contract():
     assert search.best_params_ == {"n_operators": 16}
     assert search.best_estimator_.constraints == "paper"
     assert search.best_estimator_.score(v, x) > 0.99
+
+
+def test_scikit_learn_scorers_and_cross_val_predict_use_predict():
+    """predict is simulate: a scorer other than R², and cross_val_predict, work."""
+    from sklearn.model_selection import cross_val_predict
+
+    _, v = triangle_sequence([120.0, 60.0, 120.0, 90.0], sample_rate=300)
+    x = presets.paper_mpi().simulate(v)
+    model = PrandtlIshlinskii().fit(v, x)
+    np.testing.assert_array_equal(model.predict(v), model.simulate(v))
+    base = PrandtlIshlinskii(constraints="paper")  # as above: more plays can only help
+    search = GridSearchCV(
+        base, {"n_operators": [2, 16]}, cv=2, scoring="neg_root_mean_squared_error"
+    ).fit(v, x)
+    assert search.best_params_ == {"n_operators": 16}
+    assert cross_val_predict(PrandtlIshlinskii(), v, x, cv=2).shape == x.shape

@@ -28,7 +28,8 @@ class Estimator:
     the model file and ``repr`` read them from the signature, so a new hyperparameter is
     written once. That is scikit-learn's estimator contract, without importing it:
     ``sklearn.base.clone``, grid searches and pipelines work on these models, and
-    :meth:`score` is the coefficient of determination of the predicted displacement.
+    :meth:`predict` is :meth:`simulate` and :meth:`score` the coefficient of determination
+    of the predicted displacement.
     A model without learned parameters can only be fitted.
 
     A subclass gives ``simulate(v)`` (the prediction :meth:`score` rates) and the
@@ -135,6 +136,12 @@ class Estimator:
                 )
             setattr(self, name, value)
         return self
+
+    def predict(self, v) -> np.ndarray:
+        """The displacement (µm) predicted for the voltage ``v`` (V): :meth:`simulate`, under
+        scikit-learn's name, so that its scorers, ``cross_val_predict`` and a pipeline's
+        ``predict`` work on these models too."""
+        return self.simulate(v)
 
     def score(self, v, x) -> float:
         """Coefficient of determination R² of the displacement predicted for ``v``.
