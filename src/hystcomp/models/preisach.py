@@ -23,7 +23,7 @@ from hystcomp._validation import (
 from hystcomp.errors import InvalidParameterError, InvalidTypeError
 from hystcomp.identify.compensation import compensation_error
 from hystcomp.identify.preisach import FIT_METHODS, identify_preisach
-from hystcomp.identify.scoring import transient_end
+from hystcomp.identify.scoring import error_report, transient_end
 from hystcomp.models.base import (
     DEFAULT_VOLTAGE_RANGE,
     HysteresisModel,
@@ -271,8 +271,9 @@ class Preisach(HysteresisModel):
         Returns
         -------
         Preisach
-            ``self``, fitted; ``fit_report_`` holds the fit's figures, among them
-            ``tracking_rms_um`` (the estimated tracking error of ``inverse()``, µm rms,
+            ``self``, fitted; ``fit_report_`` holds the fit's figures, among them the
+            errors of :func:`~hystcomp.identify.scoring.error_report` (``rms_error_um`` ...),
+            ``tracking_rms_um``  (the estimated tracking error of ``inverse()``, µm rms,
             :func:`hystcomp.identify.compensation.compensation_error`, from the first sample
             at an end of the range on) and ``baseline_tracking_rms_um`` (the same for a
             straight line ``v = x / k_lin``), as for PI and MPI.
@@ -292,8 +293,10 @@ class Preisach(HysteresisModel):
         self.table_ = None if result.table is None else _frozen(result.table)
         self.voltage_range_ = result.voltage_range
         self.output_offset_ = result.output_offset
-        report = dict(result.report)
-        est = compensation_error(self, v, x, start=transient_end(v))
+        start = transient_end(v)
+        # the same error figures as the PI and MPI reports, beside the fit's own
+        report = {**error_report(x, self.simulate(v), start), **result.report}
+        est = compensation_error(self, v, x, start=start)
         report["tracking_rms_um"] = est["tracking_rms_um"]
         report["baseline_tracking_rms_um"] = est["baseline_rms_um"]
         self.fit_report_ = report
