@@ -627,3 +627,14 @@ def test_the_compensator_runs_at_the_dynamics_rate():
 
         with pytest.raises(InvalidParameterError, match="the dynamics' sample time"):
             to_control(model.inverse(dynamics=slow), 5e-5)
+
+
+def test_a_reference_shorter_than_the_preview_is_held_past_its_end():
+    comp = hystcomp.presets.paper_mpi().inverse(dynamics=_stage())
+    d = comp.preview
+    for n in (1, 3, d - 1):
+        x = np.linspace(5.0, 8.0, n)
+        s = comp.stepper()
+        ahead = np.r_[x, np.full(d, x[-1])]
+        s.prime(ahead[:d])
+        np.testing.assert_array_equal(comp.simulate(x), s.step_block(ahead[d:]))

@@ -89,9 +89,9 @@ def _run_ahead(stepper, x_ref, preview: int) -> np.ndarray:
     """``stepper``'s outputs for a known reference, aligned with it: primed with its first
     ``preview`` samples, and the reference held at its last value past its end."""
     x = as_signal(x_ref, "x_ref")
-    stepper.prime(x[:preview])
-    tail = np.full(min(preview, x.size), x[-1])
-    return stepper.step_block(np.concatenate([x[preview:], tail]))
+    ahead = np.concatenate([x, np.full(preview, x[-1])])  # held, even if shorter than preview
+    stepper.prime(ahead[:preview])
+    return stepper.step_block(ahead[preview:])
 
 
 class DynamicsInverse:
