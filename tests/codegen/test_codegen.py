@@ -601,17 +601,18 @@ def test_a_model_is_refused_with_the_call_that_exports_its_compensator():
 PRIMED_DRIVER = """
 #include "{p}.h"
 
-void run_primed(const double *x_ref, double *v, long n, long preview)
+long run_primed(const double *x_ref, double *v, long n)
 {
     {p}_state s;
     long k;
     {p}_init(&s);
-    for (k = 0; k < preview; k++) {
+    for (k = 0; k < COMP_PREVIEW; k++) {
         {p}_prime(&s, x_ref[k]);
     }
-    for (k = preview; k < n; k++) {
-        v[k - preview] = {p}_step(&s, x_ref[k]);
+    for (k = COMP_PREVIEW; k < n; k++) {
+        v[k - COMP_PREVIEW] = {p}_step(&s, x_ref[k]);
     }
+    return COMP_PREVIEW;
 }
 """
 
@@ -635,10 +636,11 @@ def test_c_primed_on_the_look_ahead_is_the_batch_run(
     x = low + (high - low) * (0.5 + 0.3 * np.sin(2 * np.pi * 30.0 * t))
     d = comp.preview
     run = _library(comp, tmp_path, PRIMED_DRIVER, "run_primed")
-    run.argtypes = [ctypes.c_void_p, ctypes.c_void_p, ctypes.c_long, ctypes.c_long]
+    run.argtypes = [ctypes.c_void_p, ctypes.c_void_p, ctypes.c_long]
+    run.restype = ctypes.c_long
     ahead = np.ascontiguousarray(np.r_[x, np.full(d, x[-1])])
     v = np.empty(x.size)
-    run(ahead.ctypes.data, v.ctypes.data, ahead.size, d)
+    assert run(ahead.ctypes.data, v.ctypes.data, ahead.size) == d  # the header's NAME_PREVIEW
     batch = comp.simulate(x)
     np.testing.assert_allclose(v, batch, rtol=0, atol=1e-9)
     assert abs(batch[0] - comp.stepper().last_output) > 5.0  # it starts away from rest

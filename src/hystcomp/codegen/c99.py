@@ -151,7 +151,7 @@ class CTemplate:
 
     ``public`` are further functions of the interface, each ``(comment lines, definition)``:
     the header declares them after ``NAME_step``, with the comment, and the source defines
-    them last.
+    them last. ``defines`` are lines of the header before the state struct (constants).
     """
 
     kind: str
@@ -170,6 +170,7 @@ class CTemplate:
     hold_on_overflow: bool = True
     count_clamped: bool = True
     public: list[tuple[list[str], str]] = field(default_factory=list)
+    defines: list[str] = field(default_factory=list)
 
 
 def check_prefix(prefix: str) -> str:
@@ -259,6 +260,8 @@ def render(
             'extern "C" {',
             "#endif",
             "",
+            *template.defines,
+            *([""] if template.defines else []),
             "typedef struct {",
             *(f"    {line}" for line in fields),
             f"}} {p}_state;",
@@ -343,7 +346,9 @@ def render(
             *(f"{definition}\n" for _, definition in template.public),
         ]
     )
-    header, source_text = header.replace("{p}", p), source_text.replace("{p}", p)
+    header, source_text = (
+        text.replace("{p}", p).replace("{P}", p.upper()) for text in (header, source_text)
+    )
     # A hash of both texts, defined in the header and checked in the source: a NAME.h and a
     # NAME.c from two different exports (two runs into one folder) do not compile together.
     digest = hashlib.sha256((header + "\0" + source_text).encode()).hexdigest()[:12]

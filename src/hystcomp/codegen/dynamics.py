@@ -43,6 +43,10 @@ def add_dynamics(template: CTemplate, inverse) -> CTemplate:
         "  sample its voltage is for (fed the reference of now, the stage lags it by that).",
         f"  Call NAME_prime on the first {inverse.preview} reference samples first, then NAME_step.",
     ]
+    template.defines += [
+        "/* the samples by which {p}_step takes the reference ahead ({p}_prime that many) */",
+        f"#define {{P}}_PREVIEW {inverse.preview}",
+    ]
     template.state_fields += [f"double dyn_line[{n_fir}]; /* reference delay line, um */"]
     template.tables.append(c_table("{p}_dyn_h", taps, "FIR taps: resonance inverse, non-negative"))
     rest = c_double(inverse.rest)
