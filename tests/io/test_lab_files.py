@@ -343,3 +343,10 @@ def test_optional_columns_are_read_when_present(tmp_path, record):
     assert set(read_table(tmp_path / "v.csv", ("v",), optional=("x",))) == {"t", "v"}
     with pytest.raises(InvalidParameterError, match="'keys' and 'optional'"):
         read_table(path, ("v",), optional=("v",))
+
+
+def test_one_column_is_not_read_as_two_signals(tmp_path, record):
+    path = tmp_path / "rec.csv"
+    write_table(path, record)
+    with pytest.raises(DataFileError, match=r"read both as 'v'.*and as 'x'"):
+        read_table(path, columns={"x": "v"})

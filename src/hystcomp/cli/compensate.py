@@ -171,6 +171,6 @@ def _reach(model, lo: float, hi: float) -> tuple[str, tuple[float, float]]:
     if f"{d_lo:.4g} {d_hi:.4g}" != f"{x_lo:.4g} {x_hi:.4g}":
         text += (
             f", but after a swing over the whole range only {d_lo:.4g} .. {d_hi:.4g} µm "
-            "(its loops do not close at the ends)"
+            "(it starts from a state off its major loop, which a swing leaves for good)"
         )
     return text, (d_lo, d_hi)

@@ -72,7 +72,7 @@ def _validation(v, measured, x, source) -> str:
     from hystcomp.identify.scoring import error_report, straight_line, transient_end
 
     start = transient_end(v)
-    if start >= v.size - 1:
+    if v.size - start < max(10, v.size // 10):  # too little left after it: score it all
         start = 0
     model = error_report(measured, x, start)
     a, b = straight_line(v[start:], measured[start:])

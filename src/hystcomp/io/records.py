@@ -423,9 +423,17 @@ def read_table(
         if progress is not None:
             progress(1.0)  # done, or failed: either way the progress line goes
     out = {}
+    taken: dict[int, str] = {}
     for key in ("t", *both):
         index, label = _pick(path, raw, key, columns.get(key), key in keys)
+        if index is not None and index in taken:
+            raise DataFileError(
+                f"Data file {str(path)!r}: {label} would be read both as {taken[index]!r} "
+                f"({MEANINGS[taken[index]]}) and as {key!r} ({MEANINGS[key]}). Name "
+                f"another column for one of them (--columns {key}=...)."
+            )
         if index is not None:
+            taken[index] = key
             arr = _as_column(raw.arrays[index], path, key, label)
             factor = _units(path, raw, key, index, x_unit)
             if factor != 1.0:
