@@ -119,7 +119,7 @@ def check_thresholds(value, name: str, owner: str) -> np.ndarray:
     r = as_vector(value, name, owner)
     if r[0] != 0.0:
         raise InvalidParameterError(
-            f"The {name!r} parameter of {owner} must start at 0 (r_0 = 0, as in eqs. 12 and 15). "
+            f"The {name!r} parameter of {owner} must start at 0 (r_0 = 0, as in eqs. 16 and 17). "
             f"Got r_0 = {float(r[0])!r}; shift the thresholds so that the first is 0."
         )
     if r.size > 1 and not np.all(np.diff(r) > 0):
@@ -187,7 +187,8 @@ def as_signal(value, name: str, *, min_samples: int = 1) -> np.ndarray:
         )
     if arr.size < min_samples:
         raise InvalidSignalError(
-            f"{name!r} must have at least {min_samples} samples. Got {arr.size}."
+            f"{name!r} must have at least {min_samples} sample{'' if min_samples == 1 else 's'}. "
+            f"Got {arr.size}."
         )
     bad = _first_out_of_bounds(arr)
     if bad is not None:
