@@ -102,7 +102,7 @@ def output(
     if delay < 0:
         out = out[1:]
     elif delay > 0:
-        out = np.r_[np.zeros(min(delay, out.size)), out[: out.size - delay]]
+        out = np.r_[np.zeros(min(delay, out.size)), out[: max(out.size - delay, 0)]]
     return rest + out
 
 
