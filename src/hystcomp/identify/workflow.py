@@ -548,7 +548,7 @@ class DynamicsResult:
 
 
 #: Least share of the frequency response the dynamics must explain to be used without a
-#: warning: a linear stage gives more than 97 %, the twins' hysteresis around the bias 87
+#: warning: a linear stage gives more than 97 %, the twins' hysteresis around the bias 88
 #: and 91 %; a stage whose hysteresis changes with the rate, or that has no resonance in
 #: the band, much less (62 % on a Bouc-Wen stage whose loop widens with rate, where the
 #: inverse made 1 Hz tracking 2 to 3 times worse).
