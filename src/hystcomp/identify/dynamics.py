@@ -367,8 +367,9 @@ def _fit_creep(rise, fn, zeta, fs, lags):
     coef[1:][seen] = solved[1:]
     if not coef[0] > 0:
         raise IdentificationError(
-            "The step of the record gives no displacement: check that x answers v, and "
-            "record the answer to 'hystcomp excite dynamics'."
+            "The step of the record gives no displacement that the model can follow: check "
+            "that x answers v, that the record is the answer to 'hystcomp excite dynamics', "
+            f"and that the rig's latency is within {DELAY_RANGE[1]} samples."
         )
     weights = coef[1:] / coef[0]
     return weights, float(coef.sum())

@@ -179,6 +179,8 @@ class LinearDynamics:
             )
         model.creep_time_constants_ = taus
         model.creep_weights_ = weights
+        if isinstance(delay_samples, float) and delay_samples.is_integer():
+            delay_samples = int(delay_samples)  # 3.0, as some JSON writers put 3
         model.delay_samples_ = check_int(
             delay_samples, "delay_samples", owner, minimum=DELAY_RANGE[0], maximum=DELAY_RANGE[1]
         )
