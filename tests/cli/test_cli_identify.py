@@ -110,6 +110,11 @@ def test_simulate_on_a_record_with_x_reports_the_error_against_it(tmp_path):
         result.output
     )
     assert f"max {np.abs(err).max():.4g} µm; a straight line fitted to it: rms" in result.output
+    # a displacement in nm: warned about, and read right with --x-unit
+    write_table(tmp_path / "nm.csv", {"t": t, "v": v, "x": 1e3 * true.simulate(v)})
+    args = ["simulate", tmp_path / "m.json", tmp_path / "nm.csv", "-o", tmp_path / "s3.csv"]
+    assert "looks like nanometres" in run(*args).output
+    assert f"model rms {rms:.4g} µm" in run(*args, "--x-unit", "nm").output
     write_table(tmp_path / "v.csv", {"t": t, "v": v})
     result = run("simulate", tmp_path / "m.json", tmp_path / "v.csv", "-o", tmp_path / "s2.csv")
     assert result.exit_code == 0

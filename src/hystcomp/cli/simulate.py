@@ -14,6 +14,8 @@ from hystcomp.cli._options import (
     progress,
     quiet_option,
     read_options,
+    warn_x_unit,
+    x_unit_option,
 )
 from hystcomp.errors import ModelFileError
 from hystcomp.io.models import load_model
@@ -26,8 +28,9 @@ from hystcomp.io.records import read_table, write_table
 @output_option(what="result: t, v, x")
 @columns_option
 @fs_option
+@x_unit_option
 @quiet_option
-def simulate(model_file, input_file, output, columns, sample_rate, quiet):
+def simulate(model_file, input_file, output, columns, sample_rate, x_unit, quiet):
     """Run the model in MODEL.json on the voltage in INPUT (columns t, v).
 
     Writes t (s), v (V) and the modelled displacement x (µm). If INPUT also holds a
@@ -46,8 +49,10 @@ def simulate(model_file, input_file, output, columns, sample_rate, quiet):
         input_file,
         ("v",),
         optional=("x",),
-        **read_options(columns, sample_rate, None, quiet, input_file, reads=("v", "x")),
+        **read_options(columns, sample_rate, x_unit, quiet, input_file, reads=("v", "x")),
     )
+    if "x" in table:  # a measured displacement to validate against: in µm, like the model
+        warn_x_unit(table["x"], input_file, quiet, x_unit)
     v = table["v"]
     lo, hi = getattr(model, "voltage_range_", (-float("inf"), float("inf")))
     if v.min() < lo or v.max() > hi:
