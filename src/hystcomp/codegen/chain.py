@@ -45,7 +45,8 @@ def chain_template(compensator) -> CTemplate:
         ]
         template.step_body += [
             "",
-            f"if (!(fabs(z) < {c_double(ck.PLAY_INPUT_LIMIT)})) {{ /* huge x_ref: hold, plays unmoved */",
+            "/* NaN, +-inf or a huge x_ref (the plays' sum would overflow): hold, plays unmoved */",
+            f"if (!(fabs(z) < {c_double(ck.PLAY_INPUT_LIMIT)})) {{",
             "    s->nonfinite_count++;",
             "    return s->last;",
             "}",
