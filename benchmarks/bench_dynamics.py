@@ -23,11 +23,13 @@ ratio at several heights instead (:func:`step_heights`), ``--coupling`` the hyst
 model's error alone and through the stage's resonance (:func:`coupling`), ``--floor`` the
 least error that any linear inverse whose step response turns back by at most a given
 fraction leaves on the triangles (:func:`best_floor`), ``--turns`` the rows with targets
-when hystcomp's FIR is allowed to turn back (:func:`turning_fir`).
+when hystcomp's FIR is allowed to turn back (:func:`turning_fir`), ``--ideal`` the
+tracking with the best linear inverse for each triangle instead (:func:`ideal_tracking`).
 """
 
 from __future__ import annotations
 
+import copy
 import time
 
 import numpy as np
@@ -193,6 +195,27 @@ def best_floor(dynamics, peak_to_peak, frequency, fall_back, half=MAX_PREVIEW) -
     return _rms_of_harmonics(m @ _turning_taps(m, target, fall_back) - target)
 
 
+def ideal_tracking(c, params, method, frequency, fall_back) -> float:
+    """rms (µm) of ``method`` + dynamics on ``compare``'s triangle at ``frequency``, its FIR
+    replaced by the best one of :func:`best_floor` for that very triangle, designed on the
+    stage's *own* resonance (for ``--ideal``): what the hysteresis model leaves behind the
+    best linear inverse that knows the reference and the stage."""
+    from unittest import mock
+
+    lead = np.arange(MAX_PREVIEW, -MAX_PREVIEW - 1, -1)
+    m, target = _harmonics(_stage_dynamics(params), c.reference_amplitude, frequency, lead)
+    g = _turning_taps(m, target, fall_back)
+    kept = np.flatnonzero(np.abs(g) > 1e-12 * np.abs(g).max())
+    design = (g[kept[0] : kept[-1] + 1], int(lead[kept[0]]))
+    dyn = copy.deepcopy(c.dynamics.dynamics)  # its kept FIR designs are not ours to change
+    dyn.__dict__.pop("_fir_designs", None)
+    with mock.patch("hystcomp.models.dynamics.inverse_fir", return_value=design):
+        comp = c.models[method].inverse(dynamics=dyn)
+    x_ref, window = _triangle(c, params, frequency)
+    x = Twin(params, seed=c.config.seed).run(comp.simulate(x_ref))
+    return _rms((x - x_ref)[window])
+
+
 def turning_fir(fall_back):
     """A stand-in for :func:`hystcomp.models.dynamic_compensator.inverse_fir`: the same band
     fit, with the step response allowed to turn back by ``fall_back`` (for ``--turns``)."""
@@ -324,6 +347,22 @@ if __name__ == "__main__":
                     + f"; hystcomp's FIR {fir_floor(stage_dyn, c.reference_amplitude, f):.3f}"
                     + f" (MPI's 1 Hz rms {base:.3f})"
                 )
+        sys.exit()
+    if "--ideal" in sys.argv:  # the best linear inverse for each triangle (docs/dynamics.md)
+        for stage, params in STAGES.items():
+            c = run_comparison(CompareConfig(twin=params))
+            for method in ("mpi", "preisach"):
+                base = c.dynamics.results[1.0][f"{method} + dynamics"].rms
+                for d in (0.0, 1.0):
+                    cells = [ideal_tracking(c, params, method, f, d) for f in FAST_FREQUENCIES]
+                    print(
+                        f"{stage}: {method}, the best inverse turning back by at most {d:g}, "
+                        + ", ".join(
+                            f"{f:g} Hz {e:.3f} µm ({e / base:.2f}x)"
+                            for f, e in zip(FAST_FREQUENCIES, cells, strict=True)
+                        )
+                        + f" (1 Hz rms {base:.3f})"
+                    )
         sys.exit()
     if "--turns" in sys.argv:  # the same band fit, allowed to turn back (docs/dynamics.md)
         from unittest import mock
