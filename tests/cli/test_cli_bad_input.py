@@ -76,6 +76,8 @@ CASES = [
     ("excite dynamics: rate too high", "excite dynamics --fs 1e12 -o {out}.csv", r"\(--fs\) makes the 6\.2 s signal 6\.2e\+12 samples long, .* use at most"),
     ("export-c: huge --fs", "export-c model.json -o {out}_c --fs 1e308", r"'--fs': must be a finite number of size at most 1e\+12"),
     ("export-c onto a file", "export-c model.json -o rec.csv", r"'rec\.csv': it exists and is not a folder"),
+    ("dynamics record with a gap", "identify gap.csv --model dynamics -o {out}.json", r"record gap\.csv is not evenly sampled: 1 step differs .* from t = 0\.095 to 0\.125 s \(data row 21\)\. .*resample"),
+    ("reference with a gap, dynamics", "compensate model.json ref_gap.csv --dynamics dyn.json -o {out}.csv", r"of the reference is not evenly sampled: 2 steps differ"),
 ]  # fmt: skip
 
 EXTENDED = [
@@ -132,6 +134,10 @@ def _make_files(folder: Path) -> None:
         "one.csv": "t,v,x\n0,0,0\n",
         "flat.csv": "t,v,x\n" + "".join(f"{i},5,{i}\n" for i in range(50)),
         "ref_nan.csv": "t,x\n0,1\n0.001,nan\n0.002,3\n",
+        "gap.csv": "t,v,x\n"
+        + "".join(f"{0.005 * (i + 5 * (i > 19))},{i % 7},{i % 5}\n" for i in range(60)),
+        "ref_gap.csv": "t,x\n"
+        + "".join(f"{0.005 * (i + (i > 9) + (i > 30))},1\n" for i in range(60)),
         "huge.csv": "t,v,x\n0,0,0\n1,1e13,1\n",
         "tiny_t.csv": "t,v,x\n0,0,0\n5e-324,1,1\n1e-323,2,2\n",
         "list.json": "[1, 2, 3]",

@@ -4,9 +4,10 @@ from __future__ import annotations
 
 import click
 
-from hystcomp.errors import ModelFileError
+from hystcomp.errors import DataFileError, ModelFileError
 from hystcomp.io.atomic import atomic_paths
 from hystcomp.io.models import load_model, model_text
+from hystcomp.io.records import uneven_sampling
 from hystcomp.models.dynamics import LinearDynamics
 
 
@@ -64,4 +65,7 @@ def dynamics_for(dynamics: LinearDynamics, table) -> LinearDynamics:
             f"reference is sampled at {fs:.6g} Hz; resample the reference or identify the "
             "dynamics at the reference's rate."
         )
+    uneven = uneven_sampling(table["t"], "the reference")
+    if uneven:
+        raise DataFileError(uneven)
     return dynamics

@@ -31,7 +31,7 @@ from hystcomp.identify.scoring import (
     holdout_report,
     transient_end,
 )
-from hystcomp.io.records import x_unit_warning
+from hystcomp.io.records import uneven_sampling, x_unit_warning
 from hystcomp.models.dynamics import LinearDynamics
 from hystcomp.models.mpi import ModifiedPrandtlIshlinskii
 from hystcomp.models.pi import PrandtlIshlinskii
@@ -578,6 +578,9 @@ def identify_dynamics_record(record) -> DynamicsResult:
                 "The 'record' argument of identify_dynamics_record must be a "
                 f"hystcomp.io.records.Record (t, v, x); got {type(record).__name__}."
             )
+    uneven = uneven_sampling(record.t, f"the record {record.source}")
+    if uneven:
+        raise InvalidParameterError(uneven)
     model = LinearDynamics().fit(record.v, record.x, record.sample_rate)
     report = model.fit_report_
     lo, hi = report["fit_band_hz"]

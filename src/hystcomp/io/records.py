@@ -490,6 +490,32 @@ def x_unit_warning(x, source: str, given: str | None = None) -> str | None:
     return None
 
 
+def uneven_sampling(t, what: str) -> str | None:
+    """Why ``t`` (s, increasing) is not evenly sampled, or None.
+
+    A step more than half a median step away from it (a dropped sample, a restart of the
+    acquisition, a merged file) breaks a discrete-time model of the dynamics, which takes
+    every sample as one period after the last; rounding of a written time column stays
+    well inside that.
+    """
+    steps = np.diff(np.asarray(t, dtype=np.float64))
+    if steps.size == 0:
+        return None
+    median = float(np.median(steps))
+    bad = np.flatnonzero(np.abs(steps - median) > 0.5 * median)
+    if not bad.size:
+        return None
+    k = int(bad[0])
+    return (
+        f"The time column of {what} is not evenly sampled: {bad.size} "
+        f"{'steps differ' if bad.size > 1 else 'step differs'} from the median step "
+        f"({median:.6g} s) by more "
+        f"than half of it, the first from t = {float(t[k])!r} to {float(t[k + 1])!r} s "
+        f"(data row {k + 2}). The linear dynamics are discrete-time: resample the record onto an "
+        "even grid, or record it again without gaps."
+    )
+
+
 def _time(path: Path, t, n: int, sample_rate):
     if t is None:
         if sample_rate is None:
