@@ -222,6 +222,13 @@ def test_declared_sizes_are_refused_before_loading(tmp_path, monkeypatch):
     with pytest.raises(DataFileError, match=r"'v' of shape \(500000000,\), more than 100000000"):
         read_table(path, ("v",), sample_rate=1.0)
     assert max_samples() == MAX_SAMPLES
+    too_wide = r"shape \(200, 65\): 65 columns, more than the 64 .*Save only the signals' columns"
+    _npz_declaring(path, (200, 65))  # the samples fit, the columns do not: said so
+    with pytest.raises(DataFileError, match=too_wide):
+        read_table(path, ("v",), sample_rate=1.0)
+    scipy.io.savemat(tmp_path / "wide.mat", {"v": np.zeros((200, 65))})
+    with pytest.raises(DataFileError, match=too_wide):
+        read_table(tmp_path / "wide.mat", ("v",), sample_rate=1.0)
     monkeypatch.setenv("HYSTCOMP_MAX_SAMPLES", "100")
     _npz_declaring(path, (101, 1))
     with pytest.raises(DataFileError, match=r"more than 100 samples.*HYSTCOMP_MAX_SAMPLES"):

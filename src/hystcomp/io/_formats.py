@@ -52,6 +52,14 @@ def max_samples() -> int:
 
 
 def _too_large(path: Path, name: str, shape: tuple, limit: int) -> DataFileError:
+    rows = max((int(n) for n in shape if isinstance(n, int)), default=0)
+    if 0 < rows <= limit:  # the samples fit: too many columns
+        return DataFileError(
+            f"Data file {str(path)!r} declares an array {name!r} of shape {shape}: "
+            f"{int(np.prod(shape, dtype=object)) // rows} columns, more than the "
+            f"{MAX_MATRIX_COLUMNS} a matrix of a record may have. Save only the signals' "
+            "columns (t, v, x), or each as a variable of its own."
+        )
     return DataFileError(
         f"Data file {str(path)!r} declares an array {name!r} of shape {shape}, more than "
         f"{limit} samples, the most a record may have (HYSTCOMP_MAX_SAMPLES raises the "
