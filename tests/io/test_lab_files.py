@@ -67,6 +67,26 @@ def test_lab_text_layouts_read_as_the_canonical_csv(tmp_path, record, name, head
     _same(path, record, columns=columns)
 
 
+@pytest.mark.parametrize("newline", ["\n", "\r\n", "\r"])
+@pytest.mark.parametrize("compiled", [False, True])
+def test_long_tables_with_blank_lines_and_old_mac_line_ends_are_read(
+    tmp_path, rng, monkeypatch, newline, compiled
+):
+    import hystcomp.io._text as text
+
+    if compiled:  # the compiled parser, not numpy's, for the chunks it takes
+        monkeypatch.setattr(text, "SMALL_READ", 0)
+    t = np.arange(6000) / 2000.0  # longer than the head that the layout is read from
+    big = {"t": t, "v": 60.0 + 50.0 * np.sin(t), "x": rng.standard_normal(t.size)}
+    rows = _rows(big)
+    for k in (3, 2500, 5999):  # lines of spaces and tabs, as editors leave them
+        rows[k] += newline + " \t "
+    path = tmp_path / "long.csv"
+    path.write_bytes(newline.join(["t,v,x", *rows, ""]).encode())
+    assert path.stat().st_size > text.HEAD_BYTES
+    _same(path, big)
+
+
 @pytest.mark.parametrize(
     ("name", "head", "sep", "decimal", "edit"),
     [

@@ -130,8 +130,8 @@ def sniff(path: Path) -> Layout:
     with path.open("rb") as f:
         head = f.read(HEAD_BYTES)
     whole = len(head) < HEAD_BYTES
-    if not whole:  # cut at the last complete line
-        head = head[: head.rfind(b"\n") + 1]
+    if not whole:  # cut at the last complete line (ended by "\r" alone on old Macs)
+        head = head[: max(head.rfind(b"\n"), head.rfind(b"\r")) + 1]
     encoding = _encoding(head)
     text = head.decode(encoding)
     bom = 3 if head.startswith(b"\xef\xbb\xbf") else 0
@@ -322,7 +322,7 @@ def _parse(text: str, layout: Layout, where: str, before: int) -> np.ndarray:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", UserWarning)  # "input contained no data"
             rows = np.loadtxt(
-                text.splitlines(),
+                [line for line in text.splitlines() if line.strip()],  # blank: skipped
                 delimiter=layout.delimiter,
                 comments="#",
                 quotechar='"',
