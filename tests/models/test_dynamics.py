@@ -539,8 +539,21 @@ def test_excite_dynamics_layout():
     assert t[1] == pytest.approx(1e-4)
     assert v[0] == -10.0
     assert v[round(0.3 * 10_000)] == 0.0
-    assert np.abs(v[-20_000:]).max() == pytest.approx(4.0)
+    assert np.abs(v[-20_000:]).max() == pytest.approx(20.0 / 30.0)  # 1/30 of the range
     assert isinstance(hystcomp.presets.paper_mpi().inverse(dynamics=_stage()), DynamicCompensator)
+
+
+def test_dynamics_of_a_low_voltage_amplifier_input_are_excited_and_identified():
+    """A stage driven through a 0..3.6 V amplifier input (as the micromanipulator's record):
+    the multisine scales with the range (0.12 V peak, small signal there as 4 V is on
+    0..120 V), and the model is found as on any other range."""
+    _, v = dynamics_excitation(voltage_range=(0.0, 3.6))
+    assert v[0] == 0.0
+    assert np.abs(v[-20_000:] - 1.8).max() == pytest.approx(0.12)
+    x = 13.0 * _stage().simulate(v, initial=0.0)  # µm: 13 µm/V of amplifier input
+    fitted = LinearDynamics().fit(v, x, 20_000.0)
+    assert fitted.resonance_hz_ == pytest.approx(_stage().resonance_hz_, rel=0.005)
+    assert fitted.damping_ratio_ == pytest.approx(_stage().damping_ratio_, rel=0.05)
 
 
 def test_twin_creep_rises_about_equally_per_decade():

@@ -59,8 +59,9 @@ def excite(model, output, sample_rate, voltage_range, frequency, quiet):
     three models): ramps at the slope of the 1 Hz major triangle (times --frequency) between
     turning points at many levels, decaying loops from each end of the range then random
     ones (about 14 s). Each starts and ends at the lower end of the range. dynamics (beyond
-    the paper): a step to mid-range held 3 s (creep), then three 1 s periods of a +-4 V
-    multisine of 1 Hz .. 5 kHz around it (--frequency unused). Columns: t (s), v (V).
+    the paper): a step to mid-range held 3 s (creep), then three 1 s periods of a
+    multisine of 1 Hz .. 5 kHz around it, of 1/30 of the range peak (+-4 V on 0..120 V;
+    --frequency unused). Columns: t (s), v (V).
     """
     if output is not None:
         check_data_output(output, what="signal file")

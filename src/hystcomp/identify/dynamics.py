@@ -65,7 +65,8 @@ HOLD = 3.0
 PERIOD = 1.0
 PERIODS = 3
 BIAS_FRACTION = 0.5
-AMPLITUDE = 4.0
+#: The multisine's peak, as a fraction of the voltage range's span: 4 V on 0..120 V.
+AMPLITUDE_FRACTION = 4.0 / 120.0
 F_MIN, F_MAX = 1.0, 5000.0
 N_LINES = 120
 #: Lines used to fit the resonance, Hz (from), and how far the step's start is skipped for creep.
@@ -85,14 +86,15 @@ def dynamics_excitation(
     *,
     sample_rate: float = paper.SAMPLE_RATE,
     voltage_range: tuple[float, float] = paper.VOLTAGE_RANGE,
-    amplitude: float = AMPLITUDE,
+    amplitude: float | None = None,
     seed: int = 0,
 ) -> tuple[np.ndarray, np.ndarray]:
     """``(t, v)`` of the identification signal of the linear dynamics.
 
     A rest at the low end of ``voltage_range`` (:data:`REST` s), a step to the middle of
     the range held :data:`HOLD` s (creep), then :data:`PERIODS` periods of a 1 s multisine
-    of ``amplitude`` V peak around the middle: :data:`N_LINES` log-spaced frequencies from
+    of ``amplitude`` V peak around the middle (by default :data:`AMPLITUDE_FRACTION` of
+    the range's span, small signal on any amplifier: 4 V on 0..120 V, 0.12 V on 0..3.6 V): :data:`N_LINES` log-spaced frequencies from
     1 Hz to 5 kHz (at most 0.4 ``sample_rate``) rounded to whole Hz, the duplicates
     dropped (96 lines at 20 kHz), Schroeder phases for a low crest factor.
 
@@ -106,6 +108,9 @@ def dynamics_excitation(
     """
     owner = "dynamics_excitation"
     fs = check_real(sample_rate, "sample_rate", owner, positive=True)
+    lo, hi = voltage_range
+    if amplitude is None:
+        amplitude = AMPLITUDE_FRACTION * (hi - lo)
     amplitude = check_real(amplitude, "amplitude", owner, positive=True)
     seconds = REST + HOLD + PERIODS * PERIOD
     if seconds * fs > MAX_SIGNAL_SAMPLES:
@@ -114,14 +119,13 @@ def dynamics_excitation(
             f"{seconds * fs:.3g} samples long, more than {MAX_SIGNAL_SAMPLES:.0e}. Got {fs:g} Hz; use "
             f"at most {MAX_SIGNAL_SAMPLES / seconds:g} Hz."
         )
-    lo, hi = voltage_range
     bias = lo + BIAS_FRACTION * (hi - lo)
     if amplitude > 0.25 * (hi - lo):
         raise InvalidParameterError(
             f"The 'amplitude' parameter of {owner} must be small against the voltage range "
             f"{lo:g} .. {hi:g} V ({0.25 * (hi - lo):g} V at most): the dynamics are identified "
-            f"in small signal. Got {amplitude:g} V; use a wider voltage range (--voltage-range) "
-            "or a smaller amplitude."
+            f"in small signal. Got {amplitude:g} V; use a smaller amplitude, or leave it out for "
+            f"{AMPLITUDE_FRACTION:.3g} of the range."
         )
     n_period = round(PERIOD * fs)
     lines = multisine_lines(fs)
