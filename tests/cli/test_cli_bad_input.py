@@ -76,6 +76,7 @@ CASES = [
     ("excite dynamics: rate too high", "excite dynamics --fs 1e12 -o {out}.csv", r"\(--fs\) makes the 6\.2 s signal 6\.2e\+12 samples long, .* use at most"),
     ("export-c: huge --fs", "export-c model.json -o {out}_c --fs 1e308", r"'--fs': must be a finite number of size at most 1e\+12"),
     ("export-c onto a file", "export-c model.json -o rec.csv", r"'rec\.csv': it exists and is not a folder"),
+    ("preisach range inside the record", "identify rec.csv --model preisach --voltage-range 10 100 -o {out}.json", r"\(--voltage-range\) must contain the record's input, .* narrow the compensator's clamp instead \(--voltage-range of compensate"),
     ("dynamics record with a gap", "identify gap.csv --model dynamics -o {out}.json", r"record gap\.csv is not evenly sampled: 1 step differs .* from t = 0\.095 to 0\.125 s \(data row 21\)\. .*resample"),
     ("reference with a gap, dynamics", "compensate model.json ref_gap.csv --dynamics dyn.json -o {out}.csv", r"of the reference is not evenly sampled: 2 steps differ"),
 ]  # fmt: skip

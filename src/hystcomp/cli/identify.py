@@ -167,7 +167,8 @@ def _regularization(ctx, param, value):
     help="Amplifier range in V, the compensator's clamp [the record's range]. A range "
     "reaching beyond the record's input is refused, not capped (a cap would quietly give "
     "another range than asked): the compensator would command voltages the model never "
-    "saw. --allow-extrapolation accepts it.",
+    "saw. --allow-extrapolation accepts it. A Preisach model's plane covers the record's "
+    "whole input: narrow its clamp with compensate's --voltage-range.",
 )
 @click.option(
     "--allow-extrapolation",

@@ -376,9 +376,11 @@ def identify_preisach(
         slack = 1e-9 * (voltage_range[1] - voltage_range[0])
         if data_range[0] < voltage_range[0] - slack or data_range[1] > voltage_range[1] + slack:
             raise InvalidParameterError(
-                f"The 'voltage_range' parameter of {owner} must contain the record's input, "
-                f"which spans {data_range[0]:g}..{data_range[1]:g} V. Got "
-                f"{voltage_range[0]:g}..{voltage_range[1]:g} V; widen it or pass None."
+                f"The 'voltage_range' parameter of {owner} (--voltage-range) must contain "
+                f"the record's input, which spans {data_range[0]:g}..{data_range[1]:g} V: the "
+                f"Preisach plane covers all of it. Got {voltage_range[0]:g}..{voltage_range[1]:g} "
+                "V; widen it, or leave it out and narrow the compensator's clamp instead "
+                "(--voltage-range of compensate and export-c; Preisach.inverse(voltage_range=))."
             )
     if fit_method == "auto":
         span = voltage_range[1] - voltage_range[0]
