@@ -43,6 +43,9 @@ def test_json_round_trip_reproduces_output_exactly(make, tmp_path, rng):
     assert np.array_equal(loaded.simulate(v), model.simulate(v))
     x = model.simulate(v)
     assert np.array_equal(loaded.inverse().simulate(x), model.inverse().simulate(x))
+    # hand-edited in an editor that adds a UTF-8 byte-order mark: still the same model
+    path.write_bytes(b"\xef\xbb\xbf" + path.read_bytes())
+    assert np.array_equal(hystcomp.load_model(path).simulate(v), model.simulate(v))
 
 
 def test_failed_save_leaves_existing_file(tmp_path):

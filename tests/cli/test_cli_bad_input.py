@@ -76,6 +76,9 @@ CASES = [
     ("excite dynamics: rate too high", "excite dynamics --fs 1e12 -o {out}.csv", r"\(--fs\) makes the 6\.2 s signal 6\.2e\+12 samples long, .* use at most"),
     ("export-c: huge --fs", "export-c model.json -o {out}_c --fs 1e308", r"'--fs': must be a finite number of size at most 1e\+12"),
     ("export-c onto a file", "export-c model.json -o rec.csv", r"'rec\.csv': it exists and is not a folder"),
+    ("UTF-16 data file", "identify u16.csv --model pi -o {out}.json", r"'u16\.csv' is UTF-16 text; save it as UTF-8\.$"),
+    ("UTF-16 model file", "simulate u16.json rec.csv -o {out}.csv", r"'u16\.json' is UTF-16 text; save it as UTF-8\.$"),
+    ("integer of 5000 digits", "simulate digits.json rec.csv -o {out}.csv", r"'digits\.json' holds an integer of thousands of digits"),
     ("preisach range inside the record", "identify rec.csv --model preisach --voltage-range 10 100 -o {out}.json", r"\(--voltage-range\) must contain the record's input, .* narrow the compensator's clamp instead \(--voltage-range of compensate"),
     ("dynamics record with a gap", "identify gap.csv --model dynamics -o {out}.json", r"record gap\.csv is not evenly sampled: 1 step differs .* from t = 0\.095 to 0\.125 s \(data row 21\)\. .*resample"),
     ("reference with a gap, dynamics", "compensate model.json ref_gap.csv --dynamics dyn.json -o {out}.csv", r"of the reference is not evenly sampled: 2 steps differ"),
@@ -167,6 +170,9 @@ def _make_files(folder: Path) -> None:
     np.savez(folder / "objects.npz", t=np.arange(3.0), v=np.array([1, "a"], dtype=object))
     np.savez(folder / "complex.npz", t=np.arange(3.0), v=np.arange(3.0) + 1j, x=np.arange(3.0))
     (folder / "crash.mat").write_bytes(crashing_mat_bytes())
+    (folder / "u16.csv").write_bytes("t,v,x\n0,0,0\n1,1,1\n".encode("utf-16"))
+    (folder / "u16.json").write_bytes((folder / "model.json").read_text().encode("utf-16"))
+    (folder / "digits.json").write_text(MODEL % (1, '{"thresholds": [%s]}' % ("9" * 5000)))
 
 
 def crashing_mat_bytes() -> bytes:

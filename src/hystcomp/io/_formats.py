@@ -33,6 +33,15 @@ MAX_SAMPLES = 100_000_000
 MAX_MATRIX_COLUMNS = 64
 
 
+def utf16(path: Path) -> bool:
+    """Whether ``path`` starts with a UTF-16 byte-order mark (Windows' "Unicode" text)."""
+    try:
+        with path.open("rb") as f:
+            return f.read(2) in (b"\xff\xfe", b"\xfe\xff")
+    except OSError:
+        return False
+
+
 def max_samples() -> int:
     """The most samples a record may have: ``HYSTCOMP_MAX_SAMPLES`` if set, else
     :data:`MAX_SAMPLES`."""
@@ -267,7 +276,12 @@ def read_raw(path: Path, progress=None):
         return names, columns, True, units
     except UnicodeDecodeError:
         raise DataFileError(
-            f"Data file {str(path)!r} is not text; use .csv, .npz, .mat or a text table."
+            f"Data file {str(path)!r} is "
+            + (
+                "UTF-16 text; save it as UTF-8."
+                if utf16(path)
+                else "not text; use .csv, .npz, .mat or a text table."
+            )
         ) from None
     except MemoryError:
         raise DataFileError(

@@ -21,6 +21,7 @@ from typing import Any, TypeAlias
 
 from hystcomp._validation import as_path
 from hystcomp.errors import HystcompError, InvalidTypeError, ModelFileError
+from hystcomp.io._formats import utf16
 from hystcomp.io.atomic import atomic_path
 from hystcomp.models.base import HysteresisModel
 from hystcomp.models.dynamics import LinearDynamics
@@ -212,12 +213,17 @@ def load_model(path: str | os.PathLike) -> Model:
                 f"{name} is {path.stat().st_size} bytes, too large for a model file "
                 f"(at most {MAX_MODEL_FILE_BYTES}); check the path."
             )
-        text = path.read_text(encoding="utf-8")
+        text = path.read_text(encoding="utf-8-sig")  # a byte-order mark, as editors add
     except FileNotFoundError:
         raise ModelFileError(f"Model file {name} does not exist; check the path.") from None
     except UnicodeDecodeError:
         raise ModelFileError(
-            f"{name} is not a text file; a model file is JSON written by hystcomp."
+            f"{name} is "
+            + (
+                "UTF-16 text; save it as UTF-8."
+                if utf16(path)
+                else "not a text file; a model file is JSON written by hystcomp."
+            )
         ) from None
     except OSError as exc:
         raise ModelFileError(f"Cannot read model file {name}: {exc.strerror or exc}.") from None
@@ -229,6 +235,11 @@ def load_model(path: str | os.PathLike) -> Model:
             "a model file is written by 'hystcomp identify' or hystcomp.save_model."
         ) from None
     except ValueError as exc:  # NaN/Infinity, or an integer too long to read
+        if "integer string conversion" in str(exc):
+            raise ModelFileError(
+                f"{name} holds an integer of thousands of digits, which no model parameter "
+                "can be. Model files hold finite numbers only."
+            ) from None
         raise ModelFileError(
             f"{name} is not a valid model file: {exc}. Model files hold finite numbers only."
         ) from None
