@@ -322,3 +322,26 @@ def test_a_pipe_named_through_proc_fd_is_refused_before_any_work():
     finally:
         os.close(read)
         os.close(write)
+
+
+def test_a_full_disk_under_a_nested_atomic_writer_names_the_users_path(tmp_path):
+    """A figure writer that writes atomically itself, inside the command's own atomic
+    outputs: its failure names the file the user asked for, not a hidden temporary one."""
+    from hystcomp.io.atomic import atomic_path
+
+    def save_figure(path):  # as matplotlib's writer behind plot_identification
+        with atomic_path(path):
+            raise OSError(28, "No space left on device")
+
+    def write():
+        with atomic_paths(tmp_path / "model.json", tmp_path / "fig.png") as (_, fig):
+            save_figure(fig)
+
+    (tmp_path / "fig.png").write_bytes(b"old")
+    with pytest.raises(OutputPathError) as caught:
+        write()
+    message = str(caught.value)
+    assert f"Cannot write {str(tmp_path / 'fig.png')!r}: No space left on device" in message
+    assert ".tmp" not in message
+    assert (tmp_path / "fig.png").read_bytes() == b"old"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["fig.png"]

@@ -83,7 +83,7 @@ def test_model_documents_of_the_wrong_shape_name_the_key(tmp_path, edit, message
         ('{"a": NaN}', r"NaN is not a number a model file may hold"),
         ('{"a": -Infinity}', r"-Infinity is not a number"),
         ("[" * 50_000 + "]" * 50_000, r"nests arrays or objects too deeply"),
-        ('{"a": ' + "1" * 5000 + "}", r"not a valid model file"),
+        ('{"a": ' + "1" * 5000 + "}", r"holds an integer of thousands of digits"),
         ("\x00\x01", r"not valid JSON"),
     ],
 )
@@ -102,8 +102,11 @@ def test_model_file_size_and_kind_of_file(tmp_path, monkeypatch):
         hystcomp.load_model(path)
     with pytest.raises(ModelFileError, match=r"not a regular file"):
         hystcomp.load_model("/dev/null")
-    path.write_bytes(b"\xff\xfe{")
+    path.write_bytes(b"\x80\x81{")
     with pytest.raises(ModelFileError, match=r"not a text file"):
+        hystcomp.load_model(path)
+    path.write_bytes(b"\xff\xfe{")  # a UTF-16 byte-order mark
+    with pytest.raises(ModelFileError, match=r"is UTF-16 text; save it as UTF-8\.$"):
         hystcomp.load_model(path)
 
 

@@ -79,6 +79,9 @@ CASES = [
     ("UTF-16 data file", "identify u16.csv --model pi -o {out}.json", r"'u16\.csv' is UTF-16 text; save it as UTF-8\.$"),
     ("UTF-16 model file", "simulate u16.json rec.csv -o {out}.csv", r"'u16\.json' is UTF-16 text; save it as UTF-8\.$"),
     ("integer of 5000 digits", "simulate digits.json rec.csv -o {out}.csv", r"'digits\.json' holds an integer of thousands of digits"),
+    ("preisach transient too long", "identify rec.csv --model preisach --transient 1e9 -o {out}.json", r"identify_record \(preisach\): only 0 of 801 samples remain .*\(--transient\)"),
+    ("hysteresis record as dynamics", "identify rec.csv --model dynamics -o {out}.json", r"does not have the layout of 'hystcomp excite dynamics': found a hold of"),
+    ("hyperparameter as text", "simulate quoted.json rec.csv -o {out}.csv", r"'n_operators' .* is the text '16', not a number, .* set 'n_operators' to 16 \(no quotes\)"),
     ("preisach range inside the record", "identify rec.csv --model preisach --voltage-range 10 100 -o {out}.json", r"\(--voltage-range\) must contain the record's input, .* narrow the compensator's clamp instead \(--voltage-range of compensate"),
     ("dynamics record with a gap", "identify gap.csv --model dynamics -o {out}.json", r"record gap\.csv is not evenly sampled: 1 step differs .* from t = 0\.095 to 0\.125 s \(data row 21\)\. .*resample"),
     ("reference with a gap, dynamics", "compensate model.json ref_gap.csv --dynamics dyn.json -o {out}.csv", r"of the reference is not evenly sampled: 2 steps differ"),
@@ -164,6 +167,9 @@ def _make_files(folder: Path) -> None:
     doc["parameters"] = hystcomp.io.model_to_dict(presets.paper_pi())["parameters"]
     doc["parameters"]["weights"][3] = -1.0  # w_0 + ... + w_3 < 0
     (folder / "not_invertible.json").write_text(json.dumps(doc))
+    doc = json.loads((folder / "model.json").read_text())
+    doc["hyperparameters"]["n_operators"] = "16"
+    (folder / "quoted.json").write_text(json.dumps(doc))
     (folder / "a_folder").mkdir()
     np.save(folder / "array.npy", np.arange(3.0))
     (folder / "array.npy").rename(folder / "array.npz")
@@ -295,3 +301,22 @@ def test_a_mat_file_that_crashes_scipy_is_a_clean_error(tmp_path):
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, check=False)
     if result.returncode >= 0:
         pytest.skip("this scipy no longer crashes on the file (it raises or reads it)")
+
+
+@pytest.mark.skipif(not Path("/dev/full").exists(), reason="needs Linux's /dev/full")
+def test_a_signal_to_a_full_standard_output_is_a_clean_error(tmp_path):
+    env = {
+        **os.environ,
+        "PYTHONPATH": os.pathsep.join([str(SRC), os.environ.get("PYTHONPATH", "")]),
+    }
+    with open("/dev/full", "w") as full:
+        result = subprocess.run(
+            [sys.executable, "-m", "hystcomp", "excite", "mpi"],
+            stdout=full, stderr=subprocess.PIPE, text=True, env=env, cwd=tmp_path, check=False,
+        )  # fmt: skip
+    assert result.returncode == 2
+    expected = (
+        "hystcomp: error: Cannot write the signal to standard output: No space left on "
+        "device. Give a file with -o, or check where standard output goes."
+    )
+    assert result.stderr.splitlines() == [expected]

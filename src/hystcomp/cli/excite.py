@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import sys
+
 import click
 
 from hystcomp import paper
@@ -14,6 +16,7 @@ from hystcomp.cli._options import (
     quiet_option,
     voltage_range,
 )
+from hystcomp.errors import OutputPathError
 from hystcomp.identify.excitation import DEFAULT_SAMPLE_RATE, SIGNAL_KINDS, excitation_signal
 from hystcomp.io.records import format_csv, write_table
 
@@ -69,7 +72,16 @@ def excite(model, output, sample_rate, voltage_range, frequency, quiet):
         model, sample_rate=sample_rate, voltage_range=voltage_range, frequency=frequency
     )
     if output is None:
-        click.echo(format_csv({"t": t, "v": v}), nl=False)
+        try:
+            click.echo(format_csv({"t": t, "v": v}), nl=False)
+            sys.stdout.flush()
+        except BrokenPipeError:
+            raise  # the reader went away (| head): not an error
+        except OSError as exc:
+            raise OutputPathError(
+                f"Cannot write the signal to standard output: {exc.strerror or exc}. Give a "
+                "file with -o, or check where standard output goes."
+            ) from None
     else:
         write_table(output, {"t": t, "v": v}, progress=progress(f"writing {output}", quiet))
         click.echo(f"wrote {output}: {t.size} samples at {sample_rate:g} Hz ({t[-1]:g} s)")

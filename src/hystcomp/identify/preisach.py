@@ -448,8 +448,9 @@ def _least_squares(v, x, curves, degree, everett, grid_size, voltage_range, zero
         raise InvalidParameterError(
             "zero_diagonal=False is the paper's unconstrained fit to reversal curves; the "
             "least-squares fit keeps X(v, v) = 0 (eq. 2), which a non-negative density implies. "
-            "Pass zero_diagonal=True, or fit_method='reversal-curves' with a record of first-order "
-            "descending curves (`hystcomp excite preisach`)."
+            "Pass zero_diagonal=True (--constraints physical), or fit_method='reversal-curves' "
+            "(--fit reversal-curves) with a record of first-order descending curves "
+            "(`hystcomp excite preisach`)."
         )
     if everett == "table" and grid_size > MAX_LSQ_GRID:
         raise InvalidParameterError(

@@ -79,7 +79,7 @@ def check_transient(transient, v: np.ndarray, owner: str, *, min_used: int) -> i
         raise IdentificationError(
             f"{owner}: only {v.size - start} of {v.size} samples remain after the start-up "
             f"transient (first sample used: {start}), fewer than the {min_used} needed. "
-            "Record longer, use fewer operators, or set a shorter transient."
+            "Record longer, use fewer operators, or set a shorter transient (--transient)."
         )
     return start
 

@@ -26,6 +26,7 @@ from hystcomp.errors import IdentificationError, InvalidParameterError, InvalidT
 from hystcomp.identify.compensation import compensation_error
 from hystcomp.identify.dynamics import MAX_DAMPING
 from hystcomp.identify.scoring import (
+    check_transient,
     coverage_warning,
     error_report,
     holdout_report,
@@ -63,6 +64,9 @@ SIZE_OPTIONS = {
 ESTIMATORS = {"pi": PrandtlIshlinskii, "mpi": ModifiedPrandtlIshlinskii, "preisach": Preisach}
 
 _OWNER = "identify_record"
+#: The fewest samples left after the transient for a model without a transient option of
+#: its own (Preisach's fit needs three).
+MIN_SETTLED = 3
 
 
 def _estimator_class(kind: str):
@@ -435,6 +439,7 @@ def identify_record(
                     model.transient = start
                 model.fit(v, x)
             else:  # a model without its own transient option is fitted on the settled part
+                check_transient(start, v, f"{_OWNER} ({kind})", min_used=MIN_SETTLED)
                 model.fit(v[start:], x[start:])
         except IdentificationError as exc:
             if holdout is None:

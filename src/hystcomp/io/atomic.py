@@ -174,6 +174,11 @@ def atomic_paths(*paths: str | os.PathLike):
                 f"Cannot write {names}: {exc.strerror or exc}. Check the permissions and the "
                 "free space of the folder."
             ) from None
+        except OutputPathError as exc:  # a writer that writes atomically too: our names
+            text = str(exc)
+            for tmp, target in zip(tmps, targets, strict=False):
+                text = text.replace(str(tmp), str(target))
+            raise OutputPathError(text) from None
     finally:
         for tmp in tmps:
             with contextlib.suppress(FileNotFoundError):

@@ -205,10 +205,14 @@ class Estimator:
             if name not in cls._get_param_names():
                 continue
             if name in derived and not _same_value(value, derived[name]):
+                quoted = isinstance(value, str) and not isinstance(derived[name], str)
                 raise InvalidParameterError(
-                    f"The hyperparameter {name!r} of this {cls.__name__} is {value!r}, but its "
-                    f"parameters give {derived[name]!r}: the two disagree. The file was "
-                    f"edited by hand; set {name!r} to {derived[name]!r} or identify again."
+                    f"The hyperparameter {name!r} of this {cls.__name__} is "
+                    + (f"the text {value!r}, not a number" if quoted else repr(value))
+                    + f", but its parameters give {derived[name]!r}: the two disagree. The "
+                    f"file was edited by hand; set {name!r} to {derived[name]!r}"
+                    + (" (no quotes)" if quoted else "")
+                    + " or identify again."
                 )
             setattr(model, name, value)
         model._check_hyperparameters()  # every value, as fit() would check it
