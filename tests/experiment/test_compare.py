@@ -168,6 +168,10 @@ def test_command_writes_the_files_and_prints_the_table(tmp_path, monkeypatch):
     assert "hystcomp compare: tracking a 50 Hz triangle" in result.stderr
     assert (out / "report.md").is_file()
     assert "seed 4" in (out / "report.md").read_text()
+    quiet = CliRunner().invoke(main, ["compare", "--quick", "-q", "--out", str(out), "--seed", "4"])
+    assert quiet.exit_code == 0, quiet.output
+    assert quiet.stderr == ""  # no status lines, for a script that takes stderr as failure
+    assert quiet.stdout == result.stdout
 
 
 def test_command_refuses_a_file_as_output_folder(tmp_path):

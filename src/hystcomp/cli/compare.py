@@ -33,7 +33,14 @@ from hystcomp.cli import main
     help="Periods of each tracking reference (the first is not measured). [default: 3, 2 with --quick]",
 )
 @click.option("--quick", is_flag=True, help="A short run: 2 periods, four Preisach sinusoids.")
-def compare(out_dir: str, seed: int, periods: int | None, quick: bool) -> None:
+@click.option(
+    "--quiet",
+    "-q",
+    is_flag=True,
+    help="No status lines ('hystcomp compare: ...') on standard error; the table and the "
+    "files are the same.",
+)
+def compare(out_dir: str, seed: int, periods: int | None, quick: bool, quiet: bool) -> None:
     """Identify the Preisach, PI and MPI models on the twin and compare the four methods.
 
     Runs the paper's identification signals on the simulated axis, identifies the models,
@@ -74,7 +81,8 @@ def compare(out_dir: str, seed: int, periods: int | None, quick: bool) -> None:
             prepare_output_dir(out_dir)  # refuse a bad --out before the work
 
             def progress(line: str) -> None:
-                click.echo(f"hystcomp compare: {line}", err=True)
+                if not quiet:
+                    click.echo(f"hystcomp compare: {line}", err=True)
 
             def draw_figures(table1) -> None:  # Table I measured: its figures, beside the rest
                 jobs["figures"] = draw_in_background(
