@@ -482,6 +482,12 @@ def test_cli_round_trip(tmp_path):
         dynamics=hystcomp.load_model(tmp_path / "dyn.json")
     )
     np.testing.assert_allclose(v, expected.simulate(15.0 + 10.0 * np.sin(2 * np.pi * 100 * t)))
+    # a logger's time column: 1 µs of jitter on each 50 µs step is the same rate
+    jitter = t + 1e-6 * np.random.default_rng(3).uniform(-1.0, 1.0, t.size)
+    write_table(tmp_path / "jitter.csv", {"t": jitter, "x": 15.0 + np.zeros(t.size)})
+    jittery = ["compensate", str(tmp_path / "mpi.json"), str(tmp_path / "jitter.csv")]
+    result = run(main, [*jittery, "--dynamics", str(tmp_path / "dyn.json"), "-o", str(out)])
+    assert result.exit_code == 0, result.output
     # out of reach with the dynamics: counted and warned about, refused with --strict
     far = 15.0 + 30.0 * np.sin(2 * np.pi * 10 * t)
     write_table(tmp_path / "far.csv", {"t": t, "x": far})
