@@ -130,6 +130,40 @@ def test_a_wide_voltage_range_is_accepted_when_extrapolation_is_allowed():
         _loops(2.0), "pi", operators=4, voltage_range=(0.0, 150.0), allow_extrapolation=True
     )
     assert result.model.voltage_range_ == (0.0, 150.0)
+    said = (  # allowed, and said: the estimate stops at the record's range
+        "the voltage range 0 150 V reaches beyond the record's input (0 .. 120 V), as "
+        "allowed: the model extrapolates there, and the estimate above does not cover it. "
+        "Check the tracking there before relying on it."
+    )
+    assert result.warnings == [said]
+    inside = identify_record(
+        _loops(2.0), "pi", operators=4, voltage_range=(0.0, 120.0), allow_extrapolation=True
+    )
+    assert inside.warnings == []
+
+
+@pytest.mark.parametrize(
+    ("ratio", "says"),
+    [(0.79, None), (0.95, "barely better than a straight line (0.95x)"), (1.2, "no better than")],
+)
+def test_a_compensator_predicted_near_the_straight_line_is_warned_about(monkeypatch, ratio, says):
+    """Within 0.8x of a line, a reference unlike the record can lose the margin: said, with
+    the other models to try (the record has turning points across the range: no advice to
+    record another)."""
+    from hystcomp.identify import workflow
+
+    def estimate(model, v, x, *, start=0):
+        return {"tracking_rms_um": ratio, "baseline_rms_um": 1.0, "ratio": ratio}
+
+    monkeypatch.setattr(workflow, "compensation_error", estimate)
+    warnings = identify_record(_loops(2.0), "mpi", operators=4, deadzones=4).warnings
+    if says is None:
+        assert warnings == []
+    else:
+        assert len(warnings) == 1
+        assert f"predicted to track {says}" in warnings[0]
+        assert warnings[0].endswith("try --model pi or preisach.")
+        assert "excite rich" not in warnings[0]
 
 
 def test_a_record_must_be_a_record():

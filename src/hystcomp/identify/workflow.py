@@ -64,6 +64,10 @@ SIZE_OPTIONS = {
 ESTIMATORS = {"pi": PrandtlIshlinskii, "mpi": ModifiedPrandtlIshlinskii, "preisach": Preisach}
 
 _OWNER = "identify_record"
+#: A compensator predicted to track within this fraction of a straight line's error is
+#: warned about: the estimate is measured on the record, and another reference can lose
+#: that margin (PI on a saturating stage: estimated 0.90-0.998x, measured up to 1.24x).
+LINE_MARGIN = 0.8
 #: The fewest samples left after the transient for a model without a transient option of
 #: its own (Preisach's fit needs three).
 MIN_SETTLED = 3
@@ -490,16 +494,35 @@ def identify_record(
     unit = x_unit_warning(record.x, str(record.source)) if unit_check else None
     if unit is not None:  # the compensator would then clamp a reference in µm throughout
         warnings.append(unit)
-    if not tracking["ratio"] < 1.0:
-        warnings.append(
-            f"the {label} compensator is predicted to track no better than a straight line "
-            f"({tracking['tracking_rms_um']:.3g} vs {tracking['baseline_rms_um']:.3g} µm "
-            "rms); record a signal with turning points across the range (hystcomp excite "
-            "rich) or try another model."
-        )
     coverage = coverage_warning(v, start)
+    if not tracking["ratio"] < LINE_MARGIN:
+        others = " or ".join(k for k in ESTIMATORS if k != kind)
+        warnings.append(
+            f"the {label} compensator is predicted to track "
+            + (
+                "no better than a straight line"
+                if not tracking["ratio"] < 1.0
+                else f"barely better than a straight line ({tracking['ratio']:.2g}x)"
+            )
+            + f" ({tracking['tracking_rms_um']:.3g} vs {tracking['baseline_rms_um']:.3g} µm "
+            "rms), and other references may track worse than the line; "
+            + (
+                "record a signal with turning points across the range (hystcomp excite "
+                f"rich), or try --model {others}."
+                if coverage is not None
+                else f"try --model {others}."
+            )
+        )
     if coverage is not None:
         warnings.append(coverage)
+    if chosen_range is not None and allow_extrapolation:
+        why = extrapolation_error(chosen_range, v)
+        if why is not None:  # allowed, and still said: the estimate does not cover it
+            warnings.append(
+                f"the voltage range {why}, as allowed: the model extrapolates there, and the "
+                "estimate above does not cover it. Check the tracking there before relying "
+                "on it."
+            )
     if held is not None:
         lines.append(
             f"  hold-out:  last {held['n_holdout']} samples ({100 * holdout:g} %): model rms "
