@@ -86,3 +86,42 @@ def test_preisach_options_do_not_apply_to_pi(tmp_path, option):
     result = run("identify", tmp_path / "x.csv", "--model", "pi", *option, "-o", tmp_path / "m")
     assert_one_line_error(result)
     assert f"{option[0]} does not apply to --model pi" in result.output
+
+
+def test_eq_10_overshooting_a_step_is_warned_about_and_exact_is_not(tmp_path):
+    """The paper's structure corrects with a constant gain: on a step it overshoots, and the
+    stage keeps a minor loop the model never saw. compensate says so, with the way out; a
+    triangle from rest, whose voltage turns where the reference does, is not warned about
+    (the paper's free fit, whose X(v, v) steps at each reversal, rings there: it is warned
+    about, with reason)."""
+    model = presets.paper_preisach(zero_diagonal=True)  # no step of X(v, v) at reversals
+    hystcomp.save_model(model, tmp_path / "p.json")
+    t = np.arange(8000) / 20_000.0
+    stairs = 2.0 + 6.0 * np.floor(t / 0.1)  # from rest, four steps of 6 µm
+    write_table(tmp_path / "stairs.csv", {"t": t, "x": stairs})
+    rest = float(model.simulate([0.0])[0])
+    triangle = rest + 15.0 * (1.0 - np.abs(2.0 * (t * 5.0 % 1.0) - 1.0))  # from rest, to 62 V
+    write_table(tmp_path / "tri.csv", {"t": t, "x": triangle})
+    args = ["compensate", tmp_path / "p.json"]
+    result = run(*args, tmp_path / "stairs.csv", "-o", tmp_path / "v.csv")
+    assert result.exit_code == 0, result.output
+    warned = re.search(
+        r"hystcomp: warning: the paper's multiplicative structure \(eq\. 10\) turns the voltage "
+        r"back where the reference does not, (\d+) times? \(the largest by ([\d.]+) V, at t = "
+        r"([\d.]+) s\): it overshoots where the model is steeper than its gain rho.*"
+        r"--method exact inverts the model without it\.",
+        result.output,
+    )
+    assert warned, result.output
+    v = read_table(tmp_path / "v.csv", ("v",))["v"]
+    at = round(float(warned[3]) * 20_000.0)  # the largest: at a step, and as large as said
+    assert at in (4000, 4001, 6000, 6001)
+    assert min(abs(v[at] - v[at - 1]), abs(v[at + 1] - v[at])) == pytest.approx(
+        float(warned[2]), abs=0.01
+    )
+    assert float(warned[2]) > 1.2  # more than 1 % of the 0..120 V range
+    assert int(warned[1]) >= 2
+    exact = run(*args, tmp_path / "stairs.csv", "--method", "exact", "-o", tmp_path / "e.csv")
+    assert "warning" not in exact.output
+    plain = run(*args, tmp_path / "tri.csv", "-o", tmp_path / "w.csv")
+    assert "multiplicative structure" not in plain.output

@@ -147,6 +147,21 @@ def compensate(
                 f"{d_lo:.4g} .. {d_hi:.4g} µm, or drop --strict to accept the clamp."
             )
         click.echo(f"hystcomp: warning: {what}.", err=True)
+    if getattr(getattr(compensator, "hysteresis", compensator), "method", None) == "multiplicative":
+        spikes = _own_turns(v, table["x"], hi - lo)
+        if spikes is not None:
+            n, size, k = spikes
+            click.echo(
+                "hystcomp: warning: the paper's multiplicative structure (eq. 10) turns the "
+                f"voltage back where the reference does not, {n} time{'s' if n > 1 else ''} "
+                f"(the largest by {size:.3g} V, at t = {table['t'][k]:.6g} s"
+                + (", where the reference steps from the model's rest" if k <= 2 else "")
+                + "): it overshoots where the model is steeper than its gain rho, on a "
+                "fast step or sample after sample, and each turn leaves the stage in a minor "
+                "loop that the model did not follow. --method exact inverts the model "
+                "without it.",
+                err=True,
+            )
     written = progress(f"writing {output}", quiet)
     write_table(output, {"t": table["t"], "v": v, "x_ref": table["x"]}, progress=written)
     click.echo(
@@ -158,6 +173,29 @@ def compensate(
             f"  with the inverse of the dynamics of {dynamics_file}: "
             f"{compensator.preview} samples of look-ahead in the reference"
         )
+
+
+#: A turn of the voltage larger than this fraction of the range, where the reference does
+#: not turn, is eq. 10 overshooting: its recursion corrects with the constant gain rho, and
+#: where the model is steeper (a step, or a slope beyond 2 rho) it overshoots, or chatters.
+OWN_TURN = 0.01
+
+
+def _own_turns(v, x, span: float):
+    """``(count, largest in V, index)`` of the samples where ``v`` turns back by more than
+    :data:`OWN_TURN` of ``span`` (both its steps, in and out) and ``x`` does not turn
+    within a sample, or None."""
+    import numpy as np
+
+    dv, dx = np.diff(v), np.diff(x)
+    size = np.minimum(np.abs(dv[:-1]), np.abs(dv[1:]))
+    turns = dx[:-1] * dx[1:] < 0
+    near = turns | np.r_[False, turns[:-1]] | np.r_[turns[1:], False]  # eq. 10 a sample late
+    own = (dv[:-1] * dv[1:] < 0) & ~near & (size > OWN_TURN * span)
+    if not own.any():
+        return None
+    largest = int(np.argmax(np.where(own, size, 0.0)))
+    return int(np.count_nonzero(own)), float(size[largest]), largest + 1
 
 
 def _reach(model, lo: float, hi: float) -> tuple[str, tuple[float, float]]:
