@@ -94,9 +94,10 @@ def dynamics_excitation(
     A rest at the low end of ``voltage_range`` (:data:`REST` s), a step to the middle of
     the range held :data:`HOLD` s (creep), then :data:`PERIODS` periods of a 1 s multisine
     of ``amplitude`` V peak around the middle (by default :data:`AMPLITUDE_FRACTION` of
-    the range's span, small signal on any amplifier: 4 V on 0..120 V, 0.12 V on 0..3.6 V): :data:`N_LINES` log-spaced frequencies from
-    1 Hz to 5 kHz (at most 0.4 ``sample_rate``) rounded to whole Hz, the duplicates
-    dropped (96 lines at 20 kHz), Schroeder phases for a low crest factor.
+    the range's span, small signal on any amplifier: 4 V on 0..120 V, 0.12 V on
+    0..3.6 V): :data:`N_LINES` log-spaced frequencies from 1 Hz to 5 kHz (at most
+    0.4 ``sample_rate``) rounded to whole Hz, the duplicates dropped (96 lines at 20 kHz),
+    Schroeder phases for a low crest factor.
 
     Examples
     --------

@@ -509,10 +509,9 @@ def uneven_sampling(t, what: str) -> str | None:
     return (
         f"The time column of {what} is not evenly sampled: {bad.size} "
         f"{'steps differ' if bad.size > 1 else 'step differs'} from the median step "
-        f"({median:.6g} s) by more "
-        f"than half of it, the first from t = {float(t[k])!r} to {float(t[k + 1])!r} s "
-        f"(data row {k + 2}). The linear dynamics are discrete-time: resample the record onto an "
-        "even grid, or record it again without gaps."
+        f"({median:.6g} s) by more than half of it, the first from t = {float(t[k])!r} to "
+        f"{float(t[k + 1])!r} s (data row {k + 2}). The linear dynamics are discrete-time: "
+        "resample the record onto an even grid, or record it again without gaps."
     )
 
 
