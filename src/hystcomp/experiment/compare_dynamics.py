@@ -144,7 +144,7 @@ def dynamics_rows(dc: DynamicsComparison) -> list[dict]:
 
 
 def dynamics_markdown(dc: DynamicsComparison, table1: dict) -> list[str]:
-    """The report's section on the dynamics: the model, the table, the step, the targets."""
+    """The report's section on the dynamics: the model, the table, the step."""
     d = dc.dynamics
     rep = d.fit_report_
     lines = [
@@ -171,6 +171,14 @@ def dynamics_markdown(dc: DynamicsComparison, table1: dict) -> list[str]:
             ratio = f"{r.rms / base.rms:.2f}" if base is not None else "-"
             lines.append(f"| {f:g} | {label} | {r.rms:.3f} | {r.max:.3f} | {ratio} |")
     lines += [
+        "",
+        (
+            "What the inverse of the dynamics leaves at 100 and 200 Hz is the bandwidth of "
+            "its stable inverse and each model's own hysteresis error, which reaches the "
+            "stage's resonance there and is amplified by it: no linear inverse in front of the "
+            "hysteresis compensator takes that out (docs/dynamics.md; `python "
+            "benchmarks/bench_dynamics.py --coupling` and `--ideal` measure both)."
+        ),
         "",
         (
             f"Step to half the peak, held {STEP_HOLD:g} s: mean |error| from "
