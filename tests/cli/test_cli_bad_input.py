@@ -82,6 +82,7 @@ CASES = [
     ("preisach transient too long", "identify rec.csv --model preisach --transient 1e9 -o {out}.json", r"identify_record \(preisach\): only 0 of 801 samples remain .*\(--transient\)"),
     ("hysteresis record as dynamics", "identify rec.csv --model dynamics -o {out}.json", r"does not have the layout of 'hystcomp excite dynamics': found a hold of"),
     ("hyperparameter as text", "simulate quoted.json rec.csv -o {out}.csv", r"'n_operators' .* is the text '16', not a number, .* set 'n_operators' to 16 \(no quotes\)"),
+    ("initial memory for pi", "identify rec.csv --model pi --initial-memory descended -o {out}.json", r"--initial-memory does not apply to --model pi"),
     ("preisach range inside the record", "identify rec.csv --model preisach --voltage-range 10 100 -o {out}.json", r"\(--voltage-range\) must contain the record's input, .* narrow the compensator's clamp instead \(--voltage-range of compensate"),
     ("dynamics record with a gap", "identify gap.csv --model dynamics -o {out}.json", r"record gap\.csv is not evenly sampled: 1 step differs .* from t = 0\.095 to 0\.125 s \(data row 21\)\. .*resample"),
     ("reference with a gap, dynamics", "compensate model.json ref_gap.csv --dynamics dyn.json -o {out}.csv", r"of the reference is not evenly sampled: 2 steps differ"),

@@ -331,6 +331,18 @@ def test_mpi_regularization_reaches_the_fit_and_the_model_file(tmp_path):
     assert auto.get_params()["regularization"] == "auto"
     assert f"regularization: {chosen:g} (auto" in result.output
     assert auto.fit_report_["rms_error_um"] <= plain.fit_report_["rms_error_um"]
+    chose = auto.fit_report_["initial_memory"]
+    assert f"initial memory: {chose} (the better predicted tracking" in result.output
+    # --initial-memory gives the start instead, into the fit, the file and the compensator
+    other = {"virgin": "descended", "descended": "virgin"}[chose]
+    given = run(*args[:4], "--initial-memory", other, "-o", tmp_path / "given.json")
+    assert given.exit_code == 0, given.output
+    assert f"  initial memory: {other} (given)" in given.output
+    forced = hystcomp.load_model(tmp_path / "given.json")
+    assert forced.get_params()["initial_memory"] == other
+    assert forced.fit_report_["initial_memory"] == other
+    ramp = np.linspace(0.0, 60.0, 50)  # from rest, not to the top: the start still shows
+    assert np.abs(forced.simulate(ramp) - auto.simulate(ramp)).max() > 0.1
 
 
 @pytest.mark.parametrize(

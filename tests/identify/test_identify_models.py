@@ -111,6 +111,21 @@ def test_mpi_fit_finds_the_initial_memory_of_an_mpi_system(memory):
     # eq. 19 as printed keeps eq. 18's virgin memory whatever the record
     paper = hystcomp.ModifiedPrandtlIshlinskii(constraints="paper").fit(v, x)
     assert paper.fit_report_["initial_memory"] == "virgin"
+    # given, the other memory is kept, whatever the record predicts; and the plays start there
+    other = "descended" if memory == "virgin" else "virgin"
+    forced = hystcomp.ModifiedPrandtlIshlinskii(initial_memory=other).fit(v, x)
+    assert forced.fit_report_["initial_memory"] == other
+    assert forced.get_params()["initial_memory"] == other
+    starts = initial_play_states(0.0, forced.thresholds_, other) - forced.input_offset_
+    np.testing.assert_allclose(forced.initial_state_, starts, atol=1e-9)
+    assert forced.fit_report_["rms_error_um"] > 10.0 * model.fit_report_["rms_error_um"]
+
+
+def test_an_unknown_initial_memory_is_refused_by_name():
+    _, v = triangle_sequence(sample_rate=200.0)
+    est = hystcomp.ModifiedPrandtlIshlinskii(initial_memory="relaxed")
+    with pytest.raises(InvalidParameterError, match=r"'initial_memory' .* 'auto' or one of"):
+        est.fit(v, presets.paper_mpi().simulate(v))
 
 
 def test_initial_play_states_are_checked():
@@ -236,6 +251,7 @@ def test_fit_returns_self_and_keeps_hyperparameters():
         "margin": 1e-3,
         "regularization": "auto",
         "constraints": "physical",
+        "initial_memory": "auto",
     }
     assert est.thresholds_.size == 6
     assert est.deadzone_thresholds_.size == 4

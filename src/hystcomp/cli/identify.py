@@ -50,7 +50,8 @@ def _check_options(kind: str, given: dict) -> None:
     """Refuse, in the command's words, an option that --model (or --everett) does not take."""
     for name, value in given.items():
         if value is not None and name not in SIZE_OPTIONS[kind]:
-            raise click.UsageError(f"--{name} does not apply to --model {kind}.")
+            option = name.replace("_", "-")
+            raise click.UsageError(f"--{option} does not apply to --model {kind}.")
     if given["everett"] == "table" and given["degree"] is not None:
         raise click.UsageError("--degree applies to --everett polynomial; a table has --grid.")
     if given["grid"] is not None and given["everett"] == "polynomial":
@@ -144,6 +145,15 @@ def _regularization(ctx, param, value):
     "preisach: 'physical' [default] holds X(v, v) = 0, as eq. 2 implies; 'paper' fits eq. 5's "
     "coefficients free (with --fit reversal-curves --everett polynomial).",
 )
+@click.option(
+    "--initial-memory",
+    type=click.Choice(["auto", "virgin", "descended"]),
+    default=None,
+    help="mpi: where the plays start, for the fit and the compensator [auto: the better "
+    "predicted tracking on the record]. 'descended' is a stage at rest after it has been "
+    "driven, as most are when a reference starts; 'virgin' is eq. 18. The record cannot "
+    "say how the stage will start: give it when you know.",
+)
 @columns_option
 @fs_option
 @x_unit_option
@@ -198,6 +208,7 @@ def identify(
     grid,
     regularization,
     constraints,
+    initial_memory,
     columns,
     sample_rate,
     x_unit,
@@ -240,6 +251,7 @@ def identify(
         given = {"--operators": operators, "--deadzones": deadzones, "--degree": degree}
         given.update({"--regularization": regularization, "--transient": transient})
         given.update({"--voltage-range": voltage_range, "--holdout": holdout})
+        given["--initial-memory"] = initial_memory
         for name, value in given.items():
             if value is not None:
                 raise click.UsageError(f"{name} does not apply to --model dynamics.")
@@ -247,7 +259,7 @@ def identify(
         return
     options = {"operators": operators, "deadzones": deadzones}
     options.update(regularization=regularization, degree=degree, fit=fit, everett=everett)
-    options.update(grid=grid, constraints=constraints)
+    options.update(grid=grid, constraints=constraints, initial_memory=initial_memory)
     _check_options(kind, options)
     model = build_estimator(kind, voltage_range=voltage_range, **options)
     rec = read_record(data, **read_options(columns, sample_rate, x_unit, quiet, data))

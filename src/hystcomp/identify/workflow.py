@@ -55,7 +55,7 @@ LABELS = {"pi": "PI", "mpi": "MPI", "preisach": "Preisach", "dynamics": "dynamic
 #: The options each kind takes (beside ``voltage_range``); ``dynamics`` has its own fit.
 SIZE_OPTIONS = {
     "pi": ("operators", "constraints"),
-    "mpi": ("operators", "deadzones", "regularization", "constraints"),
+    "mpi": ("operators", "deadzones", "regularization", "constraints", "initial_memory"),
     "preisach": ("degree", "fit", "everett", "grid", "constraints"),
     "dynamics": (),
 }
@@ -95,6 +95,7 @@ def build_estimator(
     everett=None,
     grid=None,
     constraints=None,
+    initial_memory=None,
 ):
     """An unfitted hysteresis model of ``kind`` from the options of ``hystcomp identify``.
 
@@ -122,6 +123,9 @@ def build_estimator(
         PI and MPI: the weight constraints (eqs. 12, 19). Preisach: ``'paper'`` fits eq. 5's
         coefficients free, as Section III-A does (``zero_diagonal=False``), where
         ``'physical'`` (the default) holds ``X(v, v) = 0`` as eq. 2 implies.
+    initial_memory : {'auto', 'virgin', 'descended'}, optional
+        Where the plays of an MPI model start (``ModifiedPrandtlIshlinskii``'s
+        ``initial_memory``) [auto].
 
     Returns
     -------
@@ -151,6 +155,7 @@ def build_estimator(
         "everett": everett,
         "grid": grid,
         "constraints": constraints,
+        "initial_memory": initial_memory,
     }
     for name, value in given.items():
         if value is not None and name not in SIZE_OPTIONS[kind]:
@@ -165,6 +170,8 @@ def build_estimator(
         params["n_deadzones"] = DEFAULT_OPERATORS if deadzones is None else deadzones
     if regularization is not None:
         params["regularization"] = regularization
+    if initial_memory is not None:
+        params["initial_memory"] = initial_memory
     if degree is not None:
         params["degree"] = degree
     if kind == "preisach":
@@ -473,10 +480,12 @@ def identify_record(
             f"  regularization: {chosen:g} (auto: the best predicted tracking of 0, 1e-4 .. 1e-1)"
         )
     memory = getattr(model, "fit_report_", {}).get("initial_memory")
-    if memory is not None and model.get_params().get("constraints") == "physical":
+    if memory is not None and model.get_params().get("initial_memory", "auto") != "auto":
+        lines.append(f"  initial memory: {memory} (given)")
+    elif memory is not None and model.get_params().get("constraints") == "physical":
         lines.append(
             f"  initial memory: {memory} (the better predicted tracking of 'virgin', eq. 18, "
-            "and 'descended')"
+            "and 'descended'; --initial-memory gives it)"
         )
     if kind == "preisach":
         lines.append(f"  Everett fit: {_preisach_fit_line(model)}")

@@ -13,6 +13,7 @@ import numpy as np
 from hystcomp import paper
 from hystcomp._hyperparameters import check_operator_count, check_regularization_option
 from hystcomp._validation import as_vector, check_int, check_thresholds
+from hystcomp.errors import InvalidParameterError
 from hystcomp.identify.compensation import CV_FOLDS, tracking_scorer
 from hystcomp.identify.mpi import REGULARIZATION_GRID, fit_mpi_path
 from hystcomp.identify.pi import INITIAL_MEMORIES
@@ -62,6 +63,13 @@ class ModifiedPrandtlIshlinskii(PrandtlIshlinskii):
         to track best, as the regularisation (see :mod:`hystcomp.identify.mpi`);
         ``"paper"``: eq. (19) with only its partial sums kept positive, from eq. (18)'s virgin
         start. ``constraints="paper", regularization=0`` is the paper's fit exactly.
+    initial_memory : {"auto", "virgin", "descended"}, default "auto"
+        Where the plays start (:func:`hystcomp.identify.pi.initial_play_states`), for the
+        fit and for the compensator: ``"auto"`` as ``constraints`` says above; ``"virgin"``
+        is eq. (18); ``"descended"`` is a stage at rest after it has been driven, as most
+        are when a reference starts. The record cannot say how the stage will be when a
+        reference starts, and a reference that stays inside the range never wipes that
+        start out: give it when you know.
 
     Attributes
     ----------
@@ -119,6 +127,7 @@ class ModifiedPrandtlIshlinskii(PrandtlIshlinskii):
         margin=1e-3,
         regularization="auto",
         constraints="physical",
+        initial_memory="auto",
     ):
         self.n_operators = n_operators
         self.n_deadzones = n_deadzones
@@ -127,6 +136,7 @@ class ModifiedPrandtlIshlinskii(PrandtlIshlinskii):
         self.margin = margin
         self.regularization = regularization
         self.constraints = constraints
+        self.initial_memory = initial_memory
 
     def fit(self, v, x) -> Self:
         """Identify the model from a measured record by eq. (19) (Section IV-A).
@@ -151,6 +161,10 @@ class ModifiedPrandtlIshlinskii(PrandtlIshlinskii):
         m = check_operator_count(self.n_deadzones, "n_deadzones", owner)
         penalties = self._penalties(owner)
         # eq. 18's virgin plays, and with the physical constraints the descended ones too
+        if self.initial_memory != "auto":
+            memories: tuple[str, ...] = (self.initial_memory,)
+        else:
+            memories = INITIAL_MEMORIES if self.constraints == "physical" else ("virgin",)
         fits = fit_mpi_path(
             v,
             x,
@@ -161,7 +175,7 @@ class ModifiedPrandtlIshlinskii(PrandtlIshlinskii):
             regularizations=penalties,
             constraints=self.constraints,
             n_folds=CV_FOLDS,
-            initial_memories=INITIAL_MEMORIES if self.constraints == "physical" else ("virgin",),
+            initial_memories=memories,
         )
         # scored on the samples the fit used (a long record is thinned, see fit_mpi_path);
         # they hold the extremes of the input
@@ -236,6 +250,11 @@ class ModifiedPrandtlIshlinskii(PrandtlIshlinskii):
         owner = type(self).__name__
         check_int(self.n_deadzones, "n_deadzones", owner)
         check_regularization_option(self.regularization, owner)
+        if self.initial_memory not in ("auto", *INITIAL_MEMORIES):
+            raise InvalidParameterError(
+                f"The 'initial_memory' parameter of {owner} must be 'auto' or one of "
+                f"{INITIAL_MEMORIES}. Got {self.initial_memory!r} instead."
+            )
 
     def _saturation(self) -> tuple[np.ndarray, np.ndarray]:
         return self.deadzone_thresholds_, self.deadzone_weights_
