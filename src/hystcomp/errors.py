@@ -61,3 +61,8 @@ class OutputPathError(HystcompError, ValueError):
     input files, or the write itself failed (permissions, a full disk). Nothing is left
     half-written: the existing file, if any, is unchanged.
     """
+
+
+class HystcompWarning(UserWarning):
+    """Something the user should know before relying on a result (the command line prints
+    it as a ``hystcomp: warning:`` line)."""

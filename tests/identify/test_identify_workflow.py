@@ -21,11 +21,11 @@ from hystcomp.identify.scoring import coverage_warning, transient_end
 from hystcomp.identify.workflow import (
     IdentificationResult,
     build_estimator,
-    identify_dynamics_record,
     identify_record,
 )
 from hystcomp.io.records import Record
 from hystcomp.models.dynamics import LinearDynamics
+from hystcomp.workflows.pair import identify_dynamics_record
 
 FS = 1000.0  # Hz
 

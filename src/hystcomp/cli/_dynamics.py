@@ -13,7 +13,7 @@ from hystcomp.models.dynamics import LinearDynamics
 
 def identify_dynamics(rec, output: str, plot: str | None) -> None:
     """Fit :class:`LinearDynamics` to ``rec``, print the fit, write the model (and figure)."""
-    from hystcomp.identify.workflow import identify_dynamics_record
+    from hystcomp.workflows.pair import identify_dynamics_record
 
     result = identify_dynamics_record(rec)
     for line in result.lines:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import warnings
 from typing import Any
 
 import click
@@ -24,9 +25,12 @@ from hystcomp.cli._options import (
     warn_x_unit,
     x_unit_option,
 )
-from hystcomp.errors import InvalidSignalError
+from hystcomp.errors import HystcompWarning, InvalidSignalError, ModelFileError
 from hystcomp.io.models import load_model
 from hystcomp.io.records import read_table, write_table
+from hystcomp.models.dynamics import APART
+from hystcomp.models.hammerstein import HammersteinModel
+from hystcomp.workflows.pair import predicted_worse
 
 
 def inverse_options(model, table, *, slew_rate, narrow_range) -> dict:
@@ -87,13 +91,16 @@ def inverse_options(model, table, *, slew_rate, narrow_range) -> dict:
     default=None,
     metavar="DYN.json",
     help="Also invert the linear dynamics of this file (hystcomp identify --model "
-    "dynamics): v = H^-1[D^-1[x_ref]], looking ahead in the reference (beyond the paper).",
+    "dynamics): v = H^-1[D^-1[x_ref]], looking ahead in the reference (beyond the paper). "
+    "Identified apart from the model, they are matched at 1 Hz, with a warning; a model "
+    "identified with --dynamics-record holds its dynamics as one pair, used without this.",
 )
 @click.option(
     "--strict",
     is_flag=True,
     help="Refuse (exit 2, nothing written) a reference that the clamp cuts anywhere, "
-    "instead of warning.",
+    "a pair predicted to track it worse than its hysteresis model alone, or dynamics "
+    "identified apart from the model, instead of warning.",
 )
 def compensate(
     model_file,
@@ -121,14 +128,48 @@ def compensate(
     check_data_output(output, inputs=inputs, what="voltage file")
     model = load_model(model_file)
     refuse_dynamics_as_model(model, model_file)
-    chosen = method_options(model, model_file, method)
+    pair = isinstance(model, HammersteinModel)
+    if pair and dynamics_file is not None:
+        raise ModelFileError(
+            f"{model_file!r} holds a hysteresis model and its dynamics, identified as one "
+            "pair; its inverse inverts both. Drop --dynamics."
+        )
+    chosen = method_options(model.hysteresis if pair else model, model_file, method)
     options = read_options(columns, sample_rate, x_unit, quiet, reference_file, reads=("x",))
     table = read_table(reference_file, ("x",), **options)
     warn_x_unit(table["x"], reference_file, quiet, x_unit)
     options = inverse_options(model, table, slew_rate=slew_rate, narrow_range=narrow_range)
-    if dynamics_file is not None:
+    if pair:
+        dynamics_for(model.dynamics, table)  # it runs at the dynamics' rate only
+        options.pop("sample_rate", None)
+        worse = predicted_worse(model, table["x"], model.sample_rate)
+        if worse is not None:
+            rate, alone, paired = worse
+            what = (
+                f"the pair in {model_file} is predicted to track this reference (about "
+                f"{rate:.3g} Hz) at {paired:.3g} µm rms, worse than its hysteresis model "
+                f"alone ({alone:.3g} µm; estimated when it was identified)"
+            )
+            if strict:
+                raise InvalidSignalError(
+                    f"{what}. Nothing written (--strict); compensate with the hysteresis "
+                    "model alone (hystcomp identify without --dynamics-record), or drop "
+                    "--strict."
+                )
+            click.echo(f"hystcomp: warning: {what}.", err=True)
+    elif dynamics_file is not None:
         options["dynamics"] = dynamics_for(load_dynamics(dynamics_file), table)
-    compensator = model.inverse(**options, **chosen)
+        if strict:
+            raise ModelFileError(
+                f"{model_file} and {dynamics_file} were identified apart, so whether their "
+                "inverse tracks better than the hysteresis model's alone cannot be "
+                "predicted. Nothing written (--strict); identify them as one pair (hystcomp "
+                "identify DATA --model KIND --dynamics-record DYN.csv), or drop --strict."
+            )
+        click.echo(f"hystcomp: warning: {APART}", err=True)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", HystcompWarning)  # said above, in the command's words
+        compensator = model.inverse(**options, **chosen)
     with progress("computing the voltage", quiet).ticking():
         result = compensator.run(table["x"])
     v = result.v
@@ -168,9 +209,9 @@ def compensate(
         f"wrote {output}: {v.size} samples, v from {v.min():.4g} to {v.max():.4g} V "
         f"(range {lo:.4g} .. {hi:.4g} V, {result.clamped} clamped)"
     )
-    if dynamics_file is not None:
+    if dynamics_file is not None or pair:
         click.echo(
-            f"  with the inverse of the dynamics of {dynamics_file}: "
+            f"  with the inverse of the dynamics of {dynamics_file or model_file}: "
             f"{compensator.preview} samples of look-ahead in the reference"
         )
 

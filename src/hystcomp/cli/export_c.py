@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 
 import click
@@ -11,8 +12,11 @@ from hystcomp.cli import main
 from hystcomp.cli._dynamics import load_dynamics, refuse_dynamics_as_model
 from hystcomp.cli._options import method_option, method_options, positive
 from hystcomp.codegen import DEFAULT_PREFIX, check_prefix, export_c
+from hystcomp.errors import HystcompWarning, ModelFileError
 from hystcomp.io.atomic import check_output_path
 from hystcomp.io.models import load_model
+from hystcomp.models.dynamics import APART
+from hystcomp.models.hammerstein import HammersteinModel
 
 
 @main.command("export-c")
@@ -75,16 +79,29 @@ def export_c_command(model_file, directory, prefix, slew_rate, sample_rate, meth
     model = load_model(model_file)
     refuse_dynamics_as_model(model, model_file)
     options = {"slew_rate": slew_rate, "sample_rate": sample_rate}
+    pair = isinstance(model, HammersteinModel)
+    if pair and dynamics_file is not None:
+        raise ModelFileError(
+            f"{str(model_file)!r} holds a hysteresis model and its dynamics, identified as "
+            "one pair; its inverse inverts both. Drop --dynamics."
+        )
+    dynamics = model.dynamics if pair else None
     if dynamics_file is not None:
-        dynamics = load_dynamics(dynamics_file)
-        if abs(dynamics.sample_rate_ - sample_rate) > 1e-6 * sample_rate:
-            raise click.BadParameter(
-                f"is {sample_rate:g} Hz but {dynamics_file} was identified at "
-                f"{dynamics.sample_rate_:g} Hz; the code must run at the dynamics' rate.",
-                param_hint="'--fs'",
-            )
-        options["dynamics"] = dynamics
-    compensator = model.inverse(**options, **method_options(model, model_file, method))
+        dynamics = options["dynamics"] = load_dynamics(dynamics_file)
+    if dynamics is not None and abs(dynamics.sample_rate_ - sample_rate) > 1e-6 * sample_rate:
+        raise click.BadParameter(
+            f"is {sample_rate:g} Hz but {dynamics_file or model_file} was identified at "
+            f"{dynamics.sample_rate_:g} Hz; the code must run at the dynamics' rate.",
+            param_hint="'--fs'",
+        )
+    chosen = method_options(model.hysteresis if pair else model, model_file, method)
+    if pair:
+        options.pop("sample_rate")  # the pair's own
+    elif dynamics_file is not None:
+        click.echo(f"hystcomp: warning: {APART}", err=True)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", HystcompWarning)  # said above, in the command's words
+        compensator = model.inverse(**options, **chosen)
     header, source = export_c(
         compensator,
         directory,

@@ -195,6 +195,15 @@ def _regularization(ctx, param, value):
     help="Fit on the first part only and report how well the model predicts this last "
     "fraction of the record, against a straight line.",
 )
+@click.option(
+    "--dynamics-record",
+    default=None,
+    metavar="DYN",
+    help="Also identify the linear dynamics (creep, resonance), from this answer to "
+    "'hystcomp excite dynamics' (same --columns and --fs), as one pair with the hysteresis "
+    "model: D behind H, H in front of D, alternated. Writes the pair; compensate and "
+    "export-c then invert both (beyond the paper).",
+)
 @click.option("--plot", default=None, metavar="FILE", help="Fig. 8-style figure (.png/.pdf/.svg).")
 @click.option("-o", "--output", required=True, metavar="MODEL.json", help="Model file to write.")
 def identify(
@@ -217,6 +226,7 @@ def identify(
     voltage_range,
     allow_extrapolation,
     holdout,
+    dynamics_record,
     plot,
     output,
 ):
@@ -236,13 +246,14 @@ def identify(
     gain) beside the same estimate for a straight line, and warns when the compensator is
     predicted to do no better than the line, or when a hold-out leaves the fitted range.
     """
-    check_output_path(output, inputs=(data,), what="model file")
+    inputs = (data,) if dynamics_record is None else (data, dynamics_record)
+    check_output_path(output, inputs=inputs, what="model file")
     if plot is not None:  # matplotlib is imported only when a figure is asked for
         from hystcomp.experiment.fig_identification import FORMATS, plot_identification
 
         if Path(plot).suffix.lower() not in FORMATS:
             raise click.BadParameter(f"must end in {', '.join(FORMATS)}.", param_hint="--plot")
-        check_output_path(plot, inputs=(data,), what="figure")
+        check_output_path(plot, inputs=inputs, what="figure")
         if Path(plot).resolve() == Path(output).resolve():
             raise click.BadParameter("names the same file as -o.", param_hint="--plot")
     if kind == "dynamics":  # linear dynamics: a record of 'hystcomp excite dynamics'
@@ -252,6 +263,7 @@ def identify(
         given.update({"--regularization": regularization, "--transient": transient})
         given.update({"--voltage-range": voltage_range, "--holdout": holdout})
         given["--initial-memory"] = initial_memory
+        given["--dynamics-record"] = dynamics_record
         for name, value in given.items():
             if value is not None:
                 raise click.UsageError(f"{name} does not apply to --model dynamics.")
@@ -279,21 +291,35 @@ def identify(
             "--allow-extrapolation.",
             param_hint="'--voltage-range'",
         )
-    result = identify_record(
-        rec,
-        model,
-        allow_extrapolation=allow_extrapolation,
-        transient=transient,
-        holdout=holdout,
-        progress=progress(f"identifying the {LABELS[kind]} model", quiet).ticking(),
-        unit_check=False,  # checked above, before the fit, and silenced by --quiet
-    )
-    for line in result.lines:
+    fitting = {
+        "allow_extrapolation": allow_extrapolation,
+        "transient": transient,
+        "progress": progress(f"identifying the {LABELS[kind]} model", quiet).ticking(),
+        "unit_check": False,  # checked above, before the fit, and silenced by --quiet
+    }
+    if dynamics_record is None:
+        result = identify_record(rec, model, holdout=holdout, **fitting)
+        lines, warnings, written = result.lines, result.warnings, result.model
+    else:
+        from hystcomp.workflows.pair import identify_pair_record
+
+        if holdout is not None:
+            raise click.UsageError(
+                "--holdout does not apply with --dynamics-record: the pair's tracking is "
+                "estimated on the dynamics record's triangles. Hold out without it."
+            )
+        dyn = read_record(dynamics_record, **read_options(columns, sample_rate))
+        paired = identify_pair_record(rec, dyn, model, **fitting)
+        result = paired.hysteresis
+        lines = result.lines + paired.lines
+        warnings = result.warnings + paired.warnings
+        written = paired.model
+    for line in lines:
         click.echo(line)
-    for warning in result.warnings:
+    for warning in warnings:
         click.echo(f"hystcomp: warning: {warning}", err=True)
     # Everything is computed; now write all outputs at once (a failure writes none of them).
-    text = model_text(result.model)
+    text = model_text(written)
     outputs = [output] if plot is None else [output, plot]
     with atomic_paths(*outputs) as (tmp_model, *tmp_plot):
         tmp_model.write_text(text, encoding="utf-8")

@@ -6,6 +6,7 @@ import click
 import numpy as np
 
 from hystcomp.cli import main
+from hystcomp.cli._dynamics import dynamics_for
 from hystcomp.cli._options import (
     check_data_output,
     columns_option,
@@ -20,6 +21,7 @@ from hystcomp.cli._options import (
 from hystcomp.errors import ModelFileError
 from hystcomp.io.models import load_model
 from hystcomp.io.records import read_table, write_table
+from hystcomp.models.hammerstein import HammersteinModel
 
 
 @main.command("simulate")
@@ -53,6 +55,8 @@ def simulate(model_file, input_file, output, columns, sample_rate, x_unit, quiet
     )
     if "x" in table:  # a measured displacement to validate against: in µm, like the model
         warn_x_unit(table["x"], input_file, quiet, x_unit)
+    if isinstance(model, HammersteinModel):  # discrete-time dynamics: at their rate only
+        dynamics_for(model.dynamics, table)
     v = table["v"]
     lo, hi = getattr(model, "voltage_range_", (-float("inf"), float("inf")))
     if v.min() < lo or v.max() > hi:

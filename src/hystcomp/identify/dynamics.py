@@ -1,33 +1,50 @@
-"""Identification of the linear dynamics (creep and first resonance) from a small-signal record.
+"""Identification of the linear dynamics (creep and first resonance) of a hysteretic stage.
 
-The record is the actuator's answer to :func:`dynamics_excitation` (``hystcomp excite
-dynamics``), which has three parts::
+The stage is a Hammerstein system, ``x = D[H[v]]``: a rate-independent hysteresis ``H``
+followed by linear dynamics ``D`` (Croft, Shed and Devasia 2001; the paper's Fig. 2 puts
+the piezo dynamics after the hysteresis). ``D`` is identified *behind* ``H``: the input of
+the fit is ``u = H[v]``, the output of a hysteresis model, not the voltage (the workflow
+:mod:`hystcomp.workflows.pair` alternates this fit with the fit of ``H`` in front of ``D``).
 
-    rest at v_min (REST s) | step to the bias, held HOLD s | multisine around the bias, PERIODS x 1 s
+The record is the stage's answer to :func:`dynamics_excitation` (``hystcomp excite
+dynamics``), at the amplitudes tracking uses::
 
-The fit, in four short stages (about 0.1 s for a 20 kHz record):
+    rest at v_min (REST s) | step to mid-range, held HOLD s | multisine around mid-range,
+    PERIODS x 1 s, peak AMPLITUDE_FRACTION of the range | triangles over 5-90 % of the
+    range at 1, 10, 100 and 200 Hz (each reached by a ramp at its own slope)
 
-1. The frequency response ``X(f) / V(f)`` at the multisine's lines, from the average of
-   its periods after the first; the resonance ``(f_n, zeta)`` of
-   :class:`~hystcomp.LinearDynamics` fitted to the lines above 20 Hz by nonlinear least
-   squares (``scipy.optimize.least_squares``), with the local gain of the hysteresis around
-   the bias a free *complex* factor: the minor loops of a rate-independent
-   hysteresis lag the input by the same phase at every frequency, and that lag belongs to
-   the hysteresis inverse, not to ``D``.
+Why large signal: the minor loops of a small multisine around one operating point have the
+gain and phase of the hysteresis, not of the dynamics (on a Preisach stage with narrow
+minor loops, a +-4 V multisine let a one-mode model explain 24 % of the frequency
+response). Driven over most of the range, the stage's hysteresis is what its hysteresis
+model describes, and ``X / H[V]`` is ``D``. The triangles are held out of every fit: the
+workflow estimates on them how well the compensators track at those rates.
+
+The fit, in four short stages:
+
+1. The frequency response ``X(f) / U(f)`` at the multisine's lines, from the average of
+   its periods after the first (``u`` is periodic with ``v`` after one period, as a
+   rate-independent ``H[v]`` is); the resonance of :class:`~hystcomp.LinearDynamics`
+   fitted to the lines above 20 Hz by nonlinear least squares
+   (``scipy.optimize.least_squares``), with a free complex factor that takes up what is
+   left of the hysteresis's gain and phase (with ``u = v``, all of it).
 2. The creep from the step and hold: with the resonance known, the step response is linear
    in the weights of creep modes with time constants fixed on a log grid (two per decade
    from 1 ms to the hold's length); non-negative least squares (``scipy.optimize.nnls``).
 3. The multisine part again, with the step's continuing creep removed, and the resonance
    fitted again with the creep in the model.
 4. The fit report: fit % and largest magnitude error in the frequency domain up to twice
-   the resonance, rms error of the step response.
+   the resonance, rms error of the step response, and the measured frequency response
+   (for the Bode figure).
 
-The hysteresis is rate independent, so the step's height and the local slope around the
-bias are free gains: only the *shape* of the dynamics is identified, and the model is
-normalised to unit steady-state gain (the end of the hold; modes slower than the hold show
-as a part of the slowest mode). Deviation from the usual subspace or ARX fits (e.g.
-``nfoursid``): a physical structure with few parameters keeps the inverse stable by
-construction and costs no extra dependency.
+Only the *shape* of the dynamics is identified: the model is normalised to unit
+steady-state gain (the end of the hold; modes slower than the hold show as a part of the
+slowest mode), and the hysteresis model holds the static map. Deviation from the usual
+subspace or ARX fits (e.g. ``nfoursid``): a physical structure with few parameters keeps
+the inverse stable by construction and costs no extra dependency.
+
+Records of the former layout (a +-1/30 range multisine to the end, no triangles) are still
+read.
 """
 
 from __future__ import annotations
@@ -65,10 +82,18 @@ HOLD = 3.0
 PERIOD = 1.0
 PERIODS = 3
 BIAS_FRACTION = 0.5
-#: The multisine's peak, as a fraction of the voltage range's span: 4 V on 0..120 V.
-AMPLITUDE_FRACTION = 1.0 / 30.0
+#: The multisine's peak, as a fraction of the voltage range's span: 30 V on 0..120 V, so
+#: that it sweeps 25-75 % of the range, and its lines near a resonance (of zeta 0.02 and
+#: up) drive the stage within its stroke. Lines of equal amplitude: a spectrum falling
+#: with frequency, as a reference's harmonics do, left the lines near a resonance to the
+#: hysteresis model's error, which is broadband (a one-mode fit explained 51 % of a
+#: Preisach stage's response with lines falling as 1 / f above 100 Hz, 98 % flat).
+AMPLITUDE_FRACTION = 0.25
 F_MIN, F_MAX = 1.0, 5000.0
 N_LINES = 120
+#: The held-out triangles: (frequency in Hz, periods), over TRIANGLE_SPAN of the range.
+TRIANGLES = ((1.0, 2), (10.0, 4), (100.0, 20), (200.0, 20))
+TRIANGLE_SPAN = (0.05, 0.90)
 #: Lines used to fit the resonance, Hz (from), and how far the step's start is skipped for creep.
 FIT_FROM_HZ = 20.0
 #: Time constants of the resonance's decay left out at the start of the step for the creep.
@@ -82,6 +107,26 @@ MAX_DAMPING = 2.0
 DELAY_RANGE = (-1, 32)
 
 
+class Triangle(NamedTuple):
+    """A held-out triangle of the record: ``frequency`` (Hz), samples ``start .. stop``
+    (the first period included) and the samples of one ``period``."""
+
+    frequency: float
+    start: int
+    stop: int
+    period: int
+
+
+class Layout(NamedTuple):
+    """Where the parts of a dynamics record lie (sample indices)."""
+
+    step: int
+    multisine: int
+    periods: int
+    n_period: int
+    triangles: tuple[Triangle, ...]
+
+
 def dynamics_excitation(
     *,
     sample_rate: float = paper.SAMPLE_RATE,
@@ -89,23 +134,27 @@ def dynamics_excitation(
     amplitude: float | None = None,
     seed: int = 0,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """``(t, v)`` of the identification signal of the linear dynamics.
+    """``(t, v)`` of the identification signal of the linear dynamics (see the module).
 
     A rest at the low end of ``voltage_range`` (:data:`REST` s), a step to the middle of
-    the range held :data:`HOLD` s (creep), then :data:`PERIODS` periods of a 1 s multisine
-    of ``amplitude`` V peak around the middle (by default :data:`AMPLITUDE_FRACTION` of
-    the range's span, small signal on any amplifier: 4 V on 0..120 V, 0.12 V on
-    0..3.6 V): :data:`N_LINES` log-spaced frequencies from 1 Hz to 5 kHz (at most
-    0.4 ``sample_rate``) rounded to whole Hz, the duplicates dropped (96 lines at 20 kHz),
-    Schroeder phases for a low crest factor.
+    the range held :data:`HOLD` s (creep), :data:`PERIODS` periods of a 1 s multisine of
+    ``amplitude`` V peak around the middle (by default :data:`AMPLITUDE_FRACTION` of the
+    range's span: 30 V on 0..120 V, 0.9 V on 0..3.6 V): :data:`N_LINES` log-spaced
+    frequencies from 1 Hz to 5 kHz (at most 0.4 ``sample_rate``) rounded to whole Hz, the
+    duplicates dropped (96 lines at 20 kHz), Schroeder phases for a low crest factor; then the triangles of :data:`TRIANGLES` over
+    :data:`TRIANGLE_SPAN` of the range (those with fewer than 20 samples a period left
+    out), each reached by a ramp at its own slope. 9.1 s in all.
 
     Examples
     --------
     >>> t, v = dynamics_excitation()
     >>> t.size, float(v.min()), float(v[round(1.0 * 20_000)])   # rest, then the step to 60 V
-    (124000, 0.0, 60.0)
-    >>> round(float(np.abs(v[-20_000:] - 60.0).max()), 9)          # +-4 V multisine
-    4.0
+    (182802, 0.0, 60.0)
+    >>> ms = v[round(3.2 * 20_000):round(6.2 * 20_000)]          # the multisine, +-48 V
+    >>> round(float(np.abs(ms - 60.0).max()), 9)
+    48.0
+    >>> round(float(v[-1]), 9), round(float(v.max()), 9)           # triangles up to 90 %
+    (6.0, 108.0)
     """
     owner = "dynamics_excitation"
     fs = check_real(sample_rate, "sample_rate", owner, positive=True)
@@ -113,21 +162,43 @@ def dynamics_excitation(
     if amplitude is None:
         amplitude = AMPLITUDE_FRACTION * (hi - lo)
     amplitude = check_real(amplitude, "amplitude", owner, positive=True)
-    seconds = REST + HOLD + PERIODS * PERIOD
-    if seconds * fs > MAX_SIGNAL_SAMPLES:
+    if amplitude > (1.0 - BIAS_FRACTION) * (hi - lo):
         raise InvalidParameterError(
-            f"The 'sample_rate' parameter of {owner} (--fs) makes the {seconds:g} s signal "
-            f"{seconds * fs:.3g} samples long, more than {MAX_SIGNAL_SAMPLES:.0e}. Got {fs:g} Hz; use "
-            f"at most {MAX_SIGNAL_SAMPLES / seconds:g} Hz."
-        )
-    bias = lo + BIAS_FRACTION * (hi - lo)
-    if amplitude > 0.25 * (hi - lo):
-        raise InvalidParameterError(
-            f"The 'amplitude' parameter of {owner} must be small against the voltage range "
-            f"{lo:g} .. {hi:g} V ({0.25 * (hi - lo):g} V at most): the dynamics are identified "
-            f"in small signal. Got {amplitude:g} V; use a smaller amplitude, or leave it out for "
+            f"The 'amplitude' parameter of {owner} must keep the multisine inside the voltage "
+            f"range {lo:g} .. {hi:g} V (at most {(1.0 - BIAS_FRACTION) * (hi - lo):g} V about "
+            f"its middle). Got {amplitude:g} V; use a smaller amplitude, or leave it out for "
             f"{AMPLITUDE_FRACTION:.3g} of the range."
         )
+    seconds = _duration(fs, lo, hi, amplitude)
+    if seconds * fs > MAX_SIGNAL_SAMPLES:
+        raise InvalidParameterError(
+            f"The 'sample_rate' parameter of {owner} (--fs) makes the {seconds:.3g} s signal "
+            f"{seconds * fs:.3g} samples long, more than {MAX_SIGNAL_SAMPLES:.0e}. Got {fs:g} Hz; "
+            f"use at most {MAX_SIGNAL_SAMPLES / seconds:g} Hz."
+        )
+    v = np.concatenate([part for _, part in _parts(fs, lo, hi, amplitude)])
+    return np.arange(v.size) / fs, v
+
+
+def _duration(fs: float, lo: float, hi: float, amplitude: float) -> float:
+    """Seconds of :func:`dynamics_excitation`, from its layout alone (cheap)."""
+    seconds = REST + HOLD + PERIODS * PERIOD
+    a, b = lo + TRIANGLE_SPAN[0] * (hi - lo), lo + TRIANGLE_SPAN[1] * (hi - lo)
+    level = lo + BIAS_FRACTION * (hi - lo)
+    for f, periods in _triangles(fs):
+        seconds += abs(level - a) / (2.0 * (b - a) * f) + periods / f
+        level = a
+    return seconds
+
+
+def _triangles(fs: float) -> list[tuple[float, int]]:
+    """The triangles of :data:`TRIANGLES` that the sample rate draws (20 samples a period)."""
+    return [(f, n) for f, n in TRIANGLES if fs / f >= 20.0]
+
+
+def _parts(fs: float, lo: float, hi: float, amplitude: float) -> list[tuple[str, np.ndarray]]:
+    """The excitation's parts, labelled: ``rest``, ``hold``, ``multisine``, and for each
+    triangle ``ramp`` then ``triangle <f>``."""
     n_period = round(PERIOD * fs)
     lines = multisine_lines(fs)
     phases = -np.pi * np.arange(lines.size) * (np.arange(lines.size) + 1) / lines.size
@@ -135,14 +206,23 @@ def dynamics_excitation(
     spectrum[np.round(lines * PERIOD).astype(int)] = np.exp(1j * phases)
     period = np.fft.irfft(spectrum, n_period)
     period *= amplitude / np.abs(period).max()
-    v = np.concatenate(
-        [
-            np.full(round(REST * fs), lo),
-            np.full(round(HOLD * fs), bias),
-            bias + np.tile(period, PERIODS),
-        ]
-    )
-    return np.arange(v.size) / fs, v
+    bias = lo + BIAS_FRACTION * (hi - lo)
+    parts = [
+        ("rest", np.full(round(REST * fs), float(lo))),
+        ("hold", np.full(round(HOLD * fs), bias)),
+        ("multisine", bias + np.tile(period, PERIODS)),
+    ]
+    a, b = lo + TRIANGLE_SPAN[0] * (hi - lo), lo + TRIANGLE_SPAN[1] * (hi - lo)
+    level = bias
+    for f, periods in _triangles(fs):
+        n = round(fs / f)
+        slope = 2.0 * (b - a) / n  # V a sample
+        ramp = max(1, math.ceil(abs(level - a) / slope))
+        parts.append(("ramp", np.linspace(level, a, ramp + 1)[1:]))
+        phase = np.arange(n * periods) % n / n
+        parts.append((f"triangle {f:g}", a + (b - a) * (1.0 - np.abs(1.0 - 2.0 * phase))))
+        level = a
+    return parts
 
 
 def multisine_lines(sample_rate: float) -> np.ndarray:
@@ -157,7 +237,7 @@ def creep_grid(hold: float) -> np.ndarray:
     return np.geomspace(1e-3, hold, max(2, round(2 * decades) + 1))
 
 
-def fit_dynamics(v, x, sample_rate: float) -> DynamicsFit:
+def fit_dynamics(v, x, sample_rate: float, *, u=None) -> DynamicsFit:
     """Identify the linear dynamics from the answer ``x`` (µm) to :func:`dynamics_excitation`.
 
     :meth:`hystcomp.LinearDynamics.fit` delegates here.
@@ -168,6 +248,10 @@ def fit_dynamics(v, x, sample_rate: float) -> DynamicsFit:
         The record: command (V) and displacement (µm), one sample each per ``1/sample_rate``.
     sample_rate : float
         Hz.
+    u : array_like, optional
+        The input of ``D``: a hysteresis model's output ``H[v]`` (µm), for a fit behind
+        ``H`` (see the module). By default ``v`` itself, whose local gain and phase the fit
+        then takes as the hysteresis's, as a small-signal record has them.
 
     Returns
     -------
@@ -183,7 +267,14 @@ def fit_dynamics(v, x, sample_rate: float) -> DynamicsFit:
     owner = "fit_dynamics"
     fs = check_real(sample_rate, "sample_rate", owner, positive=True)
     v, x = as_signal_pair(v, x, ("v", "x"), owner)  # too short: the layout says what to record
-    step, multisine, n_period = _layout(v, fs)
+    u = v if u is None else as_signal_pair(v, u, ("v", "u"), owner)[1]
+    layout = record_layout(v, fs)
+    step, multisine, n_period, periods = (
+        layout.step,
+        layout.multisine,
+        layout.n_period,
+        layout.periods,
+    )
     if np.ptp(x[step:]) <= 1e-9 * max(1.0, float(np.max(np.abs(x)))):
         raise IdentificationError(
             f"The displacement 'x' does not move after the step of the dynamics excitation "
@@ -191,7 +282,6 @@ def fit_dynamics(v, x, sample_rate: float) -> DynamicsFit:
             "is the displacement sensor's and that the actuator was driven."
         )
     hold = (multisine - step) / fs
-    periods = (v.size - multisine) // n_period
     lines = multisine_lines(fs)
     bins = np.round(lines * n_period / fs).astype(int)
 
@@ -199,7 +289,7 @@ def fit_dynamics(v, x, sample_rate: float) -> DynamicsFit:
     lags = np.exp(-1.0 / (fs * taus))
     x0 = float(np.mean(x[max(0, step - round(0.1 * fs)) : step]))
     # the rig's latency first: the lines, each advanced by d samples, fit best at the right d
-    measured = _frf(v, x, multisine, n_period, periods, bins)
+    measured = _frf(u, x, multisine, n_period, periods, bins)
     tau, (fn, zeta) = _fit_delay(measured, lines, fs)
     delay = int(np.clip(round(tau), *DELAY_RANGE))  # the model's, in whole samples
     advance = np.exp(2j * np.pi * lines * tau / fs)  # the fit's: the fraction too
@@ -208,7 +298,7 @@ def fit_dynamics(v, x, sample_rate: float) -> DynamicsFit:
     # the step's creep goes on through the multisine: take it out and fit again
     ramp = np.r_[np.zeros(step), np.ones(v.size - step)]
     drift = step_fit * output(ramp, 0.0, fs, fn, zeta, lags, weights, delay)
-    measured = _frf(v, x - drift, multisine, n_period, periods, bins) * advance
+    measured = _frf(u, x - drift, multisine, n_period, periods, bins) * advance
     fn, zeta, _ = _fit_resonance(measured, lines, fs, lags, weights, guess=(fn, zeta))
     weights, step_fit = _fit_creep(rise, fn, zeta, fs, lags)
     parameters = {
@@ -219,11 +309,32 @@ def fit_dynamics(v, x, sample_rate: float) -> DynamicsFit:
         "creep_weights": weights.tolist(),
         "delay_samples": delay,
     }
-    return DynamicsFit(parameters, _report(parameters, lags, measured, lines, rise, step_fit))
+    report = _report(parameters, lags, measured, lines, rise, step_fit)
+    raw = measured / advance  # as the rig answered, its latency in
+    report["measured_response"] = {
+        "hz": lines.tolist(),
+        "real": raw.real.tolist(),
+        "imag": raw.imag.tolist(),
+    }
+    return DynamicsFit(parameters, report)
 
 
-def _layout(v: np.ndarray, fs: float) -> tuple[int, int, int]:
-    """Indices of the step and of the multisine's start, and the period in samples."""
+def record_layout(v, sample_rate: float) -> Layout:
+    """Where the parts of :func:`dynamics_excitation` lie in a record's command ``v``.
+
+    The step is the first change of ``v``, the multisine the first change after it; the
+    multisine's periods are those that repeat the first (a record of the former layout
+    holds the multisine to its end). The triangles are those of the excitation for the
+    record's voltage range (its rest and its mid-range level), kept where the command
+    follows them (within 1 % of the range); a record without them has none.
+
+    Raises
+    ------
+    IdentificationError
+        If the record does not have the layout of :func:`dynamics_excitation`.
+    """
+    v = np.asarray(v, dtype=np.float64)
+    fs = float(sample_rate)
     n_period = round(PERIOD * fs)
     moved = np.flatnonzero(v != v[0])
     if moved.size == 0:
@@ -242,7 +353,35 @@ def _layout(v: np.ndarray, fs: float) -> tuple[int, int, int]:
             f"s of multisine (at least {2 * PERIOD:g} s: two periods of {PERIOD:g} s). Record "
             "the answer to 'hystcomp excite dynamics' with the same --fs."
         )
-    return step, multisine, n_period
+    first = v[multisine : multisine + n_period]
+    span = float(np.ptp(v))
+    periods = 1
+    while multisine + (periods + 1) * n_period <= v.size:
+        this = v[multisine + periods * n_period : multisine + (periods + 1) * n_period]
+        if np.max(np.abs(this - first)) > 1e-6 * span:
+            break
+        periods += 1
+    if periods < 2:
+        raise IdentificationError(
+            "The record does not have the layout of 'hystcomp excite dynamics': its "
+            f"multisine does not repeat after {PERIOD:g} s. Record the answer to 'hystcomp "
+            "excite dynamics' with the same --fs."
+        )
+    lo = float(v[0])
+    hi = lo + (float(v[step]) - lo) / BIAS_FRACTION
+    triangles = []
+    at = multisine + periods * n_period
+    if hi > lo and at < v.size:
+        expected = _parts(fs, lo, hi, AMPLITUDE_FRACTION * (hi - lo))[3:]
+        for label, part in expected:
+            stop = at + part.size
+            if stop > v.size or np.max(np.abs(v[at:stop] - part)) > 0.01 * (hi - lo):
+                break
+            if label.startswith("triangle"):
+                f = float(label.split()[1])
+                triangles.append(Triangle(f, at, stop, round(fs / f)))
+            at = stop
+    return Layout(step, multisine, periods, n_period, tuple(triangles))
 
 
 def _frf(v, x, start, n_period, periods, bins) -> np.ndarray:
@@ -403,6 +542,9 @@ def _report(parameters, lags, measured, lines, rise, step_fit) -> dict:
         "step_rms_um": step_rms,
         "step_height_um": float(step_fit),
         "creep_after_1s_percent": 100.0 * after_1s,
-        "local_gain_um_per_v": float(abs(gain)),
-        "local_phase_deg": float(np.degrees(np.angle(gain))),
+        # what the free complex factor took up: the hysteresis's local gain (µm/V) and
+        # phase behind a fit on the voltage; what a hysteresis model left (about 1, 0 deg)
+        # behind a fit on its output
+        "input_gain": float(abs(gain)),
+        "input_phase_deg": float(np.degrees(np.angle(gain))),
     }

@@ -5,8 +5,8 @@ MPI, Preisach), usable from Python: it leaves out the start-up transient, holds 
 of the record if asked, fits the model, scores the fit (:mod:`hystcomp.identify.scoring`),
 estimates the compensator's tracking error (:mod:`hystcomp.identify.compensation`), and
 returns all of it with the report lines and the warnings in an
-:class:`IdentificationResult`. :func:`identify_dynamics_record` does the same for the linear
-dynamics (beyond the paper). Neither prints nor writes anything.
+:class:`IdentificationResult`; it prints and writes nothing. The linear dynamics (beyond the
+paper) are identified by :mod:`hystcomp.workflows.pair`.
 
 It is the one module of :mod:`hystcomp.identify` that sits above the models: it builds them,
 while the models' ``fit`` methods delegate to the array-level fits of the other modules here.
@@ -24,7 +24,6 @@ from hystcomp import paper
 from hystcomp._hyperparameters import check_constraints
 from hystcomp.errors import IdentificationError, InvalidParameterError, InvalidTypeError
 from hystcomp.identify.compensation import compensation_error
-from hystcomp.identify.dynamics import MAX_DAMPING
 from hystcomp.identify.scoring import (
     check_transient,
     coverage_warning,
@@ -32,17 +31,14 @@ from hystcomp.identify.scoring import (
     holdout_report,
     transient_end,
 )
-from hystcomp.io.records import uneven_sampling, x_unit_warning
-from hystcomp.models.dynamics import LinearDynamics
+from hystcomp.io.records import x_unit_warning
 from hystcomp.models.mpi import ModifiedPrandtlIshlinskii
 from hystcomp.models.pi import PrandtlIshlinskii
 from hystcomp.models.preisach import Preisach
 
 __all__ = [
-    "DynamicsResult",
     "IdentificationResult",
     "build_estimator",
-    "identify_dynamics_record",
     "identify_record",
 ]
 
@@ -559,113 +555,6 @@ def identify_record(
         lines=lines,
         warnings=warnings,
     )
-
-
-@dataclass(frozen=True, eq=False)
-class DynamicsResult:
-    """What :func:`identify_dynamics_record` found.
-
-    Attributes
-    ----------
-    model : hystcomp.models.dynamics.LinearDynamics
-        The fitted dynamics.
-    source : str
-        Where the record came from.
-    lines : list of str
-        The report, one line each, as ``hystcomp identify --model dynamics`` prints it.
-    warnings : list of str
-        Each a sentence (without the command line's ``hystcomp: warning:`` prefix): when
-        the model follows the record too poorly for its inverse to be trusted.
-    """
-
-    model: LinearDynamics
-    source: str
-    lines: list[str] = field(repr=False)
-    warnings: list[str] = field(default_factory=list)
-
-
-#: Least share of the frequency response the dynamics must explain to be used without a
-#: warning: a linear stage gives more than 97 %, the twins' hysteresis around the bias 88
-#: and 91 %; a stage whose hysteresis changes with the rate, or that has no resonance in
-#: the band, much less (62 % on a Bouc-Wen stage whose loop widens with rate, where the
-#: inverse made 1 Hz tracking 2 to 3 times worse).
-MIN_DYNAMICS_FIT = 80.0
-
-
-def identify_dynamics_record(record) -> DynamicsResult:
-    """Fit the linear dynamics (creep and first resonance) to a record and report the fit.
-
-    Beyond the paper: the record is the answer to
-    :func:`~hystcomp.identify.dynamics.dynamics_excitation` (a step, then a multisine);
-    the fit is :meth:`hystcomp.models.dynamics.LinearDynamics.fit`.
-
-    Parameters
-    ----------
-    record : hystcomp.io.records.Record
-        The measured record: time (s), voltage (V), displacement (µm).
-
-    Returns
-    -------
-    DynamicsResult
-        The fitted model and the report lines (resonance in Hz, creep in %, fit errors).
-    """
-    for name in ("t", "v", "x", "source", "sample_rate"):
-        if not hasattr(record, name):
-            raise InvalidTypeError(
-                "The 'record' argument of identify_dynamics_record must be a "
-                f"hystcomp.io.records.Record (t, v, x); got {type(record).__name__}."
-            )
-    uneven = uneven_sampling(record.t, f"the record {record.source}")
-    if uneven:
-        raise InvalidParameterError(uneven)
-    model = LinearDynamics().fit(record.v, record.x, record.sample_rate)
-    report = model.fit_report_
-    lo, hi = report["fit_band_hz"]
-    taus = model.creep_time_constants_
-    lines = [f"linear dynamics (creep and first resonance) from {record.source}"]
-    lines.append(
-        f"  record:    {len(record)} samples at {record.sample_rate:.6g} Hz "
-        f"({record.t[-1] - record.t[0]:.4g} s)"
-    )
-    lines.append(
-        f"  resonance: {model.resonance_hz_:.5g} Hz, damping ratio {model.damping_ratio_:.3g}"
-    )
-    delay = model.delay_samples_
-    if delay:  # the rig's latency, beyond the sample-and-hold's one sample
-        lines.append(
-            f"  latency:   {delay:+d} sample{'s' if abs(delay) > 1 else ''} beside the "
-            f"sample-and-hold's one ({1e6 * delay / record.sample_rate:+.4g} µs); the inverse "
-            "looks that much further ahead"
-        )
-    lines.append(
-        f"  creep:     {100 * model.creep_fraction(0.0):.3g} % of the final displacement, "
-        f"{100 * model.creep_fraction(1.0):.3g} % of it after 1 s "
-        f"({taus.size} modes, {taus[0]:.3g} .. {taus[-1]:.3g} s)"
-    )
-    lines.append(
-        f"  fit, {lo:.4g} .. {hi:.4g} Hz: {report['fit_percent']:.3g} % "
-        f"(frequency response), largest magnitude error {report['max_magnitude_error_db']:.3g} dB"
-    )
-    lines.append(
-        f"  step:      rms error {report['step_rms_um']:.4g} µm on a step of "
-        f"{report['step_height_um']:.4g} µm"
-    )
-    warnings = []
-    resonance = model.damping_ratio_ < 0.99 * MAX_DAMPING
-    if report["fit_percent"] < MIN_DYNAMICS_FIT or not resonance:
-        found = (
-            ""
-            if resonance
-            else f" and finds no resonance in it (the damping ratio is at its bound, {MAX_DAMPING:g})"
-        )
-        warnings.append(
-            f"the model explains {report['fit_percent']:.3g} % of the frequency response "
-            f"from {lo:.4g} to {hi:.4g} Hz{found}; stages with one resonance give "
-            f"{MIN_DYNAMICS_FIT:g} % and more. Its inverse may make tracking worse (a "
-            "hysteresis that changes with the rate, or more than one mode, does this): "
-            "compare compensate with and without --dynamics on a test reference first."
-        )
-    return DynamicsResult(model=model, source=str(record.source), lines=lines, warnings=warnings)
 
 
 def _verdict(improvement: float) -> str:

@@ -25,6 +25,7 @@ from hystcomp.io._formats import utf16
 from hystcomp.io.atomic import atomic_path
 from hystcomp.models.base import HysteresisModel
 from hystcomp.models.dynamics import LinearDynamics
+from hystcomp.models.hammerstein import HammersteinModel
 from hystcomp.models.mpi import ModifiedPrandtlIshlinskii
 from hystcomp.models.pi import PrandtlIshlinskii
 from hystcomp.models.preisach import Preisach
@@ -34,8 +35,9 @@ MODEL_VERSION = 1
 #: Largest model file read (bytes); a model has a few hundred numbers, not millions.
 MAX_MODEL_FILE_BYTES = 64 * 2**20
 
-#: What a model file holds: a hysteresis model, or the linear dynamics (not a hysteresis model).
-Model: TypeAlias = HysteresisModel | LinearDynamics
+#: What a model file holds: a hysteresis model, the linear dynamics (not a hysteresis
+#: model), or both identified as one pair.
+Model: TypeAlias = HysteresisModel | LinearDynamics | HammersteinModel
 
 #: Model classes by the ``kind`` written in model files.
 MODEL_KINDS: dict[str, type[Model]] = {
@@ -43,7 +45,10 @@ MODEL_KINDS: dict[str, type[Model]] = {
     ModifiedPrandtlIshlinskii.kind: ModifiedPrandtlIshlinskii,
     Preisach.kind: Preisach,
     LinearDynamics.kind: LinearDynamics,  # the linear dynamics (creep, resonance)
+    HammersteinModel.kind: HammersteinModel,  # a hysteresis model and dynamics, one pair
 }
+#: The kinds a pair's parts may have.
+PAIR_PARTS = {"hysteresis": ("pi", "mpi", "preisach"), "dynamics": ("dynamics",)}
 
 
 def model_to_dict(model: Model) -> dict[str, Any]:
@@ -129,6 +134,21 @@ def _check_document(doc: Any, source: str) -> type[Model]:
             "A newer hystcomp may know it: upgrade hystcomp."
         )
     cls = MODEL_KINDS[kind]
+    if cls is HammersteinModel:
+        for part, kinds in PAIR_PARTS.items():
+            inner = doc.get(part)
+            if not isinstance(inner, dict) or inner.get("kind") not in kinds:
+                raise ModelFileError(
+                    f'{source} has no "{part}" object of kind {" or ".join(kinds)}, which a '
+                    "'hammerstein' model (a pair) holds; the file is corrupt or was edited "
+                    "by hand."
+                )
+            _check_document(
+                {"format": MODEL_FORMAT, "version": version, **inner}, f"{source} ({part})"
+            )
+        if "fit_report" in doc and not isinstance(doc["fit_report"], dict):
+            raise ModelFileError(f'{source} has a "fit_report" that is not an object.')
+        return cls
     params = doc.get("parameters")
     if not isinstance(params, dict):
         raise ModelFileError(f'{source} has no "parameters" object; the file is corrupt.')

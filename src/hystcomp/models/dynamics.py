@@ -43,13 +43,19 @@ lags the reference by ``preview`` samples).
 
 from __future__ import annotations
 
+import warnings
 from typing import Any, ClassVar
 
 import numpy as np
 
 from hystcomp import _lti
 from hystcomp._validation import as_signal, as_vector, check_int, check_real
-from hystcomp.errors import InvalidParameterError, InvalidTypeError, NotFittedError
+from hystcomp.errors import (
+    HystcompWarning,
+    InvalidParameterError,
+    InvalidTypeError,
+    NotFittedError,
+)
 from hystcomp.identify.dynamics import DELAY_RANGE, fit_dynamics
 from hystcomp.models.dynamic_compensator import (
     MATCH_HZ,
@@ -186,14 +192,16 @@ class LinearDynamics:
         )
         return model
 
-    def fit(self, v, x, sample_rate: float) -> LinearDynamics:
+    def fit(self, v, x, sample_rate: float, *, u=None) -> LinearDynamics:
         """Identify the model from the answer ``x`` (µm) to ``hystcomp excite dynamics``.
 
         Delegates to :func:`hystcomp.identify.dynamics.fit_dynamics` (see there for the
-        method); ``v`` in V, ``sample_rate`` in Hz. Sets the parameters and
+        method); ``v`` in V, ``sample_rate`` in Hz, ``u`` the input of the dynamics when
+        they are fitted behind a hysteresis model (its output ``H[v]`` in µm; see
+        :class:`~hystcomp.models.hammerstein.HammersteinModel`). Sets the parameters and
         ``fit_report_``; returns ``self``.
         """
-        result = fit_dynamics(v, x, sample_rate)
+        result = fit_dynamics(v, x, sample_rate, u=u)
         fitted = type(self).from_parameters(**result.parameters)
         self.__dict__.update(fitted.__dict__)
         self.fit_report_ = dict(result.report)
@@ -257,6 +265,39 @@ class LinearDynamics:
                 f"the step, >= 0. Got {seconds:g}."
             )
         return _lti.creep_fraction(seconds, self.creep_time_constants_, self.creep_weights_)
+
+    def remove(self, x, sample_rate: float | None = None) -> np.ndarray:
+        """``D^-1[x]``: what went into the dynamics, for a measured displacement ``x`` (µm).
+
+        Offline, for a record: the hysteresis model of a pair is fitted on it, in front of
+        ``D`` (:class:`~hystcomp.models.hammerstein.HammersteinModel`). At the model's own
+        rate it is the stable inverse of :meth:`inverse` (unit steady-state gain, its
+        look-ahead taken from the record, from rest at ``x[0]``). At another
+        ``sample_rate`` (a hysteresis record taken slower or faster) the creep is inverted
+        exactly at that rate and the latency as the nearest whole number of its samples;
+        the resonance is left in: at the rates such records hold (1 Hz triangles) it is
+        1 to within ``(f / f_n)^2``.
+        """
+        self._check_fitted()
+        x = as_signal(x, "x")
+        fs = (
+            self.sample_rate_
+            if sample_rate is None
+            else check_real(sample_rate, "sample_rate", "LinearDynamics.remove", positive=True)
+        )
+        rest = float(x[0])
+        if abs(fs - self.sample_rate_) <= 1e-9 * self.sample_rate_:
+            return self.inverse(rest=rest).simulate(x)
+        lead = round(self.delay_samples_ * fs / self.sample_rate_)
+        taps = np.r_[np.zeros(max(0, -lead)), 1.0]
+        inverse = DynamicsInverse(
+            taps,
+            _lti.creep_lags(self.creep_time_constants_, fs),
+            self.creep_weights_,
+            preview=max(0, lead),
+            rest=rest,
+        )
+        return inverse.simulate(x)
 
     # -- the inverse -----------------------------------------------------------------------
 
@@ -398,7 +439,7 @@ class LinearDynamics:
 
 
 def with_dynamics(
-    model, compensator, dynamics, *, bandwidth_hz=None, match_hz=MATCH_HZ
+    model, compensator, dynamics, *, bandwidth_hz=None, paired=False
 ) -> DynamicCompensator:
     """``compensator`` (``model.inverse()``) in series with the inverse of ``dynamics``.
 
@@ -409,22 +450,22 @@ def with_dynamics(
     stroke, which the voltage clamp cuts anyway, and a hysteresis inverse fed the spike
     would keep in its memory a turning point that the actuator never reached.
 
-    The two are matched at ``match_hz`` (:data:`MATCH_HZ`, 1 Hz): a hysteresis model
-    identified from 1 Hz records (the paper's signals, ``hystcomp excite``) already holds
-    the creep that is faster than that, so the inverse of the dynamics is scaled to unit
-    gain there, ``D^-1 |D(1 Hz)|``: it adds only what the hysteresis model lacks, the creep
-    slower than 1 Hz (after a step) and the fast dynamics. Creep scales the displacement
-    from rest, so the scaling is about rest for a PI or MPI model whose loops close there
-    (one that starts descended, :func:`hystcomp.identify.pi.initial_play_states`): on
-    the creep stages of ``benchmarks/bench_dynamics.py`` steps to 0.2 .. 0.8 of the stroke
-    then keep a mean error of 0.03 µm (0.19 µm scaled about mid-range). Other models
-    (virgin plays, whose loops stay open at rest; the Preisach model) are scaled about the
-    middle of their displacement range, where the identification triangles have their
-    mean, which halves their static error at rest: steps keep 0.08 µm (virgin MPI) and
-    0.13 µm (the paper's Preisach fit), against 0.17 and 0.18 µm scaled about rest.
-    Deviation from "unit steady-state gain": the model file keeps ``D(1) = 1``; with
-    ``match_hz=0`` the inverse of ``D`` itself is used, which leaves a static error of the
-    fast creep's size (about 1 % of the step on a 3 % creep stage).
+    ``paired``: the model was identified in front of the dynamics, as one pair
+    (:class:`~hystcomp.models.hammerstein.HammersteinModel`), and ``D`` is inverted with its
+    unit steady-state gain. Otherwise (``model.inverse(dynamics=dyn)``, the two identified
+    apart) a :class:`~hystcomp.errors.HystcompWarning` says so, and the two are matched at
+    :data:`MATCH_HZ` (1 Hz): a hysteresis model identified from 1 Hz records (the paper's
+    signals, ``hystcomp excite``) already holds the creep and lag of that record, so the
+    inverse of the dynamics is scaled to unit gain there, ``D^-1 |D(1 Hz)|``, and adds only
+    what the hysteresis model lacks, the creep slower than 1 Hz and the fast dynamics. It
+    cannot remove the creep faster than 1 Hz that such a model holds, which the pair does
+    (on a Preisach stage with 3 % creep, MPI at 1 Hz: 0.020 µm as a pair, 0.112 µm with
+    the true dynamics matched this way, 0.057 µm without dynamics). Creep scales the
+    displacement from rest, so the scaling is about rest for a PI or MPI model whose loops
+    close there (one that starts descended,
+    :func:`hystcomp.identify.pi.initial_play_states`), and about the middle of the
+    displacement range for other models, where the identification triangles have their
+    mean.
     """
     if not isinstance(dynamics, LinearDynamics):
         raise InvalidTypeError(
@@ -435,13 +476,29 @@ def with_dynamics(
     lo, hi = compensator.voltage_range
     rest, top, back = (float(x) for x in model.simulate([lo, hi, lo]))
     output_range = (min(rest, top), max(rest, top))
-    # a play model whose loops close at rest (started descended): scaled about rest
-    closes = getattr(model, "kind", None) in ("pi", "mpi") and abs(back - rest) <= 1e-9 * abs(top)
+    if paired:
+        match_hz, centre = 0.0, rest
+    else:
+        warnings.warn(APART, HystcompWarning, stacklevel=3)
+        # a play model whose loops close at rest (started descended): scaled about rest
+        closes = getattr(model, "kind", None) in ("pi", "mpi") and abs(back - rest) <= 1e-9 * abs(
+            top
+        )
+        match_hz, centre = MATCH_HZ, rest if closes else 0.5 * (rest + top)
     inverse = dynamics.inverse(
         bandwidth_hz=bandwidth_hz,
         rest=rest,
         output_range=output_range,
         match_hz=match_hz,
-        match_centre=rest if closes else 0.5 * (rest + top),
+        match_centre=centre,
     )
     return DynamicCompensator(compensator, inverse, sample_rate=dynamics.sample_rate_)
+
+
+#: The warning of a hysteresis model and dynamics identified apart, put in series.
+APART = (
+    "the hysteresis model and the dynamics were identified apart, so the inverse of the "
+    "dynamics is matched to the model at 1 Hz and may correct creep and lag that the model "
+    "already holds; identify them as one pair: hystcomp identify DATA --model KIND "
+    "--dynamics-record DYN.csv (hystcomp.models.hammerstein.fit_pair)."
+)
