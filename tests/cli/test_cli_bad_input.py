@@ -73,7 +73,7 @@ CASES = [
     ("regularization too large", "identify rec.csv --model mpi --regularization 1e308 -o {out}.json", r"'--regularization': must be 'auto' or a number from 0 to 1e\+12; got '1e308'"),
     ("--columns not read", "compensate model.json ref.csv --columns v=2 -o {out}.csv", r"'--columns': v=2 names a column of voltage, which this command does not read .* --columns x=2"),
     ("excite: period too long", "excite mpi --frequency 1e-300 -o {out}.csv", r"one period at 1e-300 Hz is 2e\+304 samples at 20000 Hz, more than 1e\+08\. Raise the frequency"),
-    ("excite dynamics: rate too high", "excite dynamics --fs 1e12 -o {out}.csv", r"\(--fs\) makes the 6\.2 s signal 6\.2e\+12 samples long, .* use at most"),
+    ("excite dynamics: rate too high", "excite dynamics --fs 1e12 -o {out}.csv", r"\(--fs\) makes the 9\.16 s signal 9\.16e\+12 samples long, .* use at most"),
     ("export-c: huge --fs", "export-c model.json -o {out}_c --fs 1e308", r"'--fs': must be a finite number of size at most 1e\+12"),
     ("export-c onto a file", "export-c model.json -o rec.csv", r"'rec\.csv': it exists and is not a folder"),
     ("UTF-16 data file", "identify u16.csv --model pi -o {out}.json", r"'u16\.csv' is UTF-16 text; save it as UTF-8\.$"),

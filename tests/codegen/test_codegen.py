@@ -17,6 +17,7 @@ from hystcomp._kernels import preisach as pk
 from hystcomp.codegen import export_c, generate_c
 from hystcomp.errors import InvalidParameterError
 from hystcomp.identify.excitation import sinusoid_sequence
+from hystcomp.models.hammerstein import HammersteinModel
 from tests.conftest import invertible_weights, random_walk
 
 CC = shutil.which("cc")
@@ -549,10 +550,13 @@ def _counting_compensators(identified):
     return {
         "bipolar_pi": (pi.inverse(), pi),
         "paper_mpi_slewing": (mpi.inverse(slew_rate=2e5, sample_rate=20_000.0), mpi),
-        "paper_mpi_dynamics": (mpi.inverse(dynamics=dynamics), mpi),
+        "paper_mpi_dynamics": (HammersteinModel(mpi, dynamics).inverse(), mpi),
         "preisach_multiplicative": (table.inverse(method="multiplicative"), table),
         "preisach_exact_bipolar": (quartic.inverse(method="exact"), quartic),
-        "preisach_exact_dynamics": (table.inverse(method="exact", dynamics=creeping), table),
+        "preisach_exact_dynamics": (
+            HammersteinModel(table, creeping).inverse(method="exact"),
+            table,
+        ),
     }
 
 
@@ -627,10 +631,10 @@ def test_c_primed_on_the_look_ahead_is_the_batch_run(
     NAME_step gives the batch run (the reference known ahead) from its first sample, slew
     limit included, for a reference that starts away from rest (and a rig's latency)."""
     _, model = _counting_compensators(identified_preisach)[name]
-    options = {"slew_rate": 2e5, "sample_rate": 20_000.0} if slewing else {}
+    options = {"slew_rate": 2e5} if slewing else {}
     if model.kind == "preisach":
         options["method"] = "exact"
-    comp = model.inverse(dynamics=_creeping(delay), **options)
+    comp = HammersteinModel(model, _creeping(delay)).inverse(**options)
     low, high = model.reachable_range()
     t = np.arange(6000) / 20_000.0
     x = low + (high - low) * (0.5 + 0.3 * np.sin(2 * np.pi * 30.0 * t))

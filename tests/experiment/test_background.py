@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from hystcomp.experiment.background import BackgroundJob, draw_in_background
-from hystcomp.experiment.compare_dynamics import designed_twin_dynamics, identify_twin_dynamics
+from hystcomp.experiment.compare import CompareConfig, twin_pairs
 from hystcomp.plant import Twin, creep_twin
 
 pytestmark = pytest.mark.skipif(not sys.platform.startswith("linux"), reason="fork on Linux only")
@@ -46,26 +46,29 @@ def test_a_job_returns_its_result_and_none_when_it_fails():
     assert failed.collect() is None
 
 
-def test_the_dynamics_identified_in_a_second_process_are_those_identified_here(monkeypatch):
-    params = creep_twin(resonance_hz=900.0)
-    job = BackgroundJob.start(designed_twin_dynamics, params, 3)
+def test_the_pairs_identified_in_a_second_process_are_those_identified_here(monkeypatch):
+    config = CompareConfig.quick(twin=creep_twin(resonance_hz=900.0), seed=3)
+    job = BackgroundJob.start(twin_pairs, config)
     assert job is not None
     record, there = job.collect()
-    again, here = identify_twin_dynamics(params, 3)
+    again, here = twin_pairs(config)
     np.testing.assert_array_equal(record.x, again.x)
-    assert there.parameters() == here.parameters()
-    assert there.resonance_hz_ == pytest.approx(900.0, rel=0.01)
-    designed_here = here.inverse().taps
-    # the inverse's design came with the model: not designed again (no SciPy) here
+    assert set(there) == set(here) == {"mpi", "preisach"}
+    for method in here:
+        assert there[method].dynamics.parameters() == here[method].dynamics.parameters()
+        assert there[method].hysteresis.parameters() == here[method].hysteresis.parameters()
+    assert there["mpi"].dynamics.resonance_hz_ == pytest.approx(900.0, rel=0.02)
+    designed_here = here["mpi"].inverse().dynamics_inverse.taps
+    # the inverse's design came with the pair: not designed again (no SciPy) here
     import hystcomp.models.dynamics as dynamics_module
 
     def refuse(*args):
         raise AssertionError("designed again")
 
     monkeypatch.setattr(dynamics_module, "inverse_fir", refuse)
-    np.testing.assert_array_equal(there.inverse().taps, designed_here)
+    np.testing.assert_array_equal(there["mpi"].inverse().dynamics_inverse.taps, designed_here)
     # its noise is a stream of its own, not the twin's that measures Table I
-    assert not np.array_equal(record.x, Twin(params, seed=3).run(record.v))
+    assert not np.array_equal(record.x, Twin(config.twin, seed=3).run(record.v))
 
 
 def test_a_job_that_gives_nothing_in_time_is_ended_and_done_here():

@@ -107,27 +107,23 @@ def test_output_folder_that_is_a_file_is_refused(comparison, tmp_path):
     assert path.read_text() == "mine"
 
 
-@pytest.mark.parametrize("given", ["designed elsewhere", "none: identified here"])
-def test_twin_dynamics_given_from_elsewhere_give_the_same_rows(comparison, given):
-    from hystcomp.experiment.compare_dynamics import designed_twin_dynamics
+def test_pairs_identified_elsewhere_give_the_rows_of_pairs_identified_here():
+    """``hystcomp compare`` identifies the pairs in a second process from its start (the
+    same seeded records, the same fits); when that process gives nothing, the run
+    identifies them itself from its own records and models. Both give the same rows."""
+    from hystcomp.experiment.compare import twin_pairs
 
     config = CompareConfig.quick()
-    calls = []
-
-    def twin_dynamics():
-        calls.append(1)
-        if given.startswith("none"):
-            return None  # e.g. the second process failed
-        return designed_twin_dynamics(config.twin, config.seed)
-
-    c = run_comparison(config, identify=stand_in_models, twin_dynamics=twin_dynamics)
-    assert calls == [1]
-    assert c.dynamics.dynamics.parameters() == comparison.dynamics.dynamics.parameters()
-    for f, row in comparison.dynamics.results.items():
-        assert {m: r.rms for m, r in c.dynamics.results[f].items()} == {
+    elsewhere = run_comparison(config, twin_dynamics=lambda: twin_pairs(config))
+    here = run_comparison(config, twin_dynamics=lambda: None)  # the second process failed
+    for method, pair in here.dynamics.pairs.items():
+        there = elsewhere.dynamics.pairs[method]
+        assert there.dynamics.parameters() == pair.dynamics.parameters()
+    for f, row in here.dynamics.results.items():
+        assert {m: r.rms for m, r in elsewhere.dynamics.results[f].items()} == {
             m: r.rms for m, r in row.items()
         }
-    assert c.dynamics.step_error == comparison.dynamics.step_error
+    assert elsewhere.dynamics.step_error == here.dynamics.step_error
 
 
 def test_config_is_validated():

@@ -37,8 +37,9 @@ def _python(code, cache):
 @pytest.mark.slow
 def test_compare_loads_every_kernel_the_warmup_compiled(tmp_path):
     _python(
-        "from hystcomp.experiment.warmup import prepare; from hystcomp.plant import creep_twin; "
-        "prepare(creep_twin(), 0, True)",
+        "from hystcomp.experiment.warmup import prepare; "
+        "from hystcomp.experiment.compare import CompareConfig; "
+        "prepare(CompareConfig.quick(), True)",
         tmp_path,
     )
     counts = json.loads(_python(_COMPARE, tmp_path).splitlines()[-1])
@@ -48,18 +49,19 @@ def test_compare_loads_every_kernel_the_warmup_compiled(tmp_path):
 
 
 def test_the_job_compiles_first_only_on_a_first_run(monkeypatch):
-    from hystcomp.plant import creep_twin
+    from hystcomp.experiment.compare import CompareConfig
 
     started, loaded = [], []
     monkeypatch.setattr(warmup.BackgroundJob, "start", lambda *args: started.append(args))
     monkeypatch.setattr(warmup, "load_shared", loaded.append)
     presets.paper_mpi().simulate([0.0, 1.0])  # chain_run: compiled or loaded, now cached
     assert warmup._in_cache(chain.chain_run)
-    twin = creep_twin()
-    warmup.start(twin, 7)
-    assert started == [(warmup.prepare, twin, 7, False)]
-    assert loaded == [twin]  # numba's context and the twin kernel, before the fork
+    config = CompareConfig(seed=7)
+    warmup.start(config)
+    assert started == [(warmup.prepare, config, False)]
+    assert loaded == [config.twin]  # numba's context and the twin kernel, before the fork
     monkeypatch.setattr(warmup, "_in_cache", lambda kernel: False)
-    warmup.start(twin, 7)
-    assert started[1] == (warmup.prepare, twin, 7, True)
-    assert loaded == [twin]
+    warmup.start(config)
+    assert started[1] == (warmup.prepare, config, True)
+    assert loaded == [config.twin]
+    assert warmup.start(CompareConfig(dynamics=False)) is None  # nothing to do beside it

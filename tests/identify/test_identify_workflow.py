@@ -239,7 +239,7 @@ def test_dynamics_without_a_resonance_are_a_warning():
     result = identify_dynamics_record(Record(t, v, x, source="lag"))
     (warning,) = result.warnings
     assert "finds no resonance in it (the damping ratio is at its bound, 2)" in warning
-    assert "compare compensate with and without --dynamics" in warning
+    assert "compare compensate with and without the dynamics" in warning
 
 
 @pytest.mark.parametrize("kind", ["mpi", "pi", "preisach", "rich"])

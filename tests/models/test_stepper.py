@@ -14,6 +14,7 @@ from hystcomp._kernels import chain
 from hystcomp._kernels import preisach as pk
 from hystcomp._kernels._jit import step_function
 from hystcomp.errors import InvalidParameterError, InvalidSignalError, InvalidTypeError
+from hystcomp.models.hammerstein import HammersteinModel
 from hystcomp.models.preisach import Preisach, PreisachStepper
 from tests.conftest import random_walk
 
@@ -144,7 +145,7 @@ def _dynamic_compensator():
         creep_time_constants=[0.01, 0.1],
         creep_weights=[0.01, 0.01],
     )
-    return presets.paper_mpi().inverse(dynamics=dyn)
+    return HammersteinModel(presets.paper_mpi(), dyn).inverse()
 
 
 @pytest.mark.parametrize(

@@ -70,7 +70,7 @@ def compare(out_dir: str, seed: int, periods: int | None, quick: bool, quiet: bo
     try:
         # the second core: on a first run the kernels needed later, then on every run the
         # twin's dynamics (SciPy's optimisers and the fits), before matplotlib's import here
-        jobs["dynamics"] = warmup.start(config.twin, seed)
+        jobs["dynamics"] = warmup.start(config)
         from hystcomp.experiment.figures import (  # matplotlib, for a forked process
             BACKGROUND_FIGURES,
             write_figures,

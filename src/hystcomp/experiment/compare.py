@@ -239,9 +239,10 @@ def run_comparison(
         ``datasheet``, ``preisach_exact``; no ``dynamics`` or ``paper_fit`` yet) as soon
         as it is measured: ``hystcomp compare`` draws the paper's figures meanwhile.
     twin_dynamics : callable, optional
-        Returns what :func:`~hystcomp.experiment.compare_dynamics.identify_twin_dynamics`
-        returns for ``config.twin`` and ``config.seed``, computed elsewhere (``hystcomp
-        compare``: in a second process, from the start), or None: then it is computed here.
+        Returns what :func:`~hystcomp.experiment.compare_dynamics.identify_twin_pairs`
+        returns for ``config``, computed elsewhere (``hystcomp compare``: in a second
+        process, from the start), or None: then it is computed here, from this run's
+        records and models.
 
     Returns
     -------
@@ -257,8 +258,7 @@ def run_comparison(
     fs = twin.sample_rate
 
     say("identification experiments on the twin (triangles 30..120 V, sinusoids 5..120 V)")
-    record_pi = _measure(twin, triangle_sequence(sample_rate=fs))
-    record_preisach = _measure(twin, sinusoid_sequence(config.preisach_amplitudes, sample_rate=fs))
+    record_pi, record_preisach = measure_identification(config, twin)
     record_loops = _measure(twin, sinusoid_sequence(FIG5_AMPLITUDES, sample_rate=fs))
 
     say("identifying the Preisach, PI and MPI models")
@@ -310,18 +310,19 @@ def run_comparison(
         table1(measured)
     dynamics = None
     if config.dynamics:
-        from hystcomp.experiment.compare_dynamics import run_dynamics
+        from hystcomp.experiment.compare_dynamics import identify_twin_pairs, run_dynamics
 
         say("identifying the linear dynamics; tracking with their inverse up to 200 Hz")
+        identified = None if twin_dynamics is None else twin_dynamics()
+        if identified is None:
+            identified = identify_twin_pairs(config, (record_pi, record_preisach), models)
         dynamics = run_dynamics(
             twin,
-            models,
             compensators,
             amplitude,
             periods=config.periods,
             frequencies=config.frequencies,
-            seed=config.seed,
-            identified=None if twin_dynamics is None else twin_dynamics(),
+            identified=identified,
         )
     paper_fit: dict[str, TrackingResult] = {}
     if identify is identify_models:
@@ -334,6 +335,29 @@ def run_comparison(
     return dataclasses.replace(
         measured, dynamics=dynamics, paper_fit=paper_fit, seconds=time.perf_counter() - start
     )
+
+
+def measure_identification(config: CompareConfig, twin: Twin | None = None):
+    """``(record_pi, record_preisach)``: the twin's answers to the paper's identification
+    signals, the triangles then the sinusoids, from ``twin`` (by default a new one of
+    ``config``'s parameters and seed, as :func:`run_comparison` starts with)."""
+    twin = Twin(config.twin, seed=config.seed) if twin is None else twin
+    fs = twin.sample_rate
+    record_pi = _measure(twin, triangle_sequence(sample_rate=fs))
+    record_preisach = _measure(twin, sinusoid_sequence(config.preisach_amplitudes, sample_rate=fs))
+    return record_pi, record_preisach
+
+
+def twin_pairs(config: CompareConfig):
+    """What :func:`run_comparison` identifies for its dynamics part, from scratch: the
+    records and models of ``config`` (the same seeded twin gives the same ones), then
+    :func:`~hystcomp.experiment.compare_dynamics.identify_twin_pairs`. ``hystcomp compare``
+    runs it in a second process from its start."""
+    from hystcomp.experiment.compare_dynamics import identify_twin_pairs
+
+    record_pi, record_preisach = measure_identification(config)
+    models = identify_models(record_pi, record_preisach, config)
+    return identify_twin_pairs(config, (record_pi, record_preisach), models)
 
 
 def _measure(twin: Twin, signal: tuple[np.ndarray, np.ndarray]) -> Record:

@@ -2,8 +2,10 @@
 
 ``hystcomp compare`` runs this after Table I, on the same twin and with the same models:
 
-1. the twin's answer to ``hystcomp excite dynamics`` (6.2 s of signal) and the linear
-   dynamics identified from it (:func:`hystcomp.identify.dynamics.fit_dynamics`);
+1. the twin's answer to ``hystcomp excite dynamics`` (9.2 s of signal), and the MPI and
+   Preisach models each identified with the linear dynamics as one pair
+   (:func:`hystcomp.models.hammerstein.fit_pair`: the dynamics behind the model, the model
+   in front of the dynamics, from the model's own identification record);
 2. triangles at 1, 10 and 50 Hz with "MPI + dynamics" and "Preisach + dynamics", and at
    100 and 200 Hz with every method, with and without the inverse of the dynamics;
 3. a step to half the reference's peak, held 3 s (creep), with and without it.
@@ -19,8 +21,8 @@ from hystcomp.experiment.references import triangle_reference
 from hystcomp.experiment.tracking import TrackingResult, run_tracking
 from hystcomp.identify.dynamics import dynamics_excitation
 from hystcomp.io.records import Record
-from hystcomp.models.dynamics import LinearDynamics
-from hystcomp.plant import Twin, TwinParameters
+from hystcomp.models.hammerstein import fit_pair
+from hystcomp.plant import Twin
 
 #: Frequencies of the rows with the dynamics (Hz): Table I's, and two faster.
 FAST_FREQUENCIES = (100.0, 200.0)
@@ -29,7 +31,7 @@ WITH_DYNAMICS = ("preisach", "mpi")
 STEP_HOLD = 3.0  # s
 STEP_FROM = 0.02  # s after the step: the window of the step's mean |error| starts here
 #: Second entropy word of the seed of the dynamics record's sensor noise (the first is the
-#: comparison's seed): a stream of its own, see :func:`identify_twin_dynamics`.
+#: comparison's seed): a stream of its own, see :func:`identify_twin_pairs`.
 DYNAMICS_STREAM = 1
 
 
@@ -41,8 +43,9 @@ class DynamicsComparison:
     ----------
     record : Record
         The twin's answer to the dynamics excitation.
-    dynamics : LinearDynamics
-        The model identified from it.
+    pairs : dict
+        ``pairs[method]``: the :class:`HammersteinModel` of that method's model and the
+        twin's dynamics, identified together.
     results : dict
         ``results[frequency][label]``: :class:`TrackingResult`; labels are the methods
         (fast frequencies only) and ``"<method> + dynamics"``.
@@ -56,52 +59,53 @@ class DynamicsComparison:
     """
 
     record: Record
-    dynamics: LinearDynamics
+    pairs: dict
     results: dict
     step: dict
     step_error: dict
     step_drift: dict
 
 
-def identify_twin_dynamics(params: TwinParameters, seed: int) -> tuple[Record, LinearDynamics]:
-    """Step 1 of the module: the twin's answer to the dynamics excitation, and the model.
-
-    The twin here is one of its own, built at rest from ``params``, with a sensor noise
-    stream of its own drawn from ``seed`` (independent of the stream of the twin that
-    measures Table I): the identified dynamics do not depend on how many runs came before
-    (``--periods``, ``--quick``).
-    """
+def twin_dynamics_record(twin_params, seed: int) -> Record:
+    """The twin's answer to the dynamics excitation, from a twin of its own at rest whose
+    sensor noise is drawn from a stream of its own (``seed``, :data:`DYNAMICS_STREAM`): it
+    does not depend on how many runs came before (``--periods``, ``--quick``)."""
     stream = int(np.random.SeedSequence([seed, DYNAMICS_STREAM]).generate_state(1)[0])
-    twin = Twin(params, seed=stream)
+    twin = Twin(twin_params, seed=stream)
+    t, v = dynamics_excitation(sample_rate=twin.sample_rate, voltage_range=twin.voltage_range)
+    return Record(t=t, v=v, x=twin.run(v), source="the twin")
+
+
+def identify_twin_pairs(config, records, models) -> tuple[Record, dict]:
+    """Step 1 of the module: the dynamics record, and the pair of each method's model.
+
+    ``records`` (``(record_pi, record_preisach)``) and ``models`` are the comparison's
+    (:func:`hystcomp.experiment.compare.twin_pairs` measures and identifies them again,
+    as the comparison does, for ``hystcomp compare``'s second process). The inverses'
+    designs go with the pairs (pickled).
+    """
+    record_pi, record_preisach = records
+    record = twin_dynamics_record(config.twin, config.seed)
+    fs = record.sample_rate
+    own = {"mpi": record_pi, "preisach": record_preisach}
+    pairs = {}
+    for method in WITH_DYNAMICS:
+        h = own[method]
+        pair = fit_pair(
+            models[method], h.v, h.x, record.v, record.x, sample_rate=fs, alone=models[method]
+        )
+        pair.inverse()  # the inverse's design, kept with the dynamics
+        del pair.hysteresis_alone_  # the comparison's own model; not sent back
+        pairs[method] = pair
+    return record, pairs
+
+
+def run_dynamics(twin, compensators, amplitude, *, periods, frequencies, identified):
+    """The dynamics part of the comparison (see the module); ``compensators`` by method;
+    ``identified`` is what :func:`identify_twin_pairs` returns."""
     fs = twin.sample_rate
-    t, v = dynamics_excitation(sample_rate=fs, voltage_range=twin.voltage_range)
-    record = Record(t=t, v=v, x=twin.run(v), source="the twin")
-    dynamics = LinearDynamics().fit(record.v, record.x, fs)
-    return record, dynamics
-
-
-def designed_twin_dynamics(params: TwinParameters, seed: int) -> tuple[Record, LinearDynamics]:
-    """:func:`identify_twin_dynamics`, and the design of the inverse that the compensators
-    with dynamics use: all of the comparison's work that needs SciPy's optimisers (a
-    least-squares fit, non-negative least squares), which ``hystcomp compare`` runs in a
-    second process while the first measures Table I. The design goes with the model
-    (pickled)."""
-    record, dynamics = identify_twin_dynamics(params, seed)
-    dynamics.inverse()  # the band of with_dynamics (the default): designed and kept
-    return record, dynamics
-
-
-def run_dynamics(
-    twin, models, compensators, amplitude, *, periods, frequencies, seed=0, identified=None
-):
-    """The dynamics part of the comparison (see the module); ``compensators`` by method,
-    ``seed`` that of the comparison (:func:`identify_twin_dynamics`); ``identified``, if
-    given, is what :func:`identify_twin_dynamics` returns for them, computed elsewhere."""
-    fs = twin.sample_rate
-    if identified is None:
-        identified = identify_twin_dynamics(twin.params, seed)
-    record, dynamics = identified
-    with_dyn = {m: models[m].inverse(dynamics=dynamics) for m in WITH_DYNAMICS}
+    record, pairs = identified
+    with_dyn = {m: pairs[m].inverse() for m in WITH_DYNAMICS}
     results: dict[float, dict[str, TrackingResult]] = {}
     for f in (*frequencies, *FAST_FREQUENCIES):
         fast = f in FAST_FREQUENCIES
@@ -131,7 +135,7 @@ def run_dynamics(
             e = (x - x_ref)[window]
             step_error[label] = float(np.mean(np.abs(e)))
             step_drift[label] = float(np.mean(e[-ten_ms:]) - np.mean(e[:ten_ms]))
-    return DynamicsComparison(record, dynamics, results, step, step_error, step_drift)
+    return DynamicsComparison(record, pairs, results, step, step_error, step_drift)
 
 
 def dynamics_rows(dc: DynamicsComparison) -> list[dict]:
@@ -144,21 +148,29 @@ def dynamics_rows(dc: DynamicsComparison) -> list[dict]:
 
 
 def dynamics_markdown(dc: DynamicsComparison, table1: dict) -> list[str]:
-    """The report's section on the dynamics: the model, the table, the step."""
-    d = dc.dynamics
-    rep = d.fit_report_
+    """The report's section on the dynamics: the pairs, the table, the step."""
+    found = []
+    for method, pair in dc.pairs.items():
+        d = pair.dynamics
+        rep = d.fit_report_
+        found.append(
+            f"behind the {method.upper() if method == 'mpi' else method.title()} model, "
+            f"{d.resonance_hz_:.4g} Hz (damping {d.damping_ratio_:.3g}) and "
+            f"{100 * d.creep_fraction(0.0):.2g} % of creep within the 3 s hold (frequency-"
+            f"response fit {rep['fit_percent']:.3g} % up to {rep['fit_band_hz'][1]:.0f} Hz)"
+        )
     lines = [
         "## Beyond the paper: inverse of the linear dynamics",
         "",
         (
-            "The twin here has creep (3 % over 1 ms .. 100 s, `plant.creep_twin`). Its answer to "
-            "`hystcomp excite dynamics` gave a resonance of "
-            f"{d.resonance_hz_:.4g} Hz (damping {d.damping_ratio_:.3g}) and "
-            f"{100 * d.creep_fraction(0.0):.2g} % of creep within the 3 s hold (frequency-response "
-            f"fit {rep['fit_percent']:.3g} %, largest magnitude error "
-            f"{rep['max_magnitude_error_db']:.2g} dB up to {rep['fit_band_hz'][1]:.0f} Hz). "
-            "`+ dynamics` rows use `v = H^-1[D^-1[x_ref]]` with the stable, look-ahead inverse "
-            "of `hystcomp.models.dynamics`."
+            "The twin here has creep (3 % over 1 ms .. 100 s, `plant.creep_twin`). Each model "
+            "was identified with the twin's linear dynamics as one pair, `x = D[H[v]]`: `D` "
+            "fitted behind the model on the twin's answer to `hystcomp excite dynamics`, the "
+            "model fitted again in front of `D` on its own record with `D`'s creep and lag "
+            "taken out, alternated until they agree. The dynamics came out "
+            + "; ".join(found)
+            + ". `+ dynamics` rows use `v = H^-1[D^-1[x_ref]]` with the stable, look-ahead "
+            "inverse of `hystcomp.models.dynamics`."
         ),
         "",
         "| f (Hz) | method | rms (µm) | max (µm) | rms / rms at 1 Hz |",

@@ -11,10 +11,10 @@ dynamics alone. So ``hystcomp compare`` forks one process first (:func:`start`) 
    (:func:`compile_later_kernels`). Meanwhile the first process compiles the twin's and
    the Preisach model's run, which it needs first; when it reaches the others, it loads
    them;
-2. on every run, identifies the twin's linear dynamics and designs their inverse
-   (:func:`~hystcomp.experiment.compare_dynamics.designed_twin_dynamics`), which the first
-   process takes when it reaches the dynamics part (:func:`prepare`); on a first run it
-   also compiles there the kernels of a compensator with dynamics.
+2. on every run, measures the identification records again (the same seeded twin), and
+   identifies the MPI and Preisach models with the twin's linear dynamics as pairs and
+   designs their inverses (:func:`~hystcomp.experiment.compare_dynamics.identify_twin_pairs`),
+   which the first process takes when it reaches the dynamics part (:func:`prepare`).
 
 Nothing the experiment computes depends on which process compiled a kernel (the cache
 holds the same machine code) or identified the dynamics (the same computation, pickled).
@@ -24,8 +24,6 @@ from __future__ import annotations
 
 import sys
 from pathlib import Path
-
-import numpy as np
 
 from hystcomp._kernels import chain
 from hystcomp.experiment.background import BackgroundJob
@@ -53,21 +51,16 @@ def compile_later_kernels() -> None:
         model.fit(v, x).inverse().simulate(x)
 
 
-def prepare(twin: TwinParameters, seed: int, compile_first: bool):
+def prepare(config, compile_first: bool):
     """The job of :func:`start`: :func:`compile_later_kernels` if ``compile_first``, then
-    :func:`~hystcomp.experiment.compare_dynamics.designed_twin_dynamics` (the twin's kernel
-    last: the first process compiles it first, so that here it is loaded) and, if
-    ``compile_first``, an MPI compensator with that inverse (the dynamics' kernels)."""
-    from hystcomp import presets
-    from hystcomp.experiment.compare_dynamics import designed_twin_dynamics
+    :func:`~hystcomp.experiment.compare.twin_pairs` for ``config`` (the
+    twin's kernel after the others: the first process compiles it first, so that here it
+    is loaded)."""
+    from hystcomp.experiment.compare import twin_pairs
 
     if compile_first:
         compile_later_kernels()
-    identified = designed_twin_dynamics(twin, seed)
-    if compile_first:
-        model = presets.paper_mpi()
-        model.inverse(dynamics=identified[1]).simulate(np.linspace(0.0, 10.0, 100))
-    return identified
+    return twin_pairs(config)
 
 
 def load_shared(twin: TwinParameters) -> None:
@@ -80,20 +73,21 @@ def load_shared(twin: TwinParameters) -> None:
     Twin(twin).run_noiseless([0.0])
 
 
-def start(twin: TwinParameters, seed: int) -> BackgroundJob | None:
-    """Fork the process of :func:`prepare` for ``(twin, seed)``, or None where the platform
-    does not fork (Linux only, as :class:`~hystcomp.experiment.background.BackgroundJob`).
+def start(config) -> BackgroundJob | None:
+    """Fork the process of :func:`prepare` for ``config`` (a
+    :class:`~hystcomp.experiment.compare.CompareConfig`), or None where the platform does
+    not fork (Linux only, as :class:`~hystcomp.experiment.background.BackgroundJob`).
 
-    Its result is what :func:`~hystcomp.experiment.compare_dynamics.identify_twin_dynamics`
+    Its result is what :func:`~hystcomp.experiment.compare_dynamics.identify_twin_pairs`
     returns. It compiles first only if the cache lacks the play chain's batch kernel (a
     first run); otherwise this process first loads what both need (:func:`load_shared`).
     """
-    if not sys.platform.startswith("linux"):
+    if not sys.platform.startswith("linux") or not config.dynamics:
         return None
     compile_first = not _in_cache(chain.chain_run)
     if not compile_first:
-        load_shared(twin)
-    return BackgroundJob.start(prepare, twin, seed, compile_first)
+        load_shared(config.twin)
+    return BackgroundJob.start(prepare, config, compile_first)
 
 
 def _in_cache(kernel) -> bool:

@@ -143,17 +143,17 @@ def dynamics_excitation(
     frequencies from 1 Hz to 5 kHz (at most 0.4 ``sample_rate``) rounded to whole Hz, the
     duplicates dropped (96 lines at 20 kHz), Schroeder phases for a low crest factor; then the triangles of :data:`TRIANGLES` over
     :data:`TRIANGLE_SPAN` of the range (those with fewer than 20 samples a period left
-    out), each reached by a ramp at its own slope. 9.1 s in all.
+    out), each reached by a ramp at its own slope. 9.2 s in all.
 
     Examples
     --------
     >>> t, v = dynamics_excitation()
     >>> t.size, float(v.min()), float(v[round(1.0 * 20_000)])   # rest, then the step to 60 V
-    (182802, 0.0, 60.0)
-    >>> ms = v[round(3.2 * 20_000):round(6.2 * 20_000)]          # the multisine, +-48 V
+    (183298, 0.0, 60.0)
+    >>> ms = v[round(3.2 * 20_000):round(6.2 * 20_000)]          # the multisine, +-30 V
     >>> round(float(np.abs(ms - 60.0).max()), 9)
-    48.0
-    >>> round(float(v[-1]), 9), round(float(v.max()), 9)           # triangles up to 90 %
+    30.0
+    >>> round(float(v[round(6.5 * 20_000):].min()), 9), round(float(v.max()), 9)  # 5-90 %
     (6.0, 108.0)
     """
     owner = "dynamics_excitation"

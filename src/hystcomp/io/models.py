@@ -134,7 +134,7 @@ def _check_document(doc: Any, source: str) -> type[Model]:
             "A newer hystcomp may know it: upgrade hystcomp."
         )
     cls = MODEL_KINDS[kind]
-    if cls is HammersteinModel:
+    if issubclass(cls, HammersteinModel):
         for part, kinds in PAIR_PARTS.items():
             inner = doc.get(part)
             if not isinstance(inner, dict) or inner.get("kind") not in kinds:

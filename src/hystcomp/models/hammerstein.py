@@ -69,6 +69,8 @@ class HammersteinModel:
     """
 
     kind: ClassVar[str] = "hammerstein"
+    fit_report_: dict[str, Any]
+    hysteresis_alone_: HysteresisModel
 
     def __init__(self, hysteresis, dynamics):
         if not isinstance(hysteresis, HysteresisModel):
@@ -200,6 +202,7 @@ def fit_pair(
     hysteresis_rate: float | None = None,
     rounds: int = MAX_ROUNDS,
     alone=None,
+    fit_on: slice | None = None,
 ) -> HammersteinModel:
     """Identify a hysteresis model and the linear dynamics as one pair, ``x = D[H[v]]``.
 
@@ -219,6 +222,10 @@ def fit_pair(
         Most rounds of the alternation.
     alone : fitted model, optional
         ``estimator`` already fitted on ``(v, x)`` (round 0), if the caller has it.
+    fit_on : slice, optional
+        The samples of the hysteresis record that ``H`` is fitted on (all by default);
+        ``D^-1`` is applied to the whole record first, so that its creep's state is right
+        where the slice starts.
 
     Returns
     -------
@@ -251,11 +258,13 @@ def fit_pair(
         else check_real(hysteresis_rate, "hysteresis_rate", owner, positive=True)
     )
     rounds = check_int(rounds, "rounds", owner, minimum=1)
-    start = 0 if "transient" in estimator.get_params() else transient_end(v)
+    part = slice(None) if fit_on is None else fit_on
+    v_h = v[part]
+    start = 0 if "transient" in estimator.get_params() else transient_end(v_h)
 
     def fit_h(displacement):
         model = type(estimator)(**estimator.get_params())
-        return model.fit(v[start:], displacement[start:])
+        return model.fit(v_h[start:], displacement[part][start:])
 
     h = fit_h(x) if alone is None else alone
     alone = h
@@ -280,5 +289,5 @@ def fit_pair(
         "hysteresis": dict(getattr(h, "fit_report_", {})),
         "dynamics": dict(d.fit_report_),
     }
-    pair.hysteresis_alone_ = alone  # type: ignore[attr-defined]
+    pair.hysteresis_alone_ = alone
     return pair

@@ -20,7 +20,7 @@ import numpy as np
 
 from hystcomp.errors import InvalidParameterError, InvalidTypeError
 from hystcomp.identify.dynamics import MAX_DAMPING, TRIANGLE_SPAN, record_layout
-from hystcomp.identify.scoring import transient_end, turning_indices
+from hystcomp.identify.scoring import turning_indices
 from hystcomp.identify.workflow import IdentificationResult, identify_record
 from hystcomp.io.records import uneven_sampling
 from hystcomp.models.dynamics import LinearDynamics
@@ -323,23 +323,30 @@ def identify_dynamics_record(record) -> DynamicsResult:
 def dynamics_alone(record) -> LinearDynamics:
     """The linear dynamics of a record of ``hystcomp excite dynamics``, on their own.
 
-    ``D`` is fitted behind a hysteresis model (MPI) of the record itself, the two
-    alternated as in :func:`~hystcomp.models.hammerstein.fit_pair` on its step, multisine
-    and triangles: the large-signal record drives the stage through its hysteresis, which
-    a fit on the voltage would take for dynamics. The hysteresis model is not kept.
+    ``D`` is fitted behind a hysteresis model (MPI) of the record itself, fitted on its
+    1 Hz triangles (from the ramp before them, which sets the model's memory), the two
+    alternated as in :func:`~hystcomp.models.hammerstein.fit_pair`: the large-signal
+    record drives the stage through its hysteresis, which a fit on the voltage would take
+    for dynamics. The hysteresis model is not kept. A record of the former layout (a small
+    multisine, no triangles) is fitted on the voltage, as it was.
     """
     v, x = record.v, record.x
-    start = transient_end(v)
-    estimator = ModifiedPrandtlIshlinskii()
-    pair = fit_pair(estimator, v[start:], x[start:], v, x, sample_rate=record.sample_rate)
+    triangles = record_layout(v, record.sample_rate).triangles
+    if not triangles:
+        return LinearDynamics().fit(v, x, record.sample_rate)
+    slow = triangles[0]
+    start = slow.start - 1  # the ramp's last sample, at the triangle's low end
+    part = slice(start, slow.stop)
+    fs = record.sample_rate
+    pair = fit_pair(ModifiedPrandtlIshlinskii(), v, x, v, x, sample_rate=fs, fit_on=part)
     return pair.dynamics
 
 
 def reference_rate(x_ref, sample_rate: float) -> float:
-    """The rate (Hz) of a reference: half its turning points per second.
+    """The rate (Hz) of a reference: one over twice the mean time between its turns.
 
-    Turns smaller than 5 % of its span are not counted; a reference that turns fewer than
-    twice (a ramp, a step, a hold) has rate 0.
+    Turns smaller than 5 % of its span are not counted; a reference that never turns back
+    (a ramp, a step, a hold) has rate 0.
 
     Examples
     --------
@@ -352,10 +359,10 @@ def reference_rate(x_ref, sample_rate: float) -> float:
     if span <= 0.0:
         return 0.0
     idx, _ = turning_indices(x, 0.05 * span)
-    turns = max(idx.size - 2, 0)  # the first and the last index are the ends
-    if turns < 2:
+    turns = idx[:-1]  # the last is where the reference ends, not a turn
+    if turns.size < 2:
         return 0.0
-    return 0.5 * turns * sample_rate / x.size
+    return 0.5 * (turns.size - 1) * sample_rate / float(turns[-1] - turns[0])
 
 
 def predicted_worse(pair: HammersteinModel, x_ref, sample_rate: float):
