@@ -25,15 +25,16 @@ errors of a cross-validation over reversal segments), the inverse's estimate on 
 record (the former criterion) and the fit error; and the regret of choosing the MPI
 regularisation by each (measured ratio of the one it ranks first minus the best).
 
-Run alone with ``python benchmarks/bench_accuracy.py`` (a few minutes; prints the table).
-``--held-out`` runs every option below on the held-out actuators instead: they are checked
-last, after every default is chosen on the tuning ones. ``--paper`` prints the same table for the paper's fits (constraints="paper", regularization 0,
-the Preisach cubic from reversal curves, which only the sinusoids have: ``n/a`` elsewhere);
-``--preisach`` prints the comparison of the Preisach fits; ``--rho`` the rank correlations;
-``--limit`` the best MPI tracking of any size and regularisation on the quasi-static
-hysteresis of the twin and the Bouc-Wen stage (:func:`family_limit`); ``--coverage`` the
-estimated and measured tracking from records that lack what a reference does, with the
-coverage warning of ``hystcomp identify`` (:func:`coverage`).
+Run alone with ``python benchmarks/bench_accuracy.py`` (half a minute; prints the table).
+``--paper`` prints the same table for the paper's fits (constraints="paper", regularization
+0, the Preisach cubic from reversal curves, which only the sinusoids have: ``n/a``
+elsewhere); ``--preisach`` prints the comparison of the Preisach fits; ``--rho`` the rank
+correlations; ``--limit`` the best MPI tracking of any size and regularisation on the
+quasi-static hysteresis of the twin and the Bouc-Wen stage (:func:`family_limit`);
+``--coverage`` the estimated and measured tracking from records that lack what a reference
+does, with the coverage warning of ``hystcomp identify`` (:func:`coverage`). ``--held-out``
+runs all of these on the held-out actuators instead (``--limit`` on all of them): they are
+checked last, after every default is chosen on the tuning ones.
 """
 
 from __future__ import annotations

@@ -371,24 +371,23 @@ def maxwell_slip(voltage_range=(0.0, 100.0), *, seed=7):
     return run
 
 
-def _narrow_density(a, b):
-    width = (a - b) / (BIPOLAR[1] - BIPOLAR[0])
-    centre = (0.5 * (a + b) - BIPOLAR[0]) / (BIPOLAR[1] - BIPOLAR[0])
-    return width**2 * np.exp(-width / 0.1) * (1.0 + 0.8 * centre)
-
-
-def narrow_preisach(voltage_range=BIPOLAR):
-    """The quasi-static part of ``narrow`` on ``voltage_range`` (see the module): relays of
-    a density that vanishes on the diagonal, a convex reversible part, a saturation that
-    is harder at the top of the range than at the bottom."""
+def narrow_preisach(voltage_range=BIPOLAR, n=80):
+    """The quasi-static part of ``narrow`` on ``voltage_range`` (see the module): ``n x n``
+    relays of a density that vanishes on the diagonal, a convex reversible part, a
+    saturation that is harder at the top of the range than at the bottom."""
     lo, hi = voltage_range
+
+    def density(a, b):
+        width = (a - b) / (hi - lo)
+        centre = (0.5 * (a + b) - lo) / (hi - lo)
+        return width**2 * np.exp(-width / 0.1) * (1.0 + 0.8 * centre)
 
     def out_map(s, v):
         u = (v - lo) / (hi - lo)
         z = 0.74 * u * (0.8 + 0.2 * u) + 0.13 * (s + 1.0)
         return 23.5 * np.tanh(2.2 * (z - 0.35)) - 2.7
 
-    return hysteron_model(80, _narrow_density, 0.0, out_map, voltage_range)
+    return hysteron_model(n, density, 0.0, out_map, voltage_range)
 
 
 #: The twin's Bouc-Wen shape ``(c1, c2, c3, w0, u_w, rho, sigma)`` for ``ratedep``.
@@ -409,6 +408,19 @@ def rate_dependent_bouc_wen(voltage_range=UNIPOLAR, sample_rate=20_000.0):
     return run
 
 
+#: ``boucwen``: the twin with another Bouc-Wen shape, 3 % creep and a 1.2 kHz mode.
+BOUCWEN = TwinParameters(
+    anhysteretic=(34.0, 12.0, -9.0),
+    hysteresis_amplitude=3.4,
+    hysteresis_onset=0.25,
+    bouc_wen_rate=4.0,
+    bouc_wen_shape=0.9,
+    resonance_hz=1200.0,
+    damping_ratio=0.06,
+    creep_gain=0.03,
+)
+
+
 def actuator(name: str, *, seed: int = 0, sample_rate: float | None = None) -> Actuator:
     """One actuator of the panel (see the module docstring), at its own sample rate unless
     ``sample_rate`` (Hz) is given."""
@@ -419,17 +431,7 @@ def actuator(name: str, *, seed: int = 0, sample_rate: float | None = None) -> A
     if name == "twin":
         return _TwinActuator(name, TwinParameters(), fs, seed)
     if name == "boucwen":
-        params = TwinParameters(
-            anhysteretic=(34.0, 12.0, -9.0),
-            hysteresis_amplitude=3.4,
-            hysteresis_onset=0.25,
-            bouc_wen_rate=4.0,
-            bouc_wen_shape=0.9,
-            resonance_hz=1200.0,
-            damping_ratio=0.06,
-            creep_gain=0.03,
-        )
-        return _TwinActuator(name, params, fs, seed)
+        return _TwinActuator(name, BOUCWEN, fs, seed)
     stages = {
         "duhem": (duhem, Dynamics(900.0)),
         "preisach": (preisach_stage, Dynamics(800.0)),
