@@ -19,7 +19,7 @@ the targets of ``benchmarks/bench_dynamics.py``: with the dynamics, the 100 Hz (
 rms within 1.5x (2.5x) of the 1 Hz rms, and the step's mean |error| below 0.3x of that
 without them.
 
-Run alone with ``python benchmarks/bench_dynamics_panel.py`` (about a minute; prints the
+Run alone with ``python benchmarks/bench_dynamics_panel.py`` (a quarter of a minute; prints the
 table, µm: each cell "without / with" the inverse of the dynamics).
 """
 
