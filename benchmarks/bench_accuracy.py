@@ -1,11 +1,14 @@
 """Accuracy of the compensators on actuators of none of the model families (benchmarks/panel.py).
 
-For each actuator of the panel and each identification excitation (the paper's triangles
-``pi``, the paper's sinusoids ``preisach``, random turning points ``random``, and
-``hystcomp excite rich``), identify PI, MPI and Preisach with the library's defaults and
-track a 1 Hz triangle (from the actuator's remanence at 0 V to 90 % of its stroke, see
-:class:`benchmarks.panel.Bench`); each cell is the tracking rms over the uncompensated rms
-(the linear baseline of :mod:`hystcomp.experiment.baseline`, gain from the triangle record).
+For each tuning actuator of the panel (:data:`benchmarks.panel.ACTUATORS`; the held-out
+ones of :data:`benchmarks.panel.HELD_OUT` with ``--held-out``) and each identification
+excitation (the paper's triangles ``pi``, the paper's sinusoids ``preisach``, random turning
+points ``random``, and ``hystcomp excite rich``, all scaled to the actuator's range and
+sampled at its rate), identify PI, MPI and Preisach with the library's defaults and track a
+1 Hz triangle (from the actuator's remanence at the low end of its range to 90 % of its
+stroke, see :class:`benchmarks.panel.Bench`); each cell is the tracking rms over the
+uncompensated rms (the straight line through the rest point, :class:`benchmarks.panel.RestLine`,
+gain from the triangle record).
 Targets per cell: PI < 0.5, MPI < 0.2, Preisach < 0.25, none above 0.6. The Preisach model
 is fitted by least squares from any record, so every cell has a figure.
 
@@ -22,14 +25,16 @@ errors of a cross-validation over reversal segments), the inverse's estimate on 
 record (the former criterion) and the fit error; and the regret of choosing the MPI
 regularisation by each (measured ratio of the one it ranks first minus the best).
 
-Run alone with ``python benchmarks/bench_accuracy.py`` (about two minutes; prints the table).
-``--paper`` prints the same table for the paper's fits (constraints="paper", regularization 0,
-the Preisach cubic from reversal curves, which only the sinusoids have: ``n/a`` elsewhere);
-``--preisach`` prints the comparison of the Preisach fits; ``--rho`` the rank correlations;
-``--limit`` the best MPI tracking of any size and regularisation on the quasi-static
-hysteresis of the twin and the Bouc-Wen stage (:func:`family_limit`); ``--coverage`` the
-estimated and measured tracking from records that lack what a reference does, with the
-coverage warning of ``hystcomp identify`` (:func:`coverage`).
+Run alone with ``python benchmarks/bench_accuracy.py`` (half a minute; prints the table).
+``--paper`` prints the same table for the paper's fits (constraints="paper", regularization
+0, the Preisach cubic from reversal curves, which only the sinusoids have: ``n/a``
+elsewhere); ``--preisach`` prints the comparison of the Preisach fits; ``--rho`` the rank
+correlations; ``--limit`` the best MPI tracking of any size and regularisation on the
+quasi-static hysteresis of the twin and the Bouc-Wen stage (:func:`family_limit`);
+``--coverage`` the estimated and measured tracking from records that lack what a reference
+does, with the coverage warning of ``hystcomp identify`` (:func:`coverage`). ``--held-out``
+runs all of these on the held-out actuators instead (``--limit`` on all of them): they are
+checked last, after every default is chosen on the tuning ones.
 """
 
 from __future__ import annotations
@@ -41,7 +46,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from benchmarks.panel import ACTUATORS, EXCITATIONS, V_MAX, Bench, excitation
+from benchmarks.panel import ACTUATORS, EXCITATIONS, HELD_OUT, V_MAX, Bench, excitation
 
 from hystcomp import ModifiedPrandtlIshlinskii, PrandtlIshlinskii, Preisach
 from hystcomp.identify.mpi import REGULARIZATION_GRID
@@ -80,9 +85,10 @@ def estimators(paper: bool = False) -> dict:
     return {"PI": PrandtlIshlinskii(), "MPI": ModifiedPrandtlIshlinskii(), "Preisach": Preisach()}
 
 
-def ratio_table(actuators=ACTUATORS, excitations=EXCITATIONS, *, paper=False, sample_rate=20e3):
+def ratio_table(actuators=ACTUATORS, excitations=EXCITATIONS, *, paper=False, sample_rate=None):
     """``{(actuator, excitation): {method: ratio}}`` with the default fits (``paper``: the
-    paper's fits, NaN where the paper's Preisach fit has no reversal curves to fit)."""
+    paper's fits, NaN where the paper's Preisach fit has no reversal curves to fit), each
+    actuator at its own sample rate unless ``sample_rate`` (Hz) is given."""
     table = {}
     for name in actuators:
         bench = Bench(name, sample_rate=sample_rate)
@@ -152,12 +158,18 @@ def criterion_rank_correlation(actuators=ACTUATORS, excitations=EXCITATIONS) -> 
     return out
 
 
-def thin_record(kind: str, sample_rate: float) -> np.ndarray:
+def thin_record(kind: str, sample_rate: float, voltage_range=(0.0, V_MAX)) -> np.ndarray:
     """Records that may lack what a reference does (:func:`coverage`): ``walk``, a random
     walk (Brownian, 30 s, its steps held 0.1 s, seeded) scaled to the range; ``drift``, the
     same walk on a descent three times its span, so that it crosses the range once; ``loop``, one
     2 s triangle over the range; ``stairs``, a staircase up and down in 10 % steps."""
     fs = sample_rate
+    lo, hi = voltage_range
+    return lo + (hi - lo) / V_MAX * _thin_record(kind, fs)
+
+
+def _thin_record(kind: str, fs: float) -> np.ndarray:
+    """:func:`thin_record` on 0..120 V."""
     if kind in ("walk", "drift"):
         hold = round(0.1 * fs)
         steps = np.repeat(np.random.default_rng(5).normal(0.0, 1.0, 300), hold)
@@ -190,7 +202,7 @@ def coverage(actuators=ACTUATORS, sample_rate=5e3) -> list[tuple]:
             if kind in EXCITATIONS:
                 v, x = bench.record(kind)
             else:
-                v = thin_record(kind, sample_rate)
+                v = thin_record(kind, bench.act.sample_rate, bench.act.voltage_range)
                 x = bench.act.run(v)
             start = transient_end(v)
             warned = coverage_warning(v, start) is not None
@@ -205,8 +217,8 @@ def family_limit(actuators=("twin", "boucwen"), grid=(0.0, 1e-3, 1e-2, 1e-1, 1.0
     """Best MPI tracking on an actuator's quasi-static hysteresis, for the MPI family's limit.
 
     Without creep, resonance or noise (:meth:`benchmarks.panel.Actuator.hysteresis`, the
-    twin's too), from the paper's triangles and from a 0..120 V triangle (the loop that
-    is tracked), the MPI fits of 16 and 32 plays and dead-zones with every
+    twin's too), from the paper's triangles and from a triangle over the whole range (the
+    loop that is tracked), the MPI fits of 16 and 32 plays and dead-zones with every
     ``regularization`` of ``grid``: ``{(actuator, record): (best ratio, operators,
     regularization)}``, the tracking error of the reference through the same quasi-static
     hysteresis over the bench's uncompensated error. If the best is above the 0.2 target,
@@ -216,9 +228,10 @@ def family_limit(actuators=("twin", "boucwen"), grid=(0.0, 1e-3, 1e-2, 1e-1, 1.0
     for name in actuators:
         bench = Bench(name)
         static = bench.act.hysteresis
-        ramp = np.linspace(0.0, V_MAX, 20001)
-        records = {"pi": excitation("pi", bench.act.sample_rate)}
-        records["0..120 V loop"] = np.tile(np.r_[ramp, ramp[::-1][1:-1]], 3)
+        lo, hi = bench.act.voltage_range
+        ramp = np.linspace(lo, hi, 20001)
+        records = {"pi": excitation("pi", bench.act.sample_rate, (lo, hi))}
+        records[f"{lo:g}..{hi:g} V loop"] = np.tile(np.r_[ramp, ramp[::-1][1:-1]], 3)
         window = slice(bench.period, None)
         for label, v in records.items():
             x = static(v)
@@ -314,17 +327,20 @@ def run() -> list[dict]:
 
 
 if __name__ == "__main__":
-    print(format_table(ratio_table(paper="--paper" in sys.argv)))
+    # the held-out actuators are run only to check a choice made on the tuning ones
+    stages = HELD_OUT if "--held-out" in sys.argv else ACTUATORS
+    print(format_table(ratio_table(stages, paper="--paper" in sys.argv)))
     if "--preisach" in sys.argv:
-        print(format_table(preisach_table(), columns=tuple(PREISACH_FITS)))
+        print(format_table(preisach_table(stages), columns=tuple(PREISACH_FITS)))
     if "--limit" in sys.argv:
-        for (name, label), (ratio, n, value) in family_limit().items():
+        limited = HELD_OUT if "--held-out" in sys.argv else ("twin", "boucwen")
+        for (name, label), (ratio, n, value) in family_limit(limited).items():
             print(
                 f"{name} quasi-static, from {label}: best MPI {ratio:.3f} ({n} operators, "
                 f"regularization {value:g})"
             )
     if "--coverage" in sys.argv:
-        rows = coverage()
+        rows = coverage(stages)
         for row in rows:
             print("{} {} {}: estimated {:.3f}, measured {:.3f}, warned {}".format(*row))
         for warned in (True, False):
@@ -335,7 +351,7 @@ if __name__ == "__main__":
                 f"{np.sum(over > 2)} of {over.size} cells"
             )
     if "--rho" in sys.argv:
-        for crit, (rhos, regrets) in criterion_rank_correlation().items():
+        for crit, (rhos, regrets) in criterion_rank_correlation(stages).items():
             print(f"{crit:>9}: rho per cell", " ".join(f"{r:.2f}" for r in rhos))
             print(
                 f"{crit:>9}: rho median {np.median(rhos):.3f}, mean {np.mean(rhos):.3f}, "
