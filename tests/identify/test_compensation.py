@@ -154,9 +154,15 @@ def test_identify_warns_when_no_better_than_a_line_is_predicted(tmp_path, monkey
     from hystcomp.identify import workflow
 
     def pessimistic(model, v, x, *, start=0):
-        return {"tracking_rms_um": 2.0, "baseline_rms_um": 1.0, "ratio": 2.0}
+        return {
+            "tracking_rms_um": 2.0,
+            "baseline_rms_um": 1.0,
+            "ratio": 2.0,
+            "held_out_rms_um": 2.0,
+            "flatters": False,
+        }
 
-    monkeypatch.setattr(workflow, "compensation_error", pessimistic)
+    monkeypatch.setattr(workflow, "tracking_estimate", pessimistic)
     result = run("identify", path, "--model", "pi", "-o", tmp_path / "m.json")
     assert result.exit_code == 0
     warnings = [line for line in result.output.splitlines() if line.startswith("hystcomp: warn")]

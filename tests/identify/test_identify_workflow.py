@@ -153,9 +153,15 @@ def test_a_compensator_predicted_near_the_straight_line_is_warned_about(monkeypa
     from hystcomp.identify import workflow
 
     def estimate(model, v, x, *, start=0):
-        return {"tracking_rms_um": ratio, "baseline_rms_um": 1.0, "ratio": ratio}
+        return {
+            "tracking_rms_um": ratio,
+            "baseline_rms_um": 1.0,
+            "ratio": ratio,
+            "held_out_rms_um": ratio,
+            "flatters": False,
+        }
 
-    monkeypatch.setattr(workflow, "compensation_error", estimate)
+    monkeypatch.setattr(workflow, "tracking_estimate", estimate)
     warnings = identify_record(_loops(2.0), "mpi", operators=4, deadzones=4).warnings
     if says is None:
         assert warnings == []

@@ -30,8 +30,15 @@ from hystcomp.errors import (
     InvalidParameterError,
     InvalidSignalError,
 )
+from hystcomp.identify.compensation import CV_FOLDS
 from hystcomp.identify.preisach_lsq import MAX_LSQ_GRID, fit_preisach_lsq
-from hystcomp.identify.scoring import check_response, default_tolerance, turning_indices
+from hystcomp.identify.scoring import (
+    check_response,
+    default_tolerance,
+    reversal_folds,
+    transient_end,
+    turning_indices,
+)
 
 N_BINS = 200  # X samples per full-range curve: each curve is averaged in bins of span / N_BINS
 FIT_METHODS = ("auto", "reversal-curves", "least-squares")
@@ -459,8 +466,16 @@ def _least_squares(v, x, curves, degree, everett, grid_size, voltage_range, zero
             f"make a dense problem too large to solve. Got {grid_size}; use a coarser grid "
             "(25 puts a node every 5 V on 0..120 V) or the polynomial."
         )
+    start = transient_end(v)
     theta, table, offset, fit_report = fit_preisach_lsq(
-        v, x, everett=everett, degree=degree, grid_size=grid_size, voltage_range=voltage_range
+        v,
+        x,
+        everett=everett,
+        degree=degree,
+        grid_size=grid_size,
+        voltage_range=voltage_range,
+        start=start,
+        folds=reversal_folds(v, start, CV_FOLDS),
     )
     lo, hi = voltage_range
     kind, coef = (

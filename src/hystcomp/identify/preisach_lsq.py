@@ -37,6 +37,7 @@ import numpy as np
 
 from hystcomp._kernels import preisach as pk
 from hystcomp.errors import IdentificationError
+from hystcomp.identify.compensation import inside_training
 from hystcomp.identify.lsq import solve_inequality_qp
 from hystcomp.identify.scoring import transient_end
 
@@ -132,12 +133,37 @@ class EverettBasis:
         ]
         return np.concatenate(parts) if parts else np.zeros((0, self.size))
 
-    def normal_equations(self, v, x, *, start=0, stride=1) -> np.ndarray:
-        """The augmented Gram matrix ``[R | 1 | x]^T [R | 1 | x]`` over the chosen rows."""
-        gram = np.zeros((self.size + 2, self.size + 2))
+    def normal_equations(self, v, x, *, start=0, stride=1, folds=None, n_folds=1) -> np.ndarray:
+        """The augmented Gram matrix ``[R | 1 | x]^T [R | 1 | x]`` over the chosen rows.
+
+        With ``folds`` (a fold ``0 .. n_folds - 1`` for every sample, -1 for none), one Gram
+        matrix per fold over its own rows, and one over those of its rows whose input lies
+        inside the range of the other folds (:func:`~hystcomp.identify.compensation.
+        inside_training`): shape ``(2, n_folds, p + 2, p + 2)``."""
+        size = self.size + 2
+        if folds is None:
+            gram = np.zeros((size, size))
+            for block in self.rows(v, x, start=start, stride=stride):
+                pk.gram_update(block, block.shape[0], gram)
+            return np.triu(gram) + np.triu(gram, 1).T
+        folds = np.asarray(folds)
+        grams = np.zeros((2, n_folds, size, size))
+        row_v = np.asarray(v)[start::stride]
+        row_folds = folds[start::stride]
+        scored = np.zeros(row_v.size, dtype=bool)
+        for fold in range(n_folds):
+            scored |= inside_training(row_v, row_folds, fold)
+        at = 0
         for block in self.rows(v, x, start=start, stride=stride):
-            pk.gram_update(block, block.shape[0], gram)
-        return np.triu(gram) + np.triu(gram, 1).T
+            mine = row_folds[at : at + block.shape[0]]
+            kept = scored[at : at + block.shape[0]]
+            at += block.shape[0]
+            for fold in range(n_folds):
+                for which, rows in enumerate((mine == fold, (mine == fold) & kept)):
+                    part = np.ascontiguousarray(block[rows])
+                    if part.shape[0]:
+                        pk.gram_update(part, part.shape[0], grams[which, fold])
+        return np.triu(grams) + np.swapaxes(np.triu(grams, 1), -1, -2)
 
     def density_constraints(self) -> np.ndarray:
         """Rows ``A`` with ``A c >= 0`` iff the density (and the reversible part) is >= 0.
@@ -207,7 +233,7 @@ def _power(base, exponent):
     return out
 
 
-def fit_preisach_lsq(v, x, *, everett, degree, grid_size, voltage_range, start=None):
+def fit_preisach_lsq(v, x, *, everett, degree, grid_size, voltage_range, start=None, folds=None):
     """Fit a Preisach model to a record by density-constrained least squares.
 
     Parameters
@@ -222,6 +248,10 @@ def fit_preisach_lsq(v, x, *, everett, degree, grid_size, voltage_range, start=N
         The Preisach plane (V), containing the record.
     start : int, optional
         First sample of the fit; default :func:`~hystcomp.identify.scoring.transient_end`.
+    folds : ndarray of int, optional
+        A fold for every sample (:func:`~hystcomp.identify.scoring.reversal_folds`, -1
+        before ``start``): the model is also fitted without each fold, and the report holds
+        ``held_out_rms_um``, its error on the reversal segments each fit did not see.
 
     Returns
     -------
@@ -230,7 +260,8 @@ def fit_preisach_lsq(v, x, *, everett, degree, grid_size, voltage_range, start=N
     offset : float
         ``x_0`` in µm.
     report : dict
-        ``first_used_sample``, ``n_rows``, ``stride``, ``density_min``.
+        ``first_used_sample``, ``n_rows``, ``stride``, ``density_min`` (and
+        ``held_out_rms_um`` with ``folds``).
 
     Raises
     ------
@@ -250,19 +281,46 @@ def fit_preisach_lsq(v, x, *, everett, degree, grid_size, voltage_range, start=N
         )
     max_rows = max(MIN_ROWS, int(GRAM_BUDGET / (basis.size + 2) ** 2))
     stride = max(1, math.ceil(used / max_rows))
-    gram = basis.normal_equations(v, x, start=start, stride=stride)
+    n_folds = 0 if folds is None else int(np.max(folds)) + 1
+    if n_folds >= 2:
+        per_fold, scored = basis.normal_equations(
+            v, x, start=start, stride=stride, folds=folds, n_folds=n_folds
+        )
+        gram = per_fold.sum(axis=0)
+    else:
+        gram = basis.normal_equations(v, x, start=start, stride=stride)
     penalty = basis.smoothness_penalty()
     if np.any(penalty):
         count = gram[-2, -2]
         mean = gram[-2, : basis.size] / count
         centred = np.diag(gram[: basis.size, : basis.size]) - count * mean**2
         penalty *= SMOOTHING * max(float(centred.mean()), 0.0) / float(np.diag(penalty).mean())
-    coef, _ = solve_inequality_qp(gram, basis.density_constraints(), penalty=penalty)
+    constraints = basis.density_constraints()
+    coef, _ = solve_inequality_qp(gram, constraints, penalty=penalty)
     theta, table = basis.to_model(coef[:-1])
     report = {
         "first_used_sample": int(start),
         "n_rows": int(gram[-2, -2]),
         "stride": int(stride),
-        "density_min": float((basis.density_constraints() @ coef[:-1]).min()),
+        "density_min": float((constraints @ coef[:-1]).min()),
     }
+    if n_folds >= 2:
+        report["held_out_rms_um"] = _held_out_rms(per_fold, scored, gram, constraints, penalty)
     return theta, table, float(coef[-1]), report
+
+
+def _held_out_rms(per_fold, scored, gram, constraints, penalty) -> float:
+    """The rms error (µm) of the fits without each fold on the rows of that fold inside the
+    range of the others (``scored``).
+
+    A fold's squared error is a quadratic form of its Gram matrix: with ``w = (c, x_0,
+    -1)``, ``sum (R c + x_0 - x)^2 = w^T G_fold w``."""
+    sse, count = 0.0, 0.0
+    for fold_gram, scored_gram in zip(per_fold, scored, strict=True):
+        if scored_gram[-2, -2] == 0.0:
+            continue
+        coef, _ = solve_inequality_qp(gram - fold_gram, constraints, penalty=penalty)
+        w = np.r_[coef, -1.0]
+        sse += float(w @ scored_gram @ w)
+        count += float(scored_gram[-2, -2])
+    return float(np.sqrt(max(sse, 0.0) / count)) if count else float("nan")

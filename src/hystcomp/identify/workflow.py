@@ -23,7 +23,7 @@ import numpy as np
 from hystcomp import paper
 from hystcomp._hyperparameters import check_constraints
 from hystcomp.errors import IdentificationError, InvalidParameterError, InvalidTypeError
-from hystcomp.identify.compensation import compensation_error
+from hystcomp.identify.compensation import tracking_estimate
 from hystcomp.identify.scoring import (
     check_transient,
     coverage_warning,
@@ -458,7 +458,7 @@ def identify_record(
             ) from None
     x_model = model.simulate(v)
     fit = error_report(x, x_model, start)
-    tracking = compensation_error(model, v, x, start=start)
+    tracking = tracking_estimate(model, v, x, start=start)
     held = None if holdout is None else holdout_report(model, record.v, record.x, n_fit, start)
 
     label = LABELS[kind]
@@ -491,10 +491,15 @@ def identify_record(
         f"max {fit['max_error_um']:.4g} µm ({fit['max_error_percent']:.3g} %)"
     )
     lines.append(
-        f"  compensation (estimated): tracking rms {tracking['tracking_rms_um']:.4g} µm, "
-        f"straight line v = (x - b)/a {tracking['baseline_rms_um']:.4g} µm "
+        f"  compensation (estimated): tracking rms {tracking['tracking_rms_um']:.4g} µm over "
+        f"the range, straight line v = (x - b)/a {tracking['baseline_rms_um']:.4g} µm "
         f"({tracking['ratio']:.2g}x)"
     )
+    if np.isfinite(tracking["held_out_rms_um"]):
+        lines.append(
+            f"  held out:  {tracking['held_out_rms_um']:.4g} µm rms on reversal branches each "
+            "fit did not see (references that turn inside the range)"
+        )
     warnings = []
     unit = x_unit_warning(record.x, str(record.source)) if unit_check else None
     if unit is not None:  # the compensator would then clamp a reference in µm throughout
@@ -520,6 +525,14 @@ def identify_record(
         )
     if coverage is not None:
         warnings.append(coverage)
+    elif tracking["flatters"]:
+        warnings.append(
+            f"on reversal branches it was not fitted on, the {label} model is "
+            f"{tracking['held_out_rms_um'] / tracking['tracking_rms_um']:.2g}x further from "
+            f"the record ({tracking['held_out_rms_um']:.3g} µm) than the estimate above: a "
+            "reference that turns inside the range may track that much worse. Record more "
+            "turning points (hystcomp excite rich), or compare the other models."
+        )
     if chosen_range is not None and allow_extrapolation:
         why = extrapolation_error(chosen_range, v)
         if why is not None:  # allowed, and still said: the estimate does not cover it
