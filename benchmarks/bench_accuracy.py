@@ -46,6 +46,8 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
+import itertools
+
 from benchmarks.panel import ACTUATORS, EXCITATIONS, HELD_OUT, V_MAX, Bench, excitation
 
 from hystcomp import ModifiedPrandtlIshlinskii, PrandtlIshlinskii, Preisach
@@ -268,6 +270,172 @@ def format_table(table, columns=("PI", "MPI", "Preisach")) -> str:
     return "\n".join(lines)
 
 
+#: Auto's targets over the panel: the worst cell, and the share of cells within 1.2x of the
+#: best family; the estimate's: the share of cells within 1.5x of the measured tracking.
+AUTO_WORST, AUTO_NEAR, ESTIMATE_WITHIN = 0.15, 0.9, 0.9
+#: The inner turns of :func:`turning_reference`, as shares of the triangle's span.
+TURNS = (0.0, 1.0, 0.35, 0.75, 0.15, 0.6, 0.45, 0.9, 0.0, 0.5, 0.3, 1.0, 0.0)
+
+
+def turning_reference(bench: Bench) -> tuple[np.ndarray, int]:
+    """A reference over the bench triangle's span that turns inside it (:data:`TURNS`), at
+    the triangle's slope; and the first sample scored (after its first visit to the top,
+    when the memory no longer depends on the start)."""
+    fs = bench.act.sample_rate
+    lo, hi = bench.x_low, float(bench.x_ref.max())
+    points = lo + (hi - lo) * np.asarray(TURNS)
+    slope = 2.0 * (hi - lo)  # µm/s, a 1 Hz triangle's
+    parts = [
+        np.linspace(a, b, max(2, int(abs(b - a) / slope * fs)))[1:]
+        for a, b in itertools.pairwise(points)
+    ]
+    ref = np.r_[points[0], np.concatenate(parts)]
+    return ref, int(np.argmax(ref >= hi - 1e-9))
+
+
+def estimate_table(actuators=ACTUATORS, excitations=EXCITATIONS) -> list[dict]:
+    """Every family of every cell identified as ``hystcomp identify --model auto`` does
+    (:func:`hystcomp.workflows.auto.identify_best`), with its estimates and what it
+    measures: ``[{stage, record, family, chosen, estimate, held_out, triangle, turning,
+    baseline, warned}]`` (µm; ``triangle`` the bench's 1 Hz triangle, ``turning`` the
+    reference of :func:`turning_reference`, ``warned`` whether ``identify`` warned)."""
+    from hystcomp.io.records import Record
+    from hystcomp.workflows.auto import identify_best
+
+    out = []
+    for name in actuators:
+        bench = Bench(name)
+        turning, skip = turning_reference(bench)
+        for exc in excitations:
+            v, x = bench.record(exc)
+            record = Record(np.arange(v.size) / bench.act.sample_rate, v, x, source=exc)
+            chosen = identify_best(record)
+            for kind, result in chosen.results.items():
+                model = result.model
+                v_turn = model.inverse().simulate(turning)
+                e_turn = bench.act.run(v_turn)[skip:] - turning[skip:]
+                out.append(
+                    {
+                        "stage": name,
+                        "record": exc,
+                        "family": kind,
+                        "chosen": kind == chosen.best.kind,
+                        "estimate": result.tracking["tracking_rms_um"],
+                        "held_out": result.tracking["held_out_rms_um"],
+                        "triangle": bench.ratio(model) * bench.baseline_rms,
+                        "turning": float(np.sqrt(np.mean(e_turn**2))),
+                        "baseline": bench.baseline_rms,
+                        "warned": bool(result.warnings),
+                    }
+                )
+    return out
+
+
+def estimate_summary(rows: list[dict]) -> dict:
+    """Auto's worst cell and its share within 1.2x of the best family; the estimate's share
+    within 1.5x of the measured triangle, and its cells more than 2x optimistic (and
+    whether each was warned about); the held-out error's share within 1.5x of the turning
+    reference."""
+    cells: dict = {}
+    for row in rows:
+        cells.setdefault((row["stage"], row["record"]), []).append(row)
+    regrets, auto = [], []
+    for group in cells.values():
+        best = min(r["triangle"] for r in group)
+        pick = next(r for r in group if r["chosen"])
+        regrets.append(pick["triangle"] / best)
+        auto.append((pick["triangle"] / pick["baseline"], pick["stage"], pick["record"]))
+    ratio = np.array([r["estimate"] / r["triangle"] for r in rows])
+    held = np.array([r["held_out"] / r["turning"] for r in rows if np.isfinite(r["held_out"])])
+    optimistic = [r for r in rows if r["estimate"] < 0.5 * r["triangle"]]
+    return {
+        "auto_worst": max(auto),
+        "auto_near": float(np.mean(np.array(regrets) <= 1.2)),
+        "auto_regret_worst": float(max(regrets)),
+        "estimate_within": float(np.mean((ratio <= 1.5) & (ratio >= 1.0 / 1.5))),
+        "estimate_range": (float(ratio.min()), float(ratio.max())),
+        "optimistic": len(optimistic),
+        "optimistic_unwarned": sum(not r["warned"] for r in optimistic),
+        "held_out_within": float(np.mean((held <= 1.5) & (held >= 1.0 / 1.5))),
+    }
+
+
+def draw_estimates(rows: list[dict], path) -> None:
+    """Predicted against measured tracking, every cell, both estimates (docs/)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from matplotlib import pyplot as plt
+
+    fig, axes = plt.subplots(1, 2, figsize=(9.0, 4.2))
+    marks = {"pi": "s", "mpi": "o", "preisach": "^"}
+    panels = (
+        ("estimate", "triangle", "over the range: a 1 Hz triangle"),
+        ("held_out", "turning", "turning inside the range"),
+    )
+    for ax, (predicted, measured, title) in zip(axes, panels, strict=True):
+        for kind, mark in marks.items():
+            mine = [r for r in rows if r["family"] == kind and np.isfinite(r[predicted])]
+            ax.loglog(
+                [r[measured] for r in mine],
+                [r[predicted] for r in mine],
+                mark,
+                ms=4,
+                alpha=0.7,
+                label={"pi": "PI", "mpi": "MPI", "preisach": "Preisach"}[kind],
+            )
+        lims = np.array([0.01, 3.0])
+        ax.plot(lims, lims, "k-", lw=0.8, label="estimate = measured")
+        ax.plot(lims, 1.5 * lims, "k:", lw=0.8, label="1.5x either way")
+        ax.plot(lims, lims / 1.5, "k:", lw=0.8)
+        ax.set_xlim(*lims)
+        ax.set_ylim(*lims)
+        ax.set_xlabel(f"measured tracking rms, {title} (µm)")
+        ax.set_ylabel("estimated by hystcomp identify (µm)")
+        ax.grid(True, which="both", alpha=0.3)
+    axes[0].legend(fontsize=8, loc="upper left")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def estimate_rows(rows: list[dict]) -> list[dict]:
+    """Rows for benchmarks/run.py from :func:`estimate_summary`."""
+    s = estimate_summary(rows)
+    worst, stage, record = s["auto_worst"]
+    return [
+        {
+            "name": f"auto: worst cell of the panel ({stage}, {record}), 1 Hz tracking / "
+            "uncompensated",
+            "value": worst,
+            "unit": "x",
+            "target": f"<= {AUTO_WORST:g}",
+            "ok": worst <= AUTO_WORST,
+        },
+        {
+            "name": "auto: share of cells within 1.2x of the best family",
+            "value": s["auto_near"],
+            "unit": "",
+            "target": f">= {AUTO_NEAR:g}",
+            "ok": s["auto_near"] >= AUTO_NEAR,
+        },
+        {
+            "name": "estimate: share of cells within 1.5x of the measured tracking",
+            "value": s["estimate_within"],
+            "unit": "",
+            "target": f">= {ESTIMATE_WITHIN:g}",
+            "ok": s["estimate_within"] >= ESTIMATE_WITHIN,
+        },
+        {
+            "name": "estimate: cells more than 2x optimistic without a warning",
+            "value": float(s["optimistic_unwarned"]),
+            "unit": "",
+            "target": "0",
+            "ok": s["optimistic_unwarned"] == 0,
+        },
+    ]
+
+
 def run() -> list[dict]:
     """Rows for benchmarks/run.py: the worst cell per method and excitation, the worst and
     median cell of each Preisach fit, and the criterion."""
@@ -301,6 +469,7 @@ def run() -> list[dict]:
                     "ok": None,
                 }
             )
+    rows += estimate_rows(estimate_table())
     ranks = criterion_rank_correlation()
     for crit, (rhos, regrets) in ranks.items():
         rows.append(
@@ -339,6 +508,18 @@ if __name__ == "__main__":
                 f"{name} quasi-static, from {label}: best MPI {ratio:.3f} ({n} operators, "
                 f"regularization {value:g})"
             )
+    if "--estimate" in sys.argv or "--figure" in sys.argv:
+        found = estimate_table(stages)
+        for r in found:
+            print(
+                f"{r['stage']:<9} {r['record']:<9} {r['family']:<9} "
+                f"{'chosen' if r['chosen'] else '':<6} estimate {r['estimate']:.3f} "
+                f"measured {r['triangle']:.3f} | held out {r['held_out']:.3f} turning "
+                f"{r['turning']:.3f}{' (warned)' if r['warned'] else ''}"
+            )
+        print(estimate_summary(found))
+        if "--figure" in sys.argv:
+            draw_estimates(found, sys.argv[sys.argv.index("--figure") + 1])
     if "--coverage" in sys.argv:
         rows = coverage(stages)
         for row in rows:

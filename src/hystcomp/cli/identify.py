@@ -49,7 +49,7 @@ MAX_GRID = MAX_LSQ_GRID
 def _check_options(kind: str, given: dict) -> None:
     """Refuse, in the command's words, an option that --model (or --everett) does not take."""
     for name, value in given.items():
-        if value is not None and name not in SIZE_OPTIONS[kind]:
+        if value is not None and kind != "auto" and name not in SIZE_OPTIONS[kind]:
             option = name.replace("_", "-")
             raise click.UsageError(f"--{option} does not apply to --model {kind}.")
     if given["everett"] == "table" and given["degree"] is not None:
@@ -81,7 +81,14 @@ def _regularization(ctx, param, value):
 @main.command("identify")
 @click.argument("data", metavar="DATA")
 @click.option(
-    "--model", "kind", type=click.Choice(list(LABELS)), required=True, help="Model family."
+    "--model",
+    "kind",
+    type=click.Choice(["auto", *LABELS]),
+    default="auto",
+    show_default=True,
+    help="Model family; auto fits PI, MPI and Preisach and keeps the one whose compensator "
+    "is predicted to track best (the ranking is printed); dynamics: the linear dynamics "
+    "alone.",
 )
 @click.option(
     "--operators", type=int, default=None, callback=count, help="Number of plays n+1 [16]."
@@ -273,7 +280,8 @@ def identify(
     options.update(regularization=regularization, degree=degree, fit=fit, everett=everett)
     options.update(grid=grid, constraints=constraints, initial_memory=initial_memory)
     _check_options(kind, options)
-    model = build_estimator(kind, voltage_range=voltage_range, **options)
+    if kind != "auto":
+        model = build_estimator(kind, voltage_range=voltage_range, **options)
     rec = read_record(data, **read_options(columns, sample_rate, x_unit, quiet, data))
     warn_x_unit(rec.x, data, quiet, x_unit)
     n = len(rec)
@@ -294,12 +302,29 @@ def identify(
     fitting = {
         "allow_extrapolation": allow_extrapolation,
         "transient": transient,
-        "progress": progress(f"identifying the {LABELS[kind]} model", quiet).ticking(),
         "unit_check": False,  # checked above, before the fit, and silenced by --quiet
     }
+    lines: list[str] = []
+    if kind == "auto":
+        from hystcomp.workflows.auto import identify_best
+
+        given = {k: v for k, v in options.items() if v is not None}
+        chosen = identify_best(
+            rec,
+            voltage_range=voltage_range,
+            holdout=None if dynamics_record is not None else holdout,
+            progress=lambda k: progress(f"identifying the {LABELS[k]} model", quiet).ticking(),
+            **given,
+            **fitting,
+        )
+        lines += chosen.lines
+        kind = chosen.best.kind
+        options = {k: v for k, v in given.items() if k in SIZE_OPTIONS[kind]}
+        model = build_estimator(kind, voltage_range=voltage_range, **options)
+    fitting["progress"] = progress(f"identifying the {LABELS[kind]} model", quiet).ticking()
     if dynamics_record is None:
-        result = identify_record(rec, model, holdout=holdout, **fitting)
-        lines, warnings, written = result.lines, result.warnings, result.model
+        result = chosen.best if lines else identify_record(rec, model, holdout=holdout, **fitting)
+        lines, warnings, written = lines + result.lines, result.warnings, result.model
     else:
         from hystcomp.workflows.pair import identify_pair_record
 
@@ -311,7 +336,7 @@ def identify(
         dyn = read_record(dynamics_record, **read_options(columns, sample_rate))
         paired = identify_pair_record(rec, dyn, model, **fitting)
         result = paired.hysteresis
-        lines = result.lines + paired.lines
+        lines = lines + result.lines + paired.lines
         warnings = result.warnings + paired.warnings
         written = paired.model
     for line in lines:
