@@ -18,8 +18,12 @@ def plot_bode(model, path, *, measured=None) -> None:
     """Bode plot of ``model`` (magnitude in dB, phase in degrees) from 1 Hz to 0.45 fs.
 
     ``measured`` is an optional ``(frequencies, response)`` pair drawn as dots; by default
-    nothing measured is drawn.
+    the response measured at the multisine's lines when the model was identified (its
+    ``fit_report_``), divided by the fit's free complex gain (the hysteresis model's gain
+    and phase that the fit took up), so that it lies on the model where the model fits.
     """
+    if measured is None:
+        measured = measured_response(model)
     f = np.geomspace(1.0, 0.45 * model.sample_rate_, 600)
     d = model.frequency_response(f)
     fig = new_figure((6.4, 5.2))
@@ -28,7 +32,9 @@ def plot_bode(model, path, *, measured=None) -> None:
     phase.semilogx(f, np.degrees(np.unwrap(np.angle(d))))
     if measured is not None:
         fm, g = measured
-        mag.semilogx(fm, 20 * np.log10(np.abs(g)), ".", ms=3, label="measured")
+        behind = (getattr(model, "fit_report_", {}) or {}).get("input") == "hysteresis model"
+        label = "measured, X / H[V]" if behind else "measured, X / V"
+        mag.semilogx(fm, 20 * np.log10(np.abs(g)), ".", ms=3, label=label)
         phase.semilogx(fm, np.degrees(np.unwrap(np.angle(g))), ".", ms=3)
     mag.set_ylabel("magnitude (dB)")
     phase.set_ylabel("phase (deg)")
@@ -42,6 +48,19 @@ def plot_bode(model, path, *, measured=None) -> None:
     mag.legend(loc="lower left")
     fig.tight_layout()
     save_figure(fig, path, dpi=fig.dpi)
+
+
+def measured_response(model):
+    """``(frequencies, response)`` measured at identification, on the model's scale, or None."""
+    report = getattr(model, "fit_report_", {}) or {}
+    found = report.get("measured_response")
+    if not isinstance(found, dict) or not found.get("hz"):
+        return None
+    g = np.asarray(found["real"], dtype=float) + 1j * np.asarray(found["imag"], dtype=float)
+    gain = report.get("input_gain", 1.0) * np.exp(
+        1j * np.radians(report.get("input_phase_deg", 0.0))
+    )
+    return np.asarray(found["hz"], dtype=float), g / gain
 
 
 def plot_step(t, x_ref, runs: dict, path) -> None:

@@ -314,6 +314,7 @@ def fit_dynamics(v, x, sample_rate: float, *, u=None) -> DynamicsFit:
     }
     report = _report(parameters, lags, measured, lines, rise, step_fit)
     raw = measured / advance  # as the rig answered, its latency in
+    report["input"] = "voltage" if u is v else "hysteresis model"
     report["measured_response"] = {
         "hz": lines.tolist(),
         "real": raw.real.tolist(),
