@@ -331,6 +331,19 @@ def estimate_table(actuators=ACTUATORS, excitations=EXCITATIONS) -> list[dict]:
     return out
 
 
+def auto_table(rows: list[dict]) -> dict:
+    """``{(stage, record): {PI, MPI, Preisach, auto: ratio}}`` from :func:`estimate_table`:
+    each family's 1 Hz tracking over the uncompensated, and that of the family auto chose."""
+    names = {"pi": "PI", "mpi": "MPI", "preisach": "Preisach"}
+    table: dict = {}
+    for r in rows:
+        cells = table.setdefault((r["stage"], r["record"]), {})
+        cells[names[r["family"]]] = r["triangle"] / r["baseline"]
+        if r["chosen"]:
+            cells["auto"] = r["triangle"] / r["baseline"]
+    return table
+
+
 def estimate_summary(rows: list[dict]) -> dict:
     """Auto's worst cell and its share within 1.2x of the best family; the estimate's share
     within 1.5x of the measured triangle, and its cells more than 2x optimistic (and
@@ -517,6 +530,7 @@ if __name__ == "__main__":
                 f"measured {r['triangle']:.3f} | held out {r['held_out']:.3f} turning "
                 f"{r['turning']:.3f}{' (warned)' if r['warned'] else ''}"
             )
+        print(format_table(auto_table(found), columns=("PI", "MPI", "Preisach", "auto")))
         print(estimate_summary(found))
         if "--figure" in sys.argv:
             draw_estimates(found, sys.argv[sys.argv.index("--figure") + 1])
