@@ -300,7 +300,7 @@ def fit_dynamics(v, x, sample_rate: float, *, u=None) -> DynamicsFit:
     weights, step_fit = _fit_creep(rise, fn, zeta, fs, lags)
     # the step's creep goes on through the multisine: take it out and fit again
     ramp = np.r_[np.zeros(step), np.ones(v.size - step)]
-    drift = step_fit * output(ramp, 0.0, fs, fn, zeta, lags, weights, delay)
+    drift = step_fit * output(ramp, 0.0, fs, ((fn, zeta, 1.0),), lags, weights, delay)
     measured = _frf(u, x - drift, multisine, n_period, periods, bins) * advance
     fn, zeta, _ = _fit_resonance(measured, lines, fs, lags, weights, guess=(fn, zeta))
     weights, step_fit = _fit_creep(rise, fn, zeta, fs, lags)
@@ -531,13 +531,13 @@ def _report(parameters, lags, measured, lines, rise, step_fit) -> dict:
     weights = np.asarray(parameters["creep_weights"])
     top = min(2.0 * fn, lines.max())
     use = (lines >= FIT_FROM_HZ) & (lines <= top)
-    m = frequency_response(lines[use], fs, fn, zeta, lags, weights)
+    m = frequency_response(lines[use], fs, ((fn, zeta, 1.0),), lags, weights)
     g = measured[use]
     gain = np.vdot(m, g) / np.vdot(m, m)
     fit = 100.0 * (1.0 - np.linalg.norm(gain * m - g) / np.linalg.norm(g - g.mean()))
     db = np.abs(20.0 * np.log10(np.abs(gain * m) / np.abs(g)))
     unit = np.r_[0.0, np.ones(rise.size - 1)]
-    step_model = step_fit * output(unit, 0.0, fs, fn, zeta, lags, weights)
+    step_model = step_fit * output(unit, 0.0, fs, ((fn, zeta, 1.0),), lags, weights)
     step_rms = float(np.sqrt(np.mean((step_model - rise) ** 2)))
     after_1s = creep_fraction(1.0, parameters["creep_time_constants"], weights)
     return {
