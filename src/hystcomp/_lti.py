@@ -68,8 +68,15 @@ def creep_response(lags, weights, z1) -> np.ndarray:
 def resonance_response(b, a, z1) -> np.ndarray:
     """``R`` at ``z^-1 = z1``: ``(b0 z^-1 + b1 z^-2) / (1 + a1 z^-1 + a2 z^-2)`` (and alike
     for the higher orders of :func:`modal_tf`: ``b[k]`` multiplies ``z^-(k + 1)``)."""
-    num = sum(bk * z1 ** (k + 1) for k, bk in enumerate(b))
-    return num / sum(ak * z1**k for k, ak in enumerate(a))
+    if len(a) == 3:  # one mode
+        return (b[0] * z1 + b[1] * z1**2) / (a[0] + a[1] * z1 + a[2] * z1**2)
+    num = np.zeros_like(z1)
+    for bk in b[::-1]:  # Horner in z^-1
+        num = (num + bk) * z1
+    den = np.zeros_like(z1)
+    for ak in a[::-1]:
+        den = den * z1 + ak
+    return num / den
 
 
 def creep_lags(time_constants, sample_rate: float) -> np.ndarray:
