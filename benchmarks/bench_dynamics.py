@@ -137,7 +137,11 @@ def _harmonics(dynamics, peak_to_peak, frequency, lead):
     k = np.arange(1, int(0.5 * fs / frequency), 2)
     amp = 4.0 * peak_to_peak / (np.pi**2 * k**2)
     z = np.exp(2j * np.pi * k * frequency / fs)
-    m = ((b[0] * z + b[1]) / (z**2 + a[1] * z + a[2]))[:, None] * z[:, None] ** np.asarray(lead)
+    n = a.size - 1  # R(z) in powers of z, one mode's (b0 z + b1) / (z^2 + a1 z + a2) or two
+    r = sum(c * z ** (n - 1 - j) for j, c in enumerate(b)) / sum(
+        c * z ** (n - j) for j, c in enumerate(a)
+    )
+    m = r[:, None] * z[:, None] ** np.asarray(lead)
     return np.vstack([m.real, m.imag]) * np.r_[amp, amp][:, None], np.r_[amp, np.zeros_like(amp)]
 
 

@@ -43,10 +43,12 @@ stage             hysteresis    modes: Hz (damping ratio)      creep            
   there: no finite bank of lags is exact.
 
 :meth:`DynamicsStage.true_dynamics` gives the linear part as a
-:class:`hystcomp.LinearDynamics`: exact where the structure allows (one mode, creep by lags);
-for ``narrow1200`` its dominant mode alone, and for the log-uniform creep of ``boucwen630``
-and ``kp800`` lags fitted to its step response (one per half decade, non-negative least
-squares); :attr:`DynamicsStage.dynamics_exact` says which.
+:class:`hystcomp.LinearDynamics`: exact where the structure allows (one mode or two in
+parallel, creep by lags); for the log-uniform creep of ``boucwen630`` and ``kp800`` lags
+fitted to its step response (one per half decade, non-negative least squares);
+:attr:`DynamicsStage.dynamics_exact` says which. (``LinearDynamics`` held one mode before it
+held two: the bound of ``narrow1200`` was then its dominant mode alone,
+:meth:`LinearPart.true_dynamics` with ``modes=1``.)
 
 Tuning and holding out: defaults are chosen on :data:`DYNAMICS_STAGES`;
 :data:`DYNAMICS_HELD_OUT` (``kp800``, whose hysteresis kind is held out of the accuracy panel
@@ -237,12 +239,20 @@ class LinearPart:
     @property
     def exact(self) -> bool:
         """Whether :meth:`true_dynamics` is this linear part exactly."""
-        return isinstance(self.creep, LagCreep) and len(self.modes) == 1
+        return isinstance(self.creep, LagCreep) and len(self.modes) <= 2
 
-    def true_dynamics(self) -> LinearDynamics:
-        """The part as a :class:`hystcomp.LinearDynamics`: the dominant mode (the first)
-        alone, and the creep's lags (exact or fitted, see :attr:`exact`)."""
+    def true_dynamics(self, modes: int = 2) -> LinearDynamics:
+        """The part as a :class:`hystcomp.LinearDynamics`: its first ``modes`` modes (a
+        second one's weight its share of the static gain; ``modes=1``, the dominant mode
+        alone at unit gain), and the creep's lags (exact or fitted, see :attr:`exact`)."""
         taus, weights = self.creep.lags(self.sample_rate)
+        second = {}
+        if modes > 1 and len(self.modes) > 1:
+            second = {
+                "second_resonance_hz": self.modes[1].hz,
+                "second_damping_ratio": self.modes[1].damping,
+                "second_mode_gain": self.modes[1].weight,
+            }
         return LinearDynamics.from_parameters(
             sample_rate=self.sample_rate,
             resonance_hz=self.modes[0].hz,
@@ -250,6 +260,7 @@ class LinearPart:
             creep_time_constants=taus,
             creep_weights=weights,
             delay_samples=self.latency,
+            **second,
         )
 
 
@@ -339,9 +350,9 @@ class DynamicsStage:
         x = self.linear(self.hysteresis(v), rest=0.0)
         return x + NOISE_UM * self._rng.standard_normal(x.size)
 
-    def true_dynamics(self) -> LinearDynamics:
+    def true_dynamics(self, modes: int = 2) -> LinearDynamics:
         """:meth:`LinearPart.true_dynamics` (see :attr:`dynamics_exact`)."""
-        return self.linear_part.true_dynamics()
+        return self.linear_part.true_dynamics(modes)
 
     @property
     def dynamics_exact(self) -> bool:

@@ -125,7 +125,7 @@ def test_the_twin_as_a_system_equals_twin_run_noise_included():
         hystcomp.to_control(Twin(), 1e-3)
 
 
-def _dynamics():
+def _dynamics(**changes):
     from hystcomp.models.dynamics import LinearDynamics
 
     return LinearDynamics.from_parameters(
@@ -134,11 +134,28 @@ def _dynamics():
         damping_ratio=0.05,
         creep_time_constants=[0.01, 0.3],
         creep_weights=[0.02, 0.01],
+        **changes,
     )
 
 
-def test_linear_dynamics_as_a_system_equals_its_simulate():
-    dyn = _dynamics()
+@pytest.mark.parametrize(
+    "changes",
+    [
+        {},
+        {"delay_samples": 3},
+        {"delay_samples": -1},
+        {"second_resonance_hz": 2100.0, "second_damping_ratio": 0.03, "second_mode_gain": 0.1},
+        {
+            "second_resonance_hz": 2100.0,
+            "second_damping_ratio": 0.03,
+            "second_mode_gain": 0.1,
+            "delay_samples": 2,
+        },
+    ],
+    ids=["one mode", "latency", "early", "two modes", "two modes, latency"],
+)
+def test_linear_dynamics_as_a_system_equals_its_simulate(changes):
+    dyn = _dynamics(**changes)
     rng = np.random.default_rng(3)
     v = np.cumsum(rng.normal(0.0, 0.5, 3000))
     response = _response(hystcomp.to_control(dyn, DT), v)

@@ -33,7 +33,7 @@ MODES = {
     "narrow400": (400.0, 0.2, 1.0, 5.0, 0, True),
     "boucwen630": (630.0, 0.12, 1.0, 3.0, 0, False),
     "maxwell900": (900.0, 0.07, 1.0, 2.0, 2, True),
-    "narrow1200": (1200.0, 0.05, 0.92, 3.0, 0, False),
+    "narrow1200": (1200.0, 0.05, 0.92, 3.0, 0, True),
     "boucwen2000": (2000.0, 0.02, 1.0, 1.0, 1, True),
     "maxwell1500": (1500.0, 0.035, 1.0, 4.0, 0, True),
     "kp800": (800.0, 0.1, 1.0, 2.5, 1, False),
@@ -166,23 +166,28 @@ def test_linear_part_latency_and_creep(name):
 
 @pytest.mark.parametrize("name", DYNAMICS)
 def test_true_dynamics_is_linear_where_exact(name):
-    """``true_dynamics()`` is the linear part exactly on single-mode stages with creep by
-    lags; elsewhere an approximation (the dominant mode, or lags fitted to a continuum)
-    with the stage's mode and latency."""
-    hz, zeta, _, _, latency, exact = MODES[name]
+    """``true_dynamics()`` is the linear part exactly on stages with creep by lags (one mode
+    or two in parallel); elsewhere an approximation (lags fitted to a continuum) with the
+    stage's modes and latency. ``true_dynamics(1)``, the dominant mode alone, leaves a
+    second mode out."""
+    hz, zeta, weight, _, latency, exact = MODES[name]
     st = dp.stage(name)
     assert st.dynamics_exact == exact
     dyn = st.true_dynamics()
     assert (dyn.resonance_hz_, dyn.damping_ratio_, dyn.delay_samples_) == (hz, zeta, latency)
+    assert dyn.modes[0][2] == pytest.approx(weight, abs=1e-15)
     u = 20.0 + np.cumsum(np.random.default_rng(0).normal(0.0, 0.5, 20_000))
     x = st.linear(u)
     error = np.max(np.abs(dyn.simulate(u) - x)) / np.ptp(u)
     if exact:
         assert error < 1e-12
-    elif dp.SPECS[name][1].creep.__class__ is dp.LogCreep:
-        assert error < 1e-3  # lags fitted to the continuum: close, not exact
     else:
-        assert error > 1e-3  # the second mode is left out
+        assert error < 1e-3  # lags fitted to the continuum: close, not exact
+    dominant = np.max(np.abs(st.true_dynamics(1).simulate(u) - x)) / np.ptp(u)
+    if weight < 1.0:
+        assert dominant > 1e-3  # the second mode is left out
+    else:
+        assert dominant == error
 
 
 def test_log_creep_is_a_continuum_of_lags():

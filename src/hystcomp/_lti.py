@@ -66,8 +66,17 @@ def creep_response(lags, weights, z1) -> np.ndarray:
 
 
 def resonance_response(b, a, z1) -> np.ndarray:
-    """``R`` at ``z^-1 = z1``: ``(b0 z^-1 + b1 z^-2) / (1 + a1 z^-1 + a2 z^-2)``."""
-    return (b[0] * z1 + b[1] * z1**2) / (a[0] + a[1] * z1 + a[2] * z1**2)
+    """``R`` at ``z^-1 = z1``: ``(b0 z^-1 + b1 z^-2) / (1 + a1 z^-1 + a2 z^-2)`` (and alike
+    for the higher orders of :func:`modal_tf`: ``b[k]`` multiplies ``z^-(k + 1)``)."""
+    if len(a) == 3:  # one mode
+        return (b[0] * z1 + b[1] * z1**2) / (a[0] + a[1] * z1 + a[2] * z1**2)
+    num = np.zeros_like(z1)
+    for bk in b[::-1]:  # Horner in z^-1
+        num = (num + bk) * z1
+    den = np.zeros_like(z1)
+    for ak in a[::-1]:
+        den = den * z1 + ak
+    return num / den
 
 
 def creep_lags(time_constants, sample_rate: float) -> np.ndarray:
@@ -75,22 +84,56 @@ def creep_lags(time_constants, sample_rate: float) -> np.ndarray:
     return np.exp(-1.0 / (sample_rate * np.asarray(time_constants, dtype=np.float64)))
 
 
-def frequency_response(
-    frequencies, sample_rate, resonance_hz, damping_ratio, lags, weights, delay: int = 0
-):
-    """``D(exp(j 2 pi f Ts))`` of the model (see :mod:`hystcomp.models.dynamics`), with
-    ``delay`` samples of latency beyond the sample-and-hold's one."""
+def modal_tf(modes, sample_rate: float):
+    """``(b, a)`` of the modes in parallel, ``R(z) = sum_i g_i R_i(z)``, as one transfer function.
+
+    ``modes`` are ``(resonance_hz, damping_ratio, share)`` triples, each ``R_i`` of
+    :func:`resonance_zoh`; ``b`` is the numerator in powers of ``z`` (one degree below
+    ``a``, strictly proper as each section is), ``a`` the product of the sections'
+    denominators (``a[0] = 1``). One mode of share 1 is :func:`resonance_zoh` itself.
+
+    Examples
+    --------
+    >>> b, a = modal_tf([(1200.0, 0.05, 0.92), (3100.0, 0.03, 0.08)], 20_000.0)
+    >>> b.size, a.size, round(float(np.polyval(b, 1.0) / np.polyval(a, 1.0)), 12)
+    (4, 5, 1.0)
+    """
+    sections = [(share, *resonance_zoh(hz, zeta, sample_rate)) for hz, zeta, share in modes]
+    a = np.ones(1)
+    for _, _, ai in sections:
+        a = np.polymul(a, ai)
+    b = np.zeros(a.size - 1)
+    for i, (share, bi, _) in enumerate(sections):
+        term = share * bi
+        for j, (_, _, aj) in enumerate(sections):
+            if j != i:
+                term = np.polymul(term, aj)
+        b[b.size - term.size :] += term
+    return b, a
+
+
+def modal_response(modes, sample_rate: float, z1) -> np.ndarray:
+    """``R = sum_i g_i R_i`` at ``z^-1 = z1`` (``modes`` as in :func:`modal_tf`)."""
+    out = np.zeros_like(z1)
+    for hz, zeta, share in modes:
+        b, a = resonance_zoh(hz, zeta, sample_rate)
+        out = out + share * resonance_response(b, a, z1)
+    return out
+
+
+def frequency_response(frequencies, sample_rate, modes, lags, weights, delay: int = 0):
+    """``D(exp(j 2 pi f Ts))`` of the model (see :mod:`hystcomp.models.dynamics`): the
+    ``modes`` in parallel (as in :func:`modal_tf`), with ``delay`` samples of latency
+    beyond the sample-and-hold's one."""
     f = np.asarray(frequencies, dtype=np.float64)
     z1 = np.exp(-2j * np.pi * f / sample_rate)  # z^-1
-    b, a = resonance_zoh(resonance_hz, damping_ratio, sample_rate)
-    return creep_response(lags, weights, z1) * resonance_response(b, a, z1) * z1**delay
+    return creep_response(lags, weights, z1) * modal_response(modes, sample_rate, z1) * z1**delay
 
 
-def output(
-    u, rest, sample_rate, resonance_hz, damping_ratio, lags, weights, delay: int = 0
-) -> np.ndarray:
-    """``D[u]`` from rest at ``rest``: the creep bank, then the resonance, ``delay`` samples
-    late (-1: a sample early, the sample-and-hold's own delay taken off)."""
+def output(u, rest, sample_rate, modes, lags, weights, delay: int = 0) -> np.ndarray:
+    """``D[u]`` from rest at ``rest``: the creep bank, then the modes in parallel (as in
+    :func:`modal_tf`), ``delay`` samples late (-1: a sample early, the sample-and-hold's
+    own delay taken off)."""
     q = np.ascontiguousarray(u, dtype=np.float64) - rest
     if delay < 0:  # the answer to u[k + 1] is known at k: hold the input one sample more
         q = np.r_[q, q[-1:]]
@@ -98,12 +141,22 @@ def output(
     for a, c in zip(lags, weights, strict=True):
         creep += c * lag(a, q)
     creep /= 1.0 + float(np.sum(weights))
-    out = resonance(resonance_zoh(resonance_hz, damping_ratio, sample_rate), creep)
+    out = modal(modes, sample_rate, creep)
     if delay < 0:
         out = out[1:]
     elif delay > 0:
         out = np.r_[np.zeros(min(delay, out.size)), out[: max(out.size - delay, 0)]]
     return rest + out
+
+
+def modal(modes, sample_rate: float, u) -> np.ndarray:
+    """``R[u]`` from rest at 0 for the modes in parallel (as in :func:`modal_tf`): each
+    section run on its own and the outputs summed (better conditioned than the product
+    form of :func:`modal_tf`)."""
+    out = np.zeros(np.shape(u))
+    for hz, zeta, share in modes:
+        out += share * resonance(resonance_zoh(hz, zeta, sample_rate), u)
+    return out
 
 
 def lag(a: float, u) -> np.ndarray:

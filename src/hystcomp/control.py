@@ -156,15 +156,13 @@ def _twin(twin, dt: float) -> DiscreteSystem:
 
 
 def _linear_dynamics(dyn, dt: float) -> DiscreteSystem:
-    """The linear dynamics ``D(z)`` (creep bank, then the resonance) as a state-space system.
+    """The linear dynamics ``D(z)`` (creep bank, then the modes) as a state-space system.
 
     The same transfer function as :meth:`LinearDynamics.simulate
     <hystcomp.models.dynamics.LinearDynamics.simulate>`, from rest at 0 (input ``v``, the
     output ``x`` of the hysteresis in µm, to the displacement ``x_d`` in µm).
     """
     from scipy.signal import tf2ss
-
-    from hystcomp import _lti
 
     _check_rate(dt, dyn.sample_rate_, "the dynamics model's", "identify it at that rate")
     lags, weights = dyn.creep_lags, dyn.creep_weights_
@@ -173,11 +171,12 @@ def _linear_dynamics(dyn, dt: float) -> DiscreteSystem:
     # y_c = (u + sum_i c_i w_i) / (1 + sum c),  s_i' = a_i s_i + (1 - a_i) u
     c_creep = weights * lags / scale
     d_creep = (1.0 + float(np.sum(weights * (1.0 - lags)))) / scale
-    # then the resonance (b0 z + b1) / (z^2 + a1 z + a2), strictly proper, fed y_c
-    b, a = _lti.resonance_zoh(dyn.resonance_hz_, dyn.damping_ratio_, dyn.sample_rate_)
+    # then the resonance (b0 z + b1) / (z^2 + a1 z + a2), strictly proper, fed y_c (or the
+    # two modes in parallel, one transfer function of order 4)
+    b, a = dyn.resonance()
     a_res, b_res, c_res, _ = tf2ss(b, a)
-    n = lags.size
-    A = np.zeros((n + 2, n + 2))
+    n, order = lags.size, a.size - 1
+    A = np.zeros((n + order, n + order))
     A[:n, :n] = np.diag(lags)
     A[n:, :n] = np.outer(b_res[:, 0], c_creep)
     A[n:, n:] = a_res
@@ -186,14 +185,14 @@ def _linear_dynamics(dyn, dt: float) -> DiscreteSystem:
     delay = dyn.delay_samples_
     if delay < 0:  # the answer of the same sample: the output after this sample's update
         return DiscreteSystem(
-            state=np.zeros(n + 2),
+            state=np.zeros(n + order),
             update=lambda s, u: A @ s + b_col * float(np.ravel(u)[0]),
             output=lambda s, u: float(c_row @ (A @ s + b_col * float(np.ravel(u)[0]))),
             inputs=("v",),
             outputs=("x",),
         )
     # the latency: the last `delay` outputs in a line after the states, the oldest out
-    m = n + 2
+    m = n + order
 
     def update(s, u):
         out = np.empty_like(s)

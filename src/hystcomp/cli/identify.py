@@ -243,8 +243,9 @@ def identify(
     start-up transient, the input range (bipolar too) and a displacement offset are handled.
     Preisach: least squares over any record with a tabulated Everett function by default;
     --fit reversal-curves --everett polynomial --constraints paper is the paper's fit (Section
-    III-A, eq. 5). dynamics (beyond the paper): creep and first resonance from the answer to
-    'hystcomp excite dynamics', for compensate/export-c --dynamics; --plot draws its Bode plot.
+    III-A, eq. 5). dynamics (beyond the paper): creep and first resonance (and a second mode
+    when the record shows one) from the answer to 'hystcomp excite dynamics', for
+    compensate/export-c --dynamics; --plot draws its Bode plot.
     By default the play weights beyond the first are non-negative (--constraints physical);
     --constraints paper --regularization 0 is eq. 19 as printed.
 

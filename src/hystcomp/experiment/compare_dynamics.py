@@ -153,9 +153,15 @@ def dynamics_markdown(dc: DynamicsComparison, table1: dict) -> list[str]:
     for method, pair in dc.pairs.items():
         d = pair.dynamics
         rep = d.fit_report_
+        second = (
+            ""
+            if d.second_mode_gain_ is None
+            else f", a second mode at {d.second_resonance_hz_:.4g} Hz (damping "
+            f"{d.second_damping_ratio_:.3g}, {100 * d.second_mode_gain_:.2g} % of the gain)"
+        )
         found.append(
             f"behind the {method.upper() if method == 'mpi' else method.title()} model, "
-            f"{d.resonance_hz_:.4g} Hz (damping {d.damping_ratio_:.3g}) and "
+            f"{d.resonance_hz_:.4g} Hz (damping {d.damping_ratio_:.3g}){second} and "
             f"{100 * d.creep_fraction(0.0):.2g} % of creep within the 3 s hold (frequency-"
             f"response fit {rep['fit_percent']:.3g} % up to {rep['fit_band_hz'][1]:.0f} Hz)"
         )

@@ -39,9 +39,15 @@ def plot_bode(model, path, *, measured=None) -> None:
     mag.set_ylabel("magnitude (dB)")
     phase.set_ylabel("phase (deg)")
     phase.set_xlabel("frequency (Hz)")
+    second = (
+        ""
+        if model.second_mode_gain_ is None
+        else f" + {model.second_resonance_hz_:.4g} Hz, zeta {model.second_damping_ratio_:.3g}"
+        f" ({100 * model.second_mode_gain_:.2g} %)"
+    )
     mag.set_title(
-        f"Linear dynamics: {model.resonance_hz_:.4g} Hz, zeta {model.damping_ratio_:.3g}, "
-        f"creep {100 * model.creep_fraction(0.0):.2g} %"
+        f"Linear dynamics: {model.resonance_hz_:.4g} Hz, zeta {model.damping_ratio_:.3g}"
+        f"{second}, creep {100 * model.creep_fraction(0.0):.2g} %"
     )
     mag.grid(True, which="both", alpha=0.3)
     phase.grid(True, which="both", alpha=0.3)

@@ -1,4 +1,4 @@
-"""Identification of the linear dynamics (creep and first resonance) of a hysteretic stage.
+"""Identification of the linear dynamics (creep, one or two resonances) of a hysteretic stage.
 
 The stage is a Hammerstein system, ``x = D[H[v]]``: a rate-independent hysteresis ``H``
 followed by linear dynamics ``D`` (Croft, Shed and Devasia 2001; the paper's Fig. 2 puts
@@ -20,7 +20,7 @@ response). Driven over most of the range, the stage's hysteresis is what its hys
 model describes, and ``X / H[V]`` is ``D``. The triangles are held out of every fit: the
 workflow estimates on them how well the compensators track at those rates.
 
-The fit, in four short stages:
+The fit, in five short stages:
 
 1. The frequency response ``X(f) / U(f)`` at the multisine's lines, from the average of
    its periods after the first (``u`` is periodic with ``v`` after one period, as a
@@ -33,8 +33,15 @@ The fit, in four short stages:
    from 1 ms to the hold's length); non-negative least squares (``scipy.optimize.nnls``).
 3. The multisine part again, with the step's continuing creep removed, and the resonance
    fitted again with the creep in the model.
-4. The fit report: fit % and largest magnitude error in the frequency domain up to twice
-   the resonance, rms error of the step response, and the measured frequency response
+4. A second mode, above the first and within the multisine's band, in parallel with it,
+   the latency freed again with the two (:mod:`hystcomp.identify.modes`): kept when it
+   explains the lines clearly better (:func:`~hystcomp.identify.modes.keeps_second_mode`;
+   its residual at most a quarter of one mode's), and then the creep fitted again with
+   both. The latency is then the two modes' fit's: a second mode's phase, which one mode
+   cannot follow, is not taken for latency.
+5. The fit report: fit % and largest magnitude error in the frequency domain up to twice
+   the highest mode, rms error of the step response, the number of modes (``modes``) and
+   the ratio that decided it (``residual_ratio``), and the measured frequency response
    (for the Bode figure).
 
 Only the *shape* of the dynamics is identified: the model is normalised to unit
@@ -60,13 +67,14 @@ from hystcomp._lti import (
     creep_response,
     frequency_response,
     lag,
+    modal,
     output,
-    resonance,
     resonance_response,
     resonance_zoh,
 )
 from hystcomp._validation import MAX_SIGNAL_SAMPLES, as_signal_pair, check_real
 from hystcomp.errors import IdentificationError, InvalidParameterError
+from hystcomp.identify.modes import fit_modes, keeps_second_mode
 
 
 class DynamicsFit(NamedTuple):
@@ -297,22 +305,49 @@ def fit_dynamics(v, x, sample_rate: float, *, u=None) -> DynamicsFit:
     delay = int(np.clip(round(tau), *DELAY_RANGE))  # the model's, in whole samples
     advance = np.exp(2j * np.pi * lines * tau / fs)  # the fit's: the fraction too
     rise = x[step + delay : multisine] - x0  # the answer to the step, from its own start
-    weights, step_fit = _fit_creep(rise, fn, zeta, fs, lags)
+    weights, step_fit = _fit_creep(rise, ((fn, zeta, 1.0),), fs, lags)
     # the step's creep goes on through the multisine: take it out and fit again
     ramp = np.r_[np.zeros(step), np.ones(v.size - step)]
-    drift = step_fit * output(ramp, 0.0, fs, fn, zeta, lags, weights, delay)
-    measured = _frf(u, x - drift, multisine, n_period, periods, bins) * advance
+    drift = step_fit * output(ramp, 0.0, fs, ((fn, zeta, 1.0),), lags, weights, delay)
+    clean = _frf(u, x - drift, multisine, n_period, periods, bins)  # its latency in
+    measured = clean * advance
     fn, zeta, _ = _fit_resonance(measured, lines, fs, lags, weights, guess=(fn, zeta))
-    weights, step_fit = _fit_creep(rise, fn, zeta, fs, lags)
+    modes: tuple[tuple[float, float, float], ...] = ((fn, zeta, 1.0),)
+    # a second mode, kept where it explains the lines clearly better; its latency then
+    use = lines >= FIT_FROM_HZ
+    creep = creep_response(lags, weights, np.exp(-2j * np.pi * lines[use] / fs))
+    one, two = fit_modes(
+        lines[use],
+        clean[use],
+        fs,
+        creep,
+        (fn, zeta),
+        tau,
+        delay_range=DELAY_RANGE,
+        max_damping=MAX_DAMPING,
+    )
+    if keeps_second_mode(one, two, float(lines.max())):
+        modes, tau = two.modes, two.tau
+        delay = int(np.clip(round(tau), *DELAY_RANGE))
+        advance = np.exp(2j * np.pi * lines * tau / fs)
+        rise = x[step + delay : multisine] - x0
+        measured = clean * advance
+    weights, step_fit = _fit_creep(rise, modes, fs, lags)
     parameters = {
         "sample_rate": fs,
-        "resonance_hz": fn,
-        "damping_ratio": zeta,
+        "resonance_hz": modes[0][0],
+        "damping_ratio": modes[0][1],
         "creep_time_constants": taus.tolist(),
         "creep_weights": weights.tolist(),
         "delay_samples": delay,
     }
-    report = _report(parameters, lags, measured, lines, rise, step_fit)
+    if len(modes) > 1:
+        parameters["second_resonance_hz"] = modes[1][0]
+        parameters["second_damping_ratio"] = modes[1][1]
+        parameters["second_mode_gain"] = modes[1][2]
+    report = _report(parameters, modes, lags, measured, lines, rise, step_fit)
+    report["modes"] = len(modes)
+    report["residual_ratio"] = two.residual / one.residual  # two modes' over one's
     raw = measured / advance  # as the rig answered, its latency in
     report["input"] = "voltage" if u is v else "hysteresis model"
     report["measured_response"] = {
@@ -494,15 +529,16 @@ def _fit_resonance(measured, lines, fs, lags, weights, guess):
     return float(fn), float(zeta), float(result.cost)
 
 
-def _fit_creep(rise, fn, zeta, fs, lags):
-    """Non-negative creep weights and the step's final height from the step response."""
+def _fit_creep(rise, modes, fs, lags):
+    """Non-negative creep weights and the step's final height from the step response
+    (``modes`` as in :func:`hystcomp._lti.modal_tf`)."""
     from scipy.optimize import nnls
 
     # the ringing is left out: a slightly wrong resonance there would outweigh the creep
-    start = min(rise.size // 2, round(RINGING_DECAYS * fs / (2.0 * np.pi * fn * zeta)))
+    decay = max(fs / (2.0 * np.pi * fn * zeta) for fn, zeta, _ in modes)
+    start = min(rise.size // 2, round(RINGING_DECAYS * decay))
     # samples spaced evenly in log time: each decade of creep weighs the same, and it is fast
     rows = np.unique(np.geomspace(start + 1, rise.size, CREEP_SAMPLES).astype(int) - 1)
-    ba = resonance_zoh(fn, zeta, fs)
     unit = np.ones(rise.size)
     # a mode settled to within 1 % where the samples start is nearly the unit column: the
     # least squares would trade a large weight of it against the direct term to take up
@@ -511,7 +547,8 @@ def _fit_creep(rise, fn, zeta, fs, lags):
     # was not enough: a mode 98.5 % settled took 4 % of a stage's step behind one
     # hysteresis model and 0 % behind another (a 1.5 kHz stage, 4 % creep from 0.1 s on)
     seen = lags ** (start + 1) > SETTLED
-    columns = [resonance(ba, unit)[rows]] + [resonance(ba, lag(a, unit))[rows] for a in lags[seen]]
+    columns = [modal(modes, fs, unit)[rows]]
+    columns += [modal(modes, fs, lag(a, unit))[rows] for a in lags[seen]]
     solved, _ = nnls(np.column_stack(columns), rise[rows])
     coef = np.zeros(lags.size + 1)
     coef[0] = solved[0]
@@ -526,19 +563,19 @@ def _fit_creep(rise, fn, zeta, fs, lags):
     return weights, float(coef.sum())
 
 
-def _report(parameters, lags, measured, lines, rise, step_fit) -> dict:
-    """Fit % and largest magnitude error (dB) up to twice the resonance; step rms error."""
-    fs, fn, zeta = (parameters[k] for k in ("sample_rate", "resonance_hz", "damping_ratio"))
+def _report(parameters, modes, lags, measured, lines, rise, step_fit) -> dict:
+    """Fit % and largest magnitude error (dB) up to twice the highest mode; step rms error."""
+    fs = parameters["sample_rate"]
     weights = np.asarray(parameters["creep_weights"])
-    top = min(2.0 * fn, lines.max())
+    top = min(2.0 * max(hz for hz, _, _ in modes), lines.max())
     use = (lines >= FIT_FROM_HZ) & (lines <= top)
-    m = frequency_response(lines[use], fs, fn, zeta, lags, weights)
+    m = frequency_response(lines[use], fs, modes, lags, weights)
     g = measured[use]
     gain = np.vdot(m, g) / np.vdot(m, m)
     fit = 100.0 * (1.0 - np.linalg.norm(gain * m - g) / np.linalg.norm(g - g.mean()))
     db = np.abs(20.0 * np.log10(np.abs(gain * m) / np.abs(g)))
     unit = np.r_[0.0, np.ones(rise.size - 1)]
-    step_model = step_fit * output(unit, 0.0, fs, fn, zeta, lags, weights)
+    step_model = step_fit * output(unit, 0.0, fs, modes, lags, weights)
     step_rms = float(np.sqrt(np.mean((step_model - rise) ** 2)))
     after_1s = creep_fraction(1.0, parameters["creep_time_constants"], weights)
     return {

@@ -40,15 +40,17 @@ def inverse_fir(resonance, bandwidth_hz: float, sample_rate: float):
     squares weighted by ``1 / (1 + (f / 0.3 bandwidth_hz)^2)`` (a triangle's harmonics fall
     as ``1 / f^2``): :func:`scipy.optimize.nnls` on the real and imaginary parts, the sum
     as a heavily weighted row. ``R(z)`` is the resonance with its sampling zero, fitted as
-    it is (nothing is inverted, so a zero beyond ``-1`` is no matter).
+    it is (nothing is inverted, so a zero beyond ``-1`` is no matter): the whole ``R`` of
+    :meth:`hystcomp.LinearDynamics.resonance`, both modes of a model that has two (the
+    FIR then undoes the second mode's share of the in-band lag too).
 
     Non-negative taps give the inverse of a step a monotone rise (no overshoot, no dip)
     and ``|G| <= 1`` at every frequency (the inverse never amplifies). They cannot invert
     ``R`` exactly in the band: the error grows as ``f^4``, 0.2 % at 100 Hz and 1.5 % at
     200 Hz for a 630 Hz, zeta 0.1 resonance at 20 kHz. ``P = ceil(fs / (2 f_n))`` (at
-    most ``MAX_PREVIEW``) leaves room for the half period of the resonance that the taps
-    span; zero taps at the ends are dropped, and the preview is the look-ahead of the
-    first tap left.
+    most ``MAX_PREVIEW``), ``f_n`` the first (lowest) mode, leaves room for the half
+    period of the resonance that the taps span; zero taps at the ends are dropped, and the
+    preview is the look-ahead of the first tap left.
     """
     from scipy.optimize import nnls
 
@@ -64,14 +66,19 @@ def band_fit(resonance, bandwidth_hz: float, sample_rate: float):
 
     ``design @ g - target`` is the weighted error of ``R(z) G(z)`` against 1 on the band,
     real parts over imaginary parts, for taps ``g`` with the look-aheads ``lead`` (from
-    ``P`` down to ``-P``).
+    ``P`` down to ``-P``). ``resonance`` is ``(b, a)`` in powers of ``z``, ``b`` one
+    degree below ``a``: one mode's ``(b0 z + b1) / (z^2 + a1 z + a2)`` or the modes in
+    parallel of :func:`hystcomp._lti.modal_tf`.
     """
-    b, a = resonance
+    b, a = (np.asarray(c, dtype=np.float64) for c in resonance)
     fn = _resonance_hz(a, sample_rate)
     half = min(max(2, math.ceil(0.5 * sample_rate / fn)), MAX_PREVIEW)
     f = np.linspace(0.0, bandwidth_hz, _FIT_POINTS)
     z = np.exp(2j * np.pi * f / sample_rate)
-    r = (b[0] * z + b[1]) / (z**2 + a[1] * z + a[2])
+    n = a.size - 1  # the order: powers z^n .. z^0 (as one mode's (b0 z + b1) / (z^2 + ...))
+    r = sum(c * z ** (n - 1 - k) for k, c in enumerate(b)) / sum(
+        c * z ** (n - k) for k, c in enumerate(a)
+    )
     lead = np.arange(half, -half - 1, -1)  # tap j multiplies z^(half - j)
     m = r[:, None] * np.exp(2j * np.pi * np.outer(f / sample_rate, lead))
     w = 1.0 / (1.0 + (f / (0.3 * bandwidth_hz)) ** 2)
@@ -79,9 +86,11 @@ def band_fit(resonance, bandwidth_hz: float, sample_rate: float):
 
 
 def _resonance_hz(a, sample_rate: float) -> float:
-    """The undamped natural frequency (Hz) of the discrete poles ``z^2 + a1 z + a2``."""
+    """The undamped natural frequency (Hz) of the discrete poles ``z^2 + a1 z + a2``; of
+    a higher order (modes in parallel), of the two slowest poles: the first mode's."""
     poles = np.roots(a).astype(complex)
     s = np.log(poles) * sample_rate
+    s = s[np.argsort(np.abs(s), kind="stable")]
     return float(np.sqrt(np.abs(s[0] * s[1]))) / (2.0 * np.pi)
 
 

@@ -1,4 +1,4 @@
-"""The linear dynamics of the actuator (creep and first resonance) and its stable inverse.
+"""The linear dynamics of the actuator (creep, one or two resonances) and its stable inverse.
 
 Beyond the paper: the paper's rig (its Fig. 2) puts the piezo dynamics ``D(s)`` after the
 hysteresis ``H``, and its compensators invert ``H`` alone, so that their error grows with
@@ -9,11 +9,15 @@ The model, in discrete time at the sample rate ``fs`` (``Ts = 1/fs``)::
 
     D(z) = z^-d C(z) R(z)
     C(z) = (1 + sum_i c_i (1 - a_i) / (1 - a_i z^-1)) / (1 + sum_i c_i),  a_i = exp(-Ts/tau_i)
-    R(z) = ZOH{ wn^2 / (s^2 + 2 zeta wn s + wn^2) } = (b1 z + b2) / (z^2 + a1 z + a2)
+    R(z) = R1(z)                          (one mode)
+    R(z) = (1 - g) R1(z) + g R2(z)        (two modes, in parallel)
+    Rk(z) = ZOH{ wk^2 / (s^2 + 2 zeta_k wk s + wk^2) } = (b1 z + b2) / (z^2 + a1 z + a2)
 
 ``C`` is a bank of first-order creep modes with log-spaced time constants ``tau_i`` and
 weights ``c_i >= 0`` (creep rising roughly as ``log t`` over the decades they span), ``R``
-the first resonance, discretised with a zero-order hold (exactly as a sampled rig sees it),
+the first resonance, or the first and a second, higher one in parallel (modal: each mode a
+second-order section of unit static gain, ``g`` the second's share of the static gain),
+each discretised with a zero-order hold (exactly as a sampled rig sees it),
 ``d`` the rig's latency in whole samples beyond the hold's one (converters, filters; -1
 for a record whose displacement answers the voltage of the same sample).
 Both have unit gain at steady state, ``D(1) = 1``, so the hysteresis model keeps its static
@@ -24,8 +28,9 @@ The inverse (:meth:`LinearDynamics.inverse`) is stable whatever was identified:
 
 * ``C`` is minimum phase (a sum of positive first-order lags has real zeros between its
   poles), and its inverse is computed exactly by solving the bank's equation each sample.
-* ``R`` itself, sampling zero ``b1 z + b2`` included (near ``-1`` at fast sampling,
-  beyond ``-1`` non-minimum phase), is never inverted: a FIR with non-negative taps
+* ``R`` itself, sampling zeros included (near ``-1`` at fast sampling, beyond ``-1``
+  non-minimum phase; with two modes, the zeros between them too), is never inverted: a
+  FIR with non-negative taps
   (:func:`~hystcomp.models.dynamic_compensator.inverse_fir`) is fitted so that ``R`` times
   it is close to 1 on ``0 .. bandwidth_hz``. Non-negative taps summing to 1 bound its gain
   by 1 at every frequency, and make the inverse of a step rise monotonically: no overshoot
@@ -85,7 +90,7 @@ DAMPING_RANGE = (1e-6, 1e3)
 
 
 class LinearDynamics:
-    """Creep modes and the first resonance of an actuator, with unit steady-state gain.
+    """Creep modes and the first resonance (and a second) of an actuator, unit steady-state gain.
 
     Build it with :meth:`from_parameters`, identify it with :meth:`fit`
     (``hystcomp identify --model dynamics``) or load it with :func:`hystcomp.load_model`.
@@ -96,6 +101,10 @@ class LinearDynamics:
         Hz; the model is discrete-time at this rate.
     resonance_hz_, damping_ratio_ : float
         The first resonance ``wn / 2 pi`` in Hz and its damping ratio.
+    second_resonance_hz_, second_damping_ratio_, second_mode_gain_ : float or None
+        The second mode, in parallel with the first and above it: Hz, damping ratio, and
+        its share ``g`` of the static gain (``0 < g < 1``; the first mode has ``1 - g``).
+        None for a model of one mode (and for model files written before it existed).
     creep_time_constants_ : ndarray
         ``tau_i`` in s.
     creep_weights_ : ndarray
@@ -122,6 +131,9 @@ class LinearDynamics:
         "creep_time_constants",
         "creep_weights",
         "delay_samples",
+        "second_resonance_hz",
+        "second_damping_ratio",
+        "second_mode_gain",
     )
     sample_rate_: float
     resonance_hz_: float
@@ -129,6 +141,9 @@ class LinearDynamics:
     creep_time_constants_: np.ndarray
     creep_weights_: np.ndarray
     delay_samples_: int
+    second_resonance_hz_: float | None
+    second_damping_ratio_: float | None
+    second_mode_gain_: float | None
 
     @classmethod
     def from_parameters(
@@ -140,37 +155,58 @@ class LinearDynamics:
         creep_time_constants=(),
         creep_weights=(),
         delay_samples=0,
+        second_resonance_hz=None,
+        second_damping_ratio=None,
+        second_mode_gain=None,
     ) -> LinearDynamics:
         """A model from its parameters (units as in the class attributes), validated.
 
         ``delay_samples`` (0 by default, and in model files written before it existed) is
-        the latency in whole samples beyond the sample-and-hold's one."""
+        the latency in whole samples beyond the sample-and-hold's one. The second mode
+        (``second_resonance_hz``, ``second_damping_ratio``, ``second_mode_gain``) is given
+        whole or not at all (None, the default and what model files written before it
+        existed hold: one mode)."""
         owner = cls.__name__
         model = cls()
         model.sample_rate_ = check_real(sample_rate, "sample_rate", owner, positive=True)
-        model.resonance_hz_ = check_real(resonance_hz, "resonance_hz", owner, positive=True)
-        model.damping_ratio_ = check_real(damping_ratio, "damping_ratio", owner, positive=True)
-        if model.resonance_hz_ >= 0.5 * model.sample_rate_:
+        model.resonance_hz_, model.damping_ratio_ = _check_mode(
+            resonance_hz, damping_ratio, model.sample_rate_, "", owner
+        )
+        second = {
+            "second_resonance_hz": second_resonance_hz,
+            "second_damping_ratio": second_damping_ratio,
+            "second_mode_gain": second_mode_gain,
+        }
+        given = [name for name, value in second.items() if value is not None]
+        model.second_resonance_hz_ = model.second_damping_ratio_ = None
+        model.second_mode_gain_ = None
+        if given and len(given) < len(second):
+            missing = ", ".join(repr(name) for name in second if name not in given)
             raise InvalidParameterError(
-                f"The 'resonance_hz' parameter of {owner} must be below the Nyquist frequency "
-                f"({0.5 * model.sample_rate_:g} Hz). Got {model.resonance_hz_:g}; identify "
-                "from a record sampled faster."
+                f"The second mode of {owner} needs 'second_resonance_hz', "
+                f"'second_damping_ratio' and 'second_mode_gain' together. Got "
+                f"{', '.join(repr(name) for name in given)} without {missing}; give all three, "
+                "or none for a model of one mode."
             )
-        if model.resonance_hz_ < MIN_RESONANCE * model.sample_rate_:
-            raise InvalidParameterError(
-                f"The 'resonance_hz' parameter of {owner} must be at least "
-                f"{MIN_RESONANCE:g} of the sample rate ({MIN_RESONANCE * model.sample_rate_:g} "
-                f"Hz at {model.sample_rate_:g} Hz): slower, the resonance's poles cannot be "
-                f"told from 1 in double precision. Got {model.resonance_hz_:g}; identify the "
-                "dynamics from a record (hystcomp identify --model dynamics)."
+        if given:
+            hz, zeta = _check_mode(
+                second_resonance_hz, second_damping_ratio, model.sample_rate_, "second_", owner
             )
-        if not DAMPING_RANGE[0] <= model.damping_ratio_ <= DAMPING_RANGE[1]:
-            raise InvalidParameterError(
-                f"The 'damping_ratio' parameter of {owner} must be in {DAMPING_RANGE[0]:g} .. "
-                f"{DAMPING_RANGE[1]:g} (outside, the resonance's poles leave double "
-                f"precision). Got {model.damping_ratio_:g}; identify the dynamics from a "
-                "record (hystcomp identify --model dynamics)."
-            )
+            if not hz > model.resonance_hz_:
+                raise InvalidParameterError(
+                    f"The 'second_resonance_hz' parameter of {owner} must be above "
+                    f"'resonance_hz' ({model.resonance_hz_:g} Hz): the first mode is the "
+                    f"lowest. Got {hz:g}; swap the two modes."
+                )
+            gain = check_real(second_mode_gain, "second_mode_gain", owner)
+            if not 0.0 < gain < 1.0:
+                raise InvalidParameterError(
+                    f"The 'second_mode_gain' parameter of {owner} is the second mode's share "
+                    f"of the static gain, in (0, 1) (the first mode has the rest). Got "
+                    f"{gain:g}; leave the second mode out (None) for a model of one mode."
+                )
+            model.second_resonance_hz_, model.second_damping_ratio_ = hz, zeta
+            model.second_mode_gain_ = gain
         if np.size(creep_time_constants) == 0 and np.size(creep_weights) == 0:  # no creep
             taus = weights = np.zeros(0)
         else:
@@ -218,13 +254,24 @@ class LinearDynamics:
             )
 
     @property
+    def modes(self) -> tuple[tuple[float, float, float], ...]:
+        """``((hz, damping ratio, share of the static gain), ...)``: the modes in parallel,
+        the first first (one or two; the shares sum to 1)."""
+        self._check_fitted()
+        hz, zeta, g = self.second_resonance_hz_, self.second_damping_ratio_, self.second_mode_gain_
+        if hz is None or zeta is None or g is None:
+            return ((self.resonance_hz_, self.damping_ratio_, 1.0),)
+        return ((self.resonance_hz_, self.damping_ratio_, 1.0 - g), (hz, zeta, g))
+
+    @property
     def creep_lags(self) -> np.ndarray:
         """``a_i = exp(-Ts / tau_i)``, the creep poles in discrete time."""
         return _lti.creep_lags(self.creep_time_constants_, self.sample_rate_)
 
     def resonance(self):
-        """``(b, a)`` of ``R(z)`` (see :func:`hystcomp._lti.resonance_zoh`)."""
-        return _lti.resonance_zoh(self.resonance_hz_, self.damping_ratio_, self.sample_rate_)
+        """``(b, a)`` of ``R(z)``, every mode (see :func:`hystcomp._lti.modal_tf`; one mode:
+        :func:`hystcomp._lti.resonance_zoh`)."""
+        return _lti.modal_tf(self.modes, self.sample_rate_)
 
     def frequency_response(self, frequencies) -> np.ndarray:
         """``D(exp(j 2 pi f Ts))`` at ``frequencies`` in Hz (complex, unit gain at 0 Hz)."""
@@ -232,8 +279,7 @@ class LinearDynamics:
         return _lti.frequency_response(
             as_vector(frequencies, "frequencies", "LinearDynamics.frequency_response"),
             self.sample_rate_,
-            self.resonance_hz_,
-            self.damping_ratio_,
+            self.modes,
             self.creep_lags,
             self.creep_weights_,
             self.delay_samples_,
@@ -248,8 +294,7 @@ class LinearDynamics:
             u,
             rest,
             self.sample_rate_,
-            self.resonance_hz_,
-            self.damping_ratio_,
+            self.modes,
             self.creep_lags,
             self.creep_weights_,
             self.delay_samples_,
@@ -374,14 +419,14 @@ class LinearDynamics:
         )
 
     def _inverse_fir(self, bandwidth_hz: float) -> tuple[np.ndarray, int]:
-        """:func:`inverse_fir` of this model's resonance, designed once per band.
+        """:func:`inverse_fir` of this model's modes, designed once per band.
 
-        The design (a non-negative least squares) depends only on the resonance, the
+        The design (a non-negative least squares) depends only on the modes, the
         sample rate and the band, which key the designs kept; a copy or a pickled model
         carries them (``hystcomp compare`` designs the inverse in the process that
         identifies the dynamics, so that its own never imports SciPy's optimisers).
         """
-        key = (bandwidth_hz, self.sample_rate_, self.resonance_hz_, self.damping_ratio_)
+        key = (bandwidth_hz, self.sample_rate_, self.modes)
         designs = self.__dict__.setdefault("_fir_designs", {})
         if key not in designs:
             designs[key] = inverse_fir(self.resonance(), bandwidth_hz, self.sample_rate_)
@@ -391,9 +436,10 @@ class LinearDynamics:
     # -- files -----------------------------------------------------------------------------
 
     def parameters(self) -> dict[str, Any]:
-        """The parameters as plain Python values."""
+        """The parameters as plain Python values (the second mode's only when there is one,
+        so that a model of one mode writes the file it always did)."""
         self._check_fitted()
-        return {
+        out = {
             "sample_rate": self.sample_rate_,
             "resonance_hz": self.resonance_hz_,
             "damping_ratio": self.damping_ratio_,
@@ -401,6 +447,11 @@ class LinearDynamics:
             "creep_weights": self.creep_weights_.tolist(),
             "delay_samples": self.delay_samples_,
         }
+        if self.second_mode_gain_ is not None:
+            out["second_resonance_hz"] = self.second_resonance_hz_
+            out["second_damping_ratio"] = self.second_damping_ratio_
+            out["second_mode_gain"] = self.second_mode_gain_
+        return out
 
     def get_params(self) -> dict[str, Any]:
         """No hyperparameters: the model is its parameters."""
@@ -431,11 +482,46 @@ class LinearDynamics:
     def __repr__(self) -> str:
         if not hasattr(self, "resonance_hz_"):
             return "LinearDynamics(unfitted)"
+        second = (
+            ""
+            if self.second_mode_gain_ is None
+            else f", second_resonance_hz={self.second_resonance_hz_:.6g}, "
+            f"second_damping_ratio={self.second_damping_ratio_:.4g}, "
+            f"second_mode_gain={self.second_mode_gain_:.4g}"
+        )
         return (
             f"LinearDynamics(resonance_hz={self.resonance_hz_:.6g}, damping_ratio="
-            f"{self.damping_ratio_:.4g}, creep={100 * self.creep_fraction(0.0):.3g} %, "
+            f"{self.damping_ratio_:.4g}{second}, creep={100 * self.creep_fraction(0.0):.3g} %, "
             f"sample_rate={self.sample_rate_:g})"
         )
+
+
+def _check_mode(hz, zeta, sample_rate: float, prefix: str, owner: str) -> tuple[float, float]:
+    """A mode's frequency (Hz) and damping ratio, checked: below Nyquist, resolved in
+    double precision. ``prefix`` names the parameters (``""`` or ``"second_"``)."""
+    name, damping = f"{prefix}resonance_hz", f"{prefix}damping_ratio"
+    hz = check_real(hz, name, owner, positive=True)
+    zeta = check_real(zeta, damping, owner, positive=True)
+    if hz >= 0.5 * sample_rate:
+        raise InvalidParameterError(
+            f"The {name!r} parameter of {owner} must be below the Nyquist frequency "
+            f"({0.5 * sample_rate:g} Hz). Got {hz:g}; identify from a record sampled faster."
+        )
+    if hz < MIN_RESONANCE * sample_rate:
+        raise InvalidParameterError(
+            f"The {name!r} parameter of {owner} must be at least {MIN_RESONANCE:g} of the "
+            f"sample rate ({MIN_RESONANCE * sample_rate:g} Hz at {sample_rate:g} Hz): "
+            f"slower, the resonance's poles cannot be told from 1 in double precision. Got "
+            f"{hz:g}; identify the dynamics from a record (hystcomp identify --model dynamics)."
+        )
+    if not DAMPING_RANGE[0] <= zeta <= DAMPING_RANGE[1]:
+        raise InvalidParameterError(
+            f"The {damping!r} parameter of {owner} must be in {DAMPING_RANGE[0]:g} .. "
+            f"{DAMPING_RANGE[1]:g} (outside, the resonance's poles leave double precision). "
+            f"Got {zeta:g}; identify the dynamics from a record (hystcomp identify --model "
+            "dynamics)."
+        )
+    return hz, zeta
 
 
 def with_dynamics(

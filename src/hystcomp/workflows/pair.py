@@ -219,6 +219,14 @@ def dynamics_lines(dyn: LinearDynamics, record) -> list[str]:
         ),
         f"  resonance: {dyn.resonance_hz_:.5g} Hz, damping ratio {dyn.damping_ratio_:.3g}",
     ]
+    if dyn.second_mode_gain_ is not None:  # found where it explains the response clearly better
+        ratio = report.get("residual_ratio")
+        why = "" if ratio is None else f"; two modes leave {ratio:.2g} of one mode's residual"
+        lines.append(
+            f"  second mode: {dyn.second_resonance_hz_:.5g} Hz, damping ratio "
+            f"{dyn.second_damping_ratio_:.3g}, {100 * dyn.second_mode_gain_:.3g} % of the "
+            f"static gain, in parallel with the first{why}"
+        )
     delay = dyn.delay_samples_
     if delay:  # the rig's latency, beyond the sample-and-hold's one sample
         lines.append(
@@ -231,9 +239,11 @@ def dynamics_lines(dyn: LinearDynamics, record) -> list[str]:
         f"{100 * dyn.creep_fraction(1.0):.3g} % of it after 1 s "
         f"({taus.size} modes, {taus[0]:.3g} .. {taus[-1]:.3g} s)"
     )
+    modes = "two modes" if dyn.second_mode_gain_ is not None else "one mode"
     lines.append(
         f"  fit, {lo:.4g} .. {hi:.4g} Hz: {report['fit_percent']:.3g} % "
-        f"(frequency response), largest magnitude error {report['max_magnitude_error_db']:.3g} dB"
+        f"(frequency response, {modes}), largest magnitude error "
+        f"{report['max_magnitude_error_db']:.3g} dB"
     )
     lines.append(
         f"  step:      rms error {report['step_rms_um']:.4g} µm on a step of "
@@ -259,7 +269,7 @@ def dynamics_warnings(dyn: LinearDynamics) -> list[str]:
             f"the model explains {report['fit_percent']:.3g} % of the frequency response "
             f"from {lo:.4g} to {hi:.4g} Hz{found}; stages with one resonance give "
             f"{MIN_DYNAMICS_FIT:g} % and more. Its inverse may make tracking worse (a "
-            "hysteresis that changes with the rate, or more than one mode, does this): "
+            "hysteresis that changes with the rate, or more modes than two, does this): "
             "compare compensate with and without the dynamics on a test reference first."
         )
     ]
@@ -289,7 +299,8 @@ class DynamicsResult:
 
 
 def identify_dynamics_record(record) -> DynamicsResult:
-    """Fit the linear dynamics (creep and first resonance) to a record and report the fit.
+    """Fit the linear dynamics (creep, first resonance, a second mode if the record shows
+    one) to a record and report the fit.
 
     Beyond the paper: the record is the answer to
     :func:`~hystcomp.identify.dynamics.dynamics_excitation`; the fit is
