@@ -16,7 +16,7 @@ import numpy as np
 
 from hystcomp._kernels import dynamics as dk
 from hystcomp._kernels._jit import step_function
-from hystcomp._validation import as_signal, check_int
+from hystcomp._validation import as_signal, as_vector, check_int
 from hystcomp.errors import InvalidSignalError
 from hystcomp.models.compensator import CompensatorRun
 from hystcomp.models.system import Rebound, block, checked_step
@@ -121,7 +121,7 @@ class DynamicsInverse:
         output_range=(-np.inf, np.inf),
         bias: float = 0.0,
     ):
-        taps = np.asarray(taps, dtype=np.float64)
+        taps = as_vector(taps, "taps", "DynamicsInverse")  # at least one: the delay line's
         lags = np.asarray(lags, dtype=np.float64)
         weights = np.asarray(weights, dtype=np.float64)
         self.preview = check_int(preview, "preview", "DynamicsInverse", minimum=0)
@@ -129,7 +129,9 @@ class DynamicsInverse:
         self.output_range = (float(output_range[0]), float(output_range[1]))
         header = [taps.size, lags.size, 1.0 + weights.sum(), 1.0 + (weights * (1.0 - lags)).sum()]
         header += [*self.output_range, float(bias)]
-        state = np.r_[np.full(taps.size + lags.size, self.rest), 0.0]  # and the clamp count
+        # the head of the delay line (slot 0) and the scratch slots, the delay line (held
+        # twice over, see hystcomp._kernels.dynamics) and the creep lags at rest, the count
+        state = np.r_[np.zeros(dk.ST_LINE), np.full(2 * taps.size + lags.size, self.rest), 0.0]
         packed = np.concatenate([header, taps, lags, weights, state])
         packed.setflags(write=False)
         self._packed = packed
