@@ -332,6 +332,26 @@ def test_stepper_equals_batch(compensator):
     np.testing.assert_allclose(stepped[d + 5 :], batch[5:], rtol=0, atol=1e-9)
 
 
+def test_the_step_is_one_compiled_call_and_the_block_run_bit_for_bit(compensator):
+    """``step`` calls the filter and the hysteresis compensator in one compiled kernel
+    (behind the type test of the sample); it gives the block run's bits, counts a sample
+    out of reach once, and holds on a non-finite reference."""
+    from hystcomp._kernels import dynamics as dk
+    from hystcomp._kernels._jit import step_function
+
+    x = _wild_reference(compensator, n=6000)
+    x[[100, 2000, 2001, 4000]] = [np.nan, np.inf, -np.inf, 1e308]  # the last one clamped
+    s = compensator.stepper()
+    assert s.step.func is step_function(dk.PAIR_STEPS[s._hyst.kernels.step], arrays=2)
+    streamed = [s.step(u) for u in x]
+    block = compensator.stepper()
+    assert np.array_equal(streamed, block.step_block(x))
+    assert (s.clamped_count, s.nonfinite_count) == (block.clamped_count, block.nonfinite_count)
+    assert s.nonfinite_count == 3
+    assert 500 < s.clamped_count < x.size - 500
+    assert streamed[100] == streamed[99]  # held
+
+
 def test_output_clamped_and_slew_limited(compensator):
     x = _wild_reference(compensator)
     v = compensator.simulate(x)

@@ -1,6 +1,6 @@
-"""Compiled kernels of the linear dynamics: the inverse (one step, and a batch loop that runs
-the same code) and the two stages of the forward model (a creep lag, the resonance) that
-:mod:`hystcomp._lti` runs for the model's output and its identification.
+"""Compiled kernels of the linear dynamics: the inverse (a batch loop, one step, and one step
+in front of a hysteresis compensator) and the two stages of the forward model (a creep lag,
+the resonance) that :mod:`hystcomp._lti` runs for the model's output and its identification.
 
 The inverse filter (see :mod:`hystcomp.models.dynamics`) is a FIR stage (non-negative taps
 fitted so that the resonance times them is close to 1 in the band) in series with the
@@ -36,6 +36,7 @@ import math
 
 import numpy as np
 
+from hystcomp._kernels import chain, preisach
 from hystcomp._kernels._jit import inline_kernel, kernel, step_kernel
 from hystcomp._kernels.chain import CLAMP_TOLERANCE
 
@@ -146,6 +147,42 @@ def inverse_run(p, u, out):
 def inverse_run_cuts(p, u, out, cuts):
     """:func:`inverse_run`, and ``cuts[k]`` True where the clamp counted sample ``k``."""
     inverse_block(p, u, out, cuts)
+
+
+# -- the inverse filter in front of a hysteresis compensator, one compiled call a sample ----
+
+
+@step_kernel
+def chain_pair_step(pd, ph, u):
+    """``u`` (µm) through the inverse filter ``pd``, then the packed chain ``ph``: the voltage.
+
+    The streaming step of a compensator with dynamics in one compiled call. A sample that
+    the filter's clamp counted (out of reach) is not counted again by the voltage range's:
+    the chain's count is put back. A non-finite ``u`` leaves the filter as it was, and the
+    chain holds its last output and counts it.
+    """
+    slot = chain.chain_state_start(ph) + chain.STATE_CLAMPED
+    counted = ph[slot]
+    v = chain.chain_step(ph, inverse_step(pd, u))
+    if pd[state_start(pd) + ST_CUT] != 0.0:
+        ph[slot] = counted
+    return v
+
+
+@step_kernel
+def preisach_pair_step(pd, ph, u):
+    """:func:`chain_pair_step` with a packed Preisach compensator ``ph`` behind the filter."""
+    slot = preisach.state_start(ph) + preisach.ST_CLAMPED
+    counted = ph[slot]
+    v = preisach.preisach_step(ph, inverse_step(pd, u))
+    if pd[state_start(pd) + ST_CUT] != 0.0:
+        ph[slot] = counted
+    return v
+
+
+#: The step kernel of the inverse filter in front of a compensator, by the compensator's
+#: step kernel (:class:`~hystcomp.models.dynamic_compensator.DynamicStepper`).
+PAIR_STEPS = {chain.chain_step: chain_pair_step, preisach.preisach_step: preisach_pair_step}
 
 
 @kernel
