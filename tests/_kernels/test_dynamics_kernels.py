@@ -87,7 +87,7 @@ def test_step_equals_the_batch_run_bit_for_bit(rng, n_taps, n_creep):
     x = _reference(rng, 2000)
     batch = inverse.packed.copy()
     out = np.empty_like(x)
-    cuts = np.empty(x.size, dtype=np.bool_)
+    cuts = np.empty_like(x)
     dk.inverse_run_cuts(batch, x, out, cuts)
     stepped = inverse.packed.copy()
     step = step_function(dk.inverse_step)
@@ -101,7 +101,7 @@ def test_step_equals_the_batch_run_bit_for_bit(rng, n_taps, n_creep):
         np.delete(stepped, s + np.arange(dk.ST_HEAD + 1, dk.ST_LINE)),
         np.delete(batch, s + np.arange(dk.ST_HEAD + 1, dk.ST_LINE)),
     )
-    assert np.array_equal(np.diff(np.r_[0.0, counts]) == 1.0, cuts)
+    assert np.array_equal(np.diff(np.r_[0.0, counts]), cuts)
     assert cuts.sum() > 50
 
 

@@ -34,10 +34,8 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
-
 from hystcomp._kernels import chain, preisach
-from hystcomp._kernels._jit import inline_kernel, kernel, step_kernel
+from hystcomp._kernels._jit import inner_kernel, kernel, step_kernel
 from hystcomp._kernels.chain import CLAMP_TOLERANCE
 
 N_FIR, N_CREEP, SCALE, DIRECT, LOW, HIGH, BIAS = range(7)
@@ -60,16 +58,17 @@ def clamped_slot(p):
     return state_start(p) + ST_LINE + 2 * int(p[N_FIR]) + int(p[N_CREEP])
 
 
-@inline_kernel
+@inner_kernel
 def inverse_block(p, u, out, cuts):
     """Run every sample of ``u`` through the inverse filter ``p`` into ``out`` (state kept).
 
     The state is read into locals once and written back at the end; the delay line and the
-    creep lags are updated in place. ``cuts[k]`` is set where the clamp counted sample ``k``
-    (if ``cuts`` is not empty). A non-finite sample gives NaN and leaves the state as it
-    was; a huge finite one whose result overflows gives NaN too (it stays in the delay
+    creep lags are updated in place. ``cuts[k]`` is 1.0 where the clamp counted sample ``k``,
+    else 0.0 (if ``cuts`` is not empty). A non-finite sample gives NaN and leaves the state
+    as it was; a huge finite one whose result overflows gives NaN too (it stays in the delay
     line, the lags and the count unmoved). ``u``, ``out`` and ``cuts`` may be slots of ``p``
-    outside the state (:func:`inverse_step`).
+    outside the state (:func:`inverse_step`). Compiled once, for float64 arrays, whichever
+    kernel calls it: the batch runs and the step run the same code.
     """
     n_fir = int(p[N_FIR])
     n_creep = int(p[N_CREEP])
@@ -140,12 +139,14 @@ def inverse_step(p, u):
 def inverse_run(p, u, out):
     """Run every sample of ``u`` through the inverse filter ``p`` into ``out`` (state kept
     in ``p``), as :func:`inverse_step` would one by one."""
-    inverse_block(p, u, out, np.empty(0, dtype=np.bool_))
+    inverse_block(p, u, out, out[:0])
 
 
 @kernel
 def inverse_run_cuts(p, u, out, cuts):
-    """:func:`inverse_run`, and ``cuts[k]`` True where the clamp counted sample ``k``."""
+    """:func:`inverse_run`, and ``cuts[k]`` 1.0 where the clamp counted sample ``k``, else 0.0
+    (float64, as the scratch slot of :func:`inverse_step`: one compiled :func:`inverse_block`
+    serves all three)."""
     inverse_block(p, u, out, cuts)
 
 

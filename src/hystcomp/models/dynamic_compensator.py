@@ -190,9 +190,9 @@ class DynamicsInverseStepper(Rebound):
         """:meth:`step_block`, and where the clamp to the displacement range counted."""
         u = block(x_ref, "step_block")
         out = np.empty_like(u)
-        cuts = np.empty(u.size, dtype=np.bool_)
+        cuts = np.empty_like(u)
         dk.inverse_run_cuts(self._p, u, out, cuts)
-        return out, cuts
+        return out, cuts != 0.0
 
     def prime(self, x_ref) -> None:
         """Feed the first ``preview`` reference samples, whose outputs come before time 0."""
