@@ -207,3 +207,36 @@ def everett_basis_cells(n_seg, v_min, v_max):
 def preisach_regressors(v, basis, v_min, v_max):
     """Eqs. (3)-(4) with each basis Everett function alone: one column per element."""
     return np.column_stack([preisach_extrema(v, f, v_min, v_max) for f in basis])
+
+
+def dynamics_inverse(x, taps, lags, weights, *, rest, bias, low, high, tolerance):
+    """The inverse filter of the linear dynamics from rest, sample by sample: the FIR over a
+    list of past samples (newest first, all at ``rest`` before the first), then the creep
+    bank's equation ``(q + sum_i c_i lag_i) / (1 + sum_i c_i) = w`` solved for ``q`` with
+    ``lag_i = a_i lag_i[k-1] + (1 - a_i) q``, clamped to ``[low, high]``.
+
+    Returns the outputs (NaN where held: a non-finite sample, which leaves the state alone,
+    or an overflow) and the count of outputs that the clamp moved by more than ``tolerance``.
+    """
+    past = [float(rest)] * len(taps)
+    state = [float(rest)] * len(lags)
+    out, clamped = [], 0
+    for xk in x:
+        if not np.isfinite(xk):
+            out.append(np.nan)
+            continue
+        past = [float(xk), *past[:-1]]
+        w = bias + sum(h * u for h, u in zip(taps, past, strict=True))
+        # q + sum_i c_i (a_i lag_i + (1 - a_i) q) = w (1 + sum_i c_i)
+        known = sum(c * a * s for c, a, s in zip(weights, lags, state, strict=True))
+        direct = 1.0 + sum(c * (1.0 - a) for c, a in zip(weights, lags, strict=True))
+        q = (w * (1.0 + sum(weights)) - known) / direct  # Python floats: inf, no error
+        if not np.isfinite(q):
+            out.append(np.nan)
+            continue
+        if q > high + tolerance or q < low - tolerance:
+            clamped += 1
+        q = min(max(q, low), high)
+        state = [a * s + (1.0 - a) * q for a, s in zip(lags, state, strict=True)]
+        out.append(q)
+    return np.array(out), clamped

@@ -315,12 +315,10 @@ def test_stepper_equals_batch(compensator):
     d = compensator.preview
     s.prime(x[:d])
     streamed = np.array([s.step(u) for u in np.r_[x[d:], np.full(d, x[-1])]])
-    np.testing.assert_allclose(streamed, batch, rtol=0, atol=1e-9)
+    np.testing.assert_array_equal(streamed, batch)  # the same kernels: bit for bit
     s.reset()
     s.prime(x[:d])
-    np.testing.assert_allclose(
-        s.step_block(np.r_[x[d:], np.full(d, x[-1])]), batch, rtol=0, atol=1e-9
-    )
+    np.testing.assert_array_equal(s.step_block(np.r_[x[d:], np.full(d, x[-1])]), batch)
     # the generated C has no prime: it starts `preview` samples early, applying those
     # outputs (docs/c-export.md); the slew limit holds throughout, and once it no longer
     # binds on the start (a few samples here) the voltages are the batch run's
@@ -330,6 +328,26 @@ def test_stepper_equals_batch(compensator):
         compensator.max_step * (1 + 1e-12)
     )
     np.testing.assert_allclose(stepped[d + 5 :], batch[5:], rtol=0, atol=1e-9)
+
+
+def test_the_step_is_one_compiled_call_and_the_block_run_bit_for_bit(compensator):
+    """``step`` calls the filter and the hysteresis compensator in one compiled kernel
+    (behind the type test of the sample); it gives the block run's bits, counts a sample
+    out of reach once, and holds on a non-finite reference."""
+    from hystcomp._kernels import dynamics as dk
+    from hystcomp._kernels._jit import step_function
+
+    x = _wild_reference(compensator, n=6000)
+    x[[100, 2000, 2001, 4000]] = [np.nan, np.inf, -np.inf, 1e308]  # the last one clamped
+    s = compensator.stepper()
+    assert s.step.func is step_function(dk.PAIR_STEPS[s._hyst.kernels.step], arrays=2)
+    streamed = [s.step(u) for u in x]
+    block = compensator.stepper()
+    assert np.array_equal(streamed, block.step_block(x))
+    assert (s.clamped_count, s.nonfinite_count) == (block.clamped_count, block.nonfinite_count)
+    assert s.nonfinite_count == 3
+    assert 500 < s.clamped_count < x.size - 500
+    assert streamed[100] == streamed[99]  # held
 
 
 def test_output_clamped_and_slew_limited(compensator):

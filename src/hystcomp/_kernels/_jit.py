@@ -66,14 +66,15 @@ def step_kernel(func):
 
 
 @functools.cache
-def step_function(kernel):
-    """Step kernel ``kernel`` compiled for a float64 array and a float, as a plain ``f(p, u)``.
+def step_function(kernel, arrays: int = 1):
+    """Step kernel ``kernel`` compiled for ``arrays`` float64 arrays and a float, as a plain
+    ``f(p, u)`` (or ``f(p, q, u)`` for a kernel over two packed systems).
 
     It skips numba's dispatch on argument types (a third of the cost of a call) and so
-    trusts its arguments more still: ``p`` must be a writable, C-contiguous float64 array.
-    The first call compiles the kernel or loads it from the on-disk cache.
+    trusts its arguments more still: each array must be a writable, C-contiguous float64
+    array. The first call compiles the kernel or loads it from the on-disk cache.
     """
-    return kernel.compile((numba.types.float64[::1], numba.types.float64))
+    return kernel.compile((*[numba.types.float64[::1]] * arrays, numba.types.float64))
 
 
 StepKernels = namedtuple("StepKernels", "step run state_start last nonfinite clamped")

@@ -1,6 +1,6 @@
-"""Compiled kernels of the linear dynamics: the inverse (one step, and a batch loop over it)
-and the two stages of the forward model (a creep lag, the resonance) that
-:mod:`hystcomp._lti` runs for the model's output and its identification.
+"""Compiled kernels of the linear dynamics: the inverse (a batch loop, one step, and one step
+in front of a hysteresis compensator) and the two stages of the forward model (a creep lag,
+the resonance) that :mod:`hystcomp._lti` runs for the model's output and its identification.
 
 The inverse filter (see :mod:`hystcomp.models.dynamics`) is a FIR stage (non-negative taps
 fitted so that the resonance times them is close to 1 in the band) in series with the
@@ -8,7 +8,14 @@ exact inverse of the creep bank. Its parameters and state are one packed
 float64 array, as the chain's (:mod:`hystcomp._kernels.chain`)::
 
     [N_FIR, N_CREEP, SCALE, DIRECT, LOW, HIGH, BIAS, h_0 .. h_{N_FIR-1}, a_1 .. a_n, c_1 .. c_n,
-     delay line (N_FIR samples, newest first), creep lag states (n), count of clamped outputs]
+     head, input, output, cut (the scratch slots of one step), delay line (2 N_FIR slots),
+     creep lag states (n), count of clamped outputs]
+
+The delay line is circular: each sample moves ``head`` back one place (from 0 to
+``N_FIR - 1``) and is written there, instead of shifting every sample along. It is held twice
+over, each sample written at ``head`` and at ``head + N_FIR``, so that the ``N_FIR`` samples
+from the newest (``line[head]``) to the oldest are always contiguous and the taps run over
+them in one loop that the compiler vectorises, with no index that wraps.
 
 The creep bank of the forward model is ``D_c[q] = (q + sum_i c_i lag_i) / SCALE`` with
 ``lag_i[k] = a_i lag_i[k-1] + (1 - a_i) q[k]`` and ``SCALE = 1 + sum_i c_i``. Its inverse
@@ -27,74 +34,156 @@ from __future__ import annotations
 
 import math
 
-from hystcomp._kernels._jit import kernel, step_kernel
+from hystcomp._kernels import chain, preisach
+from hystcomp._kernels._jit import inner_kernel, kernel, step_kernel
 from hystcomp._kernels.chain import CLAMP_TOLERANCE
 
 N_FIR, N_CREEP, SCALE, DIRECT, LOW, HIGH, BIAS = range(7)
 HEADER = 7
+#: Offsets from :func:`state_start` of the state slots: the head of the delay line (the index
+#: of its newest sample), the scratch slots of a one-sample run (its input, its output, 1 if
+#: the clamp counted it, else 0), then the delay line.
+ST_HEAD, ST_INPUT, ST_OUTPUT, ST_CUT, ST_LINE = range(5)
 
 
 @kernel
 def state_start(p):
-    """Index of the first state slot (the newest sample of the delay line)."""
+    """Index of the first state slot (:data:`ST_HEAD`)."""
     return HEADER + int(p[N_FIR]) + 2 * int(p[N_CREEP])
 
 
 @kernel
 def clamped_slot(p):
     """Index of the count of clamped outputs (the last slot)."""
-    return HEADER + 2 * int(p[N_FIR]) + 3 * int(p[N_CREEP])
+    return state_start(p) + ST_LINE + 2 * int(p[N_FIR]) + int(p[N_CREEP])
+
+
+@inner_kernel
+def inverse_block(p, u, out, cuts):
+    """Run every sample of ``u`` through the inverse filter ``p`` into ``out`` (state kept).
+
+    The state is read into locals once and written back at the end; the delay line and the
+    creep lags are updated in place. ``cuts[k]`` is 1.0 where the clamp counted sample ``k``,
+    else 0.0 (if ``cuts`` is not empty). A non-finite sample gives NaN and leaves the state
+    as it was; a huge finite one whose result overflows gives NaN too (it stays in the delay
+    line, the lags and the count unmoved). ``u``, ``out`` and ``cuts`` may be slots of ``p``
+    outside the state (:func:`inverse_step`). Compiled once, for float64 arrays, whichever
+    kernel calls it: the batch runs and the step run the same code.
+    """
+    n_fir = int(p[N_FIR])
+    n_creep = int(p[N_CREEP])
+    a0 = HEADER + n_fir
+    c0 = a0 + n_creep
+    s = c0 + n_creep
+    line0 = s + ST_LINE
+    lag0 = line0 + 2 * n_fir
+    taps = p[HEADER:a0]
+    a = p[a0:c0]
+    c = p[c0:s]
+    line = p[line0:lag0]
+    lags = p[lag0 : lag0 + n_creep]
+    bias, scale, direct, low, high = p[BIAS], p[SCALE], p[DIRECT], p[LOW], p[HIGH]
+    tol = CLAMP_TOLERANCE * (high - low)  # inf without a clamp: nothing counts
+    keep_cuts = cuts.size > 0
+    head = int(p[s + ST_HEAD])
+    count = p[lag0 + n_creep]
+    for k in range(u.size):
+        x = u[k]
+        y = math.nan
+        cut = False
+        if math.isfinite(x):
+            head = head - 1 if head > 0 else n_fir - 1
+            line[head] = x
+            line[head + n_fir] = x
+            w = bias
+            for j in range(n_fir):
+                w += taps[j] * line[head + j]
+            acc = w * scale
+            for i in range(n_creep):
+                acc -= c[i] * a[i] * lags[i]
+            y = acc / direct
+            if math.isfinite(y):
+                cut = y > high + tol or y < low - tol
+                if cut:
+                    count += 1.0
+                y = min(max(y, low), high)
+                for i in range(n_creep):
+                    lags[i] = a[i] * lags[i] + (1.0 - a[i]) * y
+            else:  # a huge finite reference overflowed: held downstream
+                y = math.nan
+        out[k] = y
+        if keep_cuts:
+            cuts[k] = cut
+    p[s + ST_HEAD] = head
+    p[lag0 + n_creep] = count
 
 
 @step_kernel
 def inverse_step(p, u):
-    """One reference sample ``u`` (µm) through the inverse filter; NaN (state kept) if not finite."""
-    if not math.isfinite(u):
-        return math.nan
-    n_fir = int(p[N_FIR])
-    n_creep = int(p[N_CREEP])
-    h = HEADER
-    a = h + n_fir
-    c = a + n_creep
-    d = c + n_creep
-    lags = d + n_fir
-    for j in range(n_fir - 1, 0, -1):
-        p[d + j] = p[d + j - 1]
-    p[d] = u
-    w = p[BIAS]
-    for j in range(n_fir):
-        w += p[h + j] * p[d + j]
-    acc = w * p[SCALE]
-    for i in range(n_creep):
-        acc -= p[c + i] * p[a + i] * p[lags + i]
-    y = acc / p[DIRECT]
-    if not math.isfinite(y):  # a huge finite reference overflowed: held downstream
-        return math.nan
-    tol = CLAMP_TOLERANCE * (p[HIGH] - p[LOW])  # inf without a clamp: nothing counts
-    if y > p[HIGH] + tol or y < p[LOW] - tol:
-        p[lags + n_creep] += 1.0
-    y = min(max(y, p[LOW]), p[HIGH])
-    for i in range(n_creep):
-        ai = p[a + i]
-        p[lags + i] = ai * p[lags + i] + (1.0 - ai) * y
-    return y
+    """One reference sample ``u`` (µm) through the inverse filter; NaN (state kept) if not finite.
+
+    A one-sample :func:`inverse_block` run through the scratch slots of the state, so that
+    the streaming step and the batch run are the same code and agree bit for bit; the slot
+    :data:`ST_CUT` then says whether the clamp counted the sample.
+    """
+    s = state_start(p)
+    i = s + ST_INPUT
+    o = s + ST_OUTPUT
+    q = s + ST_CUT
+    p[i] = u
+    inverse_block(p, p[i : i + 1], p[o : o + 1], p[q : q + 1])
+    return p[o]
 
 
 @kernel
 def inverse_run(p, u, out):
-    """Run :func:`inverse_step` over every sample of ``u`` (state kept in ``p``)."""
-    for k in range(u.size):
-        out[k] = inverse_step(p, u[k])
+    """Run every sample of ``u`` through the inverse filter ``p`` into ``out`` (state kept
+    in ``p``), as :func:`inverse_step` would one by one."""
+    inverse_block(p, u, out, out[:0])
 
 
 @kernel
 def inverse_run_cuts(p, u, out, cuts):
-    """:func:`inverse_run`, and ``cuts[k]`` True where the clamp counted sample ``k``."""
-    slot = clamped_slot(p)
-    for k in range(u.size):
-        before = p[slot]
-        out[k] = inverse_step(p, u[k])
-        cuts[k] = p[slot] != before
+    """:func:`inverse_run`, and ``cuts[k]`` 1.0 where the clamp counted sample ``k``, else 0.0
+    (float64, as the scratch slot of :func:`inverse_step`: one compiled :func:`inverse_block`
+    serves all three)."""
+    inverse_block(p, u, out, cuts)
+
+
+# -- the inverse filter in front of a hysteresis compensator, one compiled call a sample ----
+
+
+@step_kernel
+def chain_pair_step(pd, ph, u):
+    """``u`` (µm) through the inverse filter ``pd``, then the packed chain ``ph``: the voltage.
+
+    The streaming step of a compensator with dynamics in one compiled call. A sample that
+    the filter's clamp counted (out of reach) is not counted again by the voltage range's:
+    the chain's count is put back. A non-finite ``u`` leaves the filter as it was, and the
+    chain holds its last output and counts it.
+    """
+    slot = chain.chain_state_start(ph) + chain.STATE_CLAMPED
+    counted = ph[slot]
+    v = chain.chain_step(ph, inverse_step(pd, u))
+    if pd[state_start(pd) + ST_CUT] != 0.0:
+        ph[slot] = counted
+    return v
+
+
+@step_kernel
+def preisach_pair_step(pd, ph, u):
+    """:func:`chain_pair_step` with a packed Preisach compensator ``ph`` behind the filter."""
+    slot = preisach.state_start(ph) + preisach.ST_CLAMPED
+    counted = ph[slot]
+    v = preisach.preisach_step(ph, inverse_step(pd, u))
+    if pd[state_start(pd) + ST_CUT] != 0.0:
+        ph[slot] = counted
+    return v
+
+
+#: The step kernel of the inverse filter in front of a compensator, by the compensator's
+#: step kernel (:class:`~hystcomp.models.dynamic_compensator.DynamicStepper`).
+PAIR_STEPS = {chain.chain_step: chain_pair_step, preisach.preisach_step: preisach_pair_step}
 
 
 @kernel

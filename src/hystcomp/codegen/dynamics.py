@@ -47,15 +47,21 @@ def add_dynamics(template: CTemplate, inverse) -> CTemplate:
         "/* the samples by which {p}_step takes the reference ahead ({p}_prime that many) */",
         f"#define {{P}}_PREVIEW {inverse.preview}",
     ]
-    template.state_fields += [f"double dyn_line[{n_fir}]; /* reference delay line, um */"]
+    # the circular delay line of the kernel (hystcomp._kernels.dynamics): held twice over,
+    # so that the samples from the newest, dyn_line[dyn_head], to the oldest are contiguous
+    template.state_fields += [
+        f"double dyn_line[{2 * n_fir}]; /* reference delay line, twice over, um */",
+        f"int dyn_head; /* dyn_line[dyn_head] (and [dyn_head + {n_fir}]) is the newest sample */",
+    ]
     template.tables.append(c_table("{p}_dyn_h", taps, "FIR taps: resonance inverse, non-negative"))
     rest = c_double(inverse.rest)
     template.reset_body += [
         "{",
         "    int j;",
-        f"    for (j = 0; j < {n_fir}; j++) {{",
+        f"    for (j = 0; j < {2 * n_fir}; j++) {{",
         f"        s->dyn_line[j] = {rest};",
         "    }",
+        "    s->dyn_head = 0;",
     ]
     # the filter, one function for NAME_step and NAME_prime: x_ref in, filtered in place;
     # -1 if the result overflowed (held), 1 if the clamp cut it (counted), else 0
@@ -64,14 +70,15 @@ def add_dynamics(template: CTemplate, inverse) -> CTemplate:
         "{",
         "    int j;",
         "    int cut = 0;",
+        f"    int head = s->dyn_head > 0 ? s->dyn_head - 1 : {n_fir - 1};",
         f"    double w = {c_double(p[dk.BIAS])};",
         "    double y;",
-        f"    for (j = {n_fir - 1}; j > 0; j--) {{",
-        "        s->dyn_line[j] = s->dyn_line[j - 1];",
-        "    }",
-        "    s->dyn_line[0] = *x;",
+        "    const double *line = s->dyn_line + head;",
+        "    s->dyn_head = head; /* one place back, instead of shifting every sample */",
+        "    s->dyn_line[head] = *x;",
+        f"    s->dyn_line[head + {n_fir}] = *x;",
         f"    for (j = 0; j < {n_fir}; j++) {{",
-        "        w += {p}_dyn_h[j] * s->dyn_line[j];",
+        "        w += {p}_dyn_h[j] * line[j];",
         "    }",
     ]
     if n_creep:

@@ -16,10 +16,10 @@ import numpy as np
 
 from hystcomp._kernels import dynamics as dk
 from hystcomp._kernels._jit import step_function
-from hystcomp._validation import as_signal, check_int
+from hystcomp._validation import as_signal, as_vector, check_int
 from hystcomp.errors import InvalidSignalError
 from hystcomp.models.compensator import CompensatorRun
-from hystcomp.models.system import Rebound, block, checked_step
+from hystcomp.models.system import Rebound, block, checked_pair_step, checked_step
 
 #: Frequency (Hz) at which a hysteresis compensator and the inverse of the dynamics are
 #: matched in :func:`with_dynamics`: that of the paper's identification signals.
@@ -130,7 +130,7 @@ class DynamicsInverse:
         output_range=(-np.inf, np.inf),
         bias: float = 0.0,
     ):
-        taps = np.asarray(taps, dtype=np.float64)
+        taps = as_vector(taps, "taps", "DynamicsInverse")  # at least one: the delay line's
         lags = np.asarray(lags, dtype=np.float64)
         weights = np.asarray(weights, dtype=np.float64)
         self.preview = check_int(preview, "preview", "DynamicsInverse", minimum=0)
@@ -138,7 +138,9 @@ class DynamicsInverse:
         self.output_range = (float(output_range[0]), float(output_range[1]))
         header = [taps.size, lags.size, 1.0 + weights.sum(), 1.0 + (weights * (1.0 - lags)).sum()]
         header += [*self.output_range, float(bias)]
-        state = np.r_[np.full(taps.size + lags.size, self.rest), 0.0]  # and the clamp count
+        # the head of the delay line (slot 0) and the scratch slots, the delay line (held
+        # twice over, see hystcomp._kernels.dynamics) and the creep lags at rest, the count
+        state = np.r_[np.zeros(dk.ST_LINE), np.full(2 * taps.size + lags.size, self.rest), 0.0]
         packed = np.concatenate([header, taps, lags, weights, state])
         packed.setflags(write=False)
         self._packed = packed
@@ -197,9 +199,9 @@ class DynamicsInverseStepper(Rebound):
         """:meth:`step_block`, and where the clamp to the displacement range counted."""
         u = block(x_ref, "step_block")
         out = np.empty_like(u)
-        cuts = np.empty(u.size, dtype=np.bool_)
+        cuts = np.empty_like(u)
         dk.inverse_run_cuts(self._p, u, out, cuts)
-        return out, cuts
+        return out, cuts != 0.0
 
     def prime(self, x_ref) -> None:
         """Feed the first ``preview`` reference samples, whose outputs come before time 0."""
@@ -294,39 +296,27 @@ class DynamicStepper(Rebound):
     """The stepper of a :class:`DynamicCompensator`: the inverse filter, then the hysteresis.
 
     A non-finite reference leaves the filter as it was and holds the last voltage.
+    :meth:`step` is bound to one compiled kernel that runs both stages on their states
+    (:data:`hystcomp._kernels.dynamics.PAIR_STEPS`), behind the same type test of the sample
+    as the hysteresis stepper's: one call from Python a sample, under 200 ns
+    (``python benchmarks/run.py dynamics_speed``), and the bits of :meth:`step_block`.
     """
 
     def __init__(self, dynamics, hysteresis):
         self._dyn = dynamics
         self._hyst = hysteresis
-        self._seen = np.array([float(dynamics.clamped_count)])
         self._bind()
 
     def _bind(self) -> None:
         self.step = self._bound_step()  # type: ignore[method-assign]
 
     def _bound_step(self):
-        """The step as a closure over both stages' states. A sample that the filter's clamp
-        counted (out of reach) is not counted again by the voltage range's: only an output
-        at an end of the filter's range can have been cut, and ``seen[0]`` holds the
-        filter's count when last looked at."""
-        dyn_step, hyst_step = self._dyn.step, self._hyst.step
-        dyn_p, hyst_p, seen = self._dyn._p, self._hyst._p, self._seen
-        cuts, counted = dk.clamped_slot.py_func(dyn_p), self._hyst._clamped_slot
-        low, high = float(dyn_p[dk.LOW]), float(dyn_p[dk.HIGH])
-
-        def step(x_ref):
-            r = dyn_step(x_ref)
-            if low < r < high:
-                return hyst_step(r)
-            kept = hyst_p[counted]
-            v = hyst_step(r)
-            if dyn_p[cuts] != seen[0]:
-                seen[0] = dyn_p[cuts]
-                hyst_p[counted] = kept
-            return v
-
-        return step
+        """The step as one compiled call over both stages' states (the type test of the
+        sample aside): the filter, then the hysteresis compensator, whose count of clamped
+        outputs is put back where the filter's clamp counted the sample (out of reach:
+        counted once)."""
+        kernel = dk.PAIR_STEPS[self._hyst.kernels.step]
+        return checked_pair_step(step_function(kernel, arrays=2), self._dyn._p, self._hyst._p)
 
     def step(self, x_ref: float) -> float:
         """One reference sample (µm, :attr:`preview` ahead) -> the voltage to apply now (V)."""
@@ -337,7 +327,6 @@ class DynamicStepper(Rebound):
         r, cut = self._dyn.step_block_cuts(x_ref)
         if not cut.any():
             return self._hyst.step_block(r)
-        self._seen[0] = self._dyn.clamped_count
         hyst_p, counted = self._hyst._p, self._hyst._clamped_slot
         out = np.empty_like(r)
         edges = [0, *(np.flatnonzero(np.diff(cut)) + 1).tolist(), r.size]
@@ -351,13 +340,11 @@ class DynamicStepper(Rebound):
     def prime(self, x_ref) -> None:
         """Feed the first ``preview`` reference samples to the filter (no voltage is output)."""
         self._dyn.prime(x_ref)
-        self._seen[0] = self._dyn.clamped_count
 
     def reset(self) -> None:
         """Back to rest."""
         self._dyn.reset()
         self._hyst.reset()
-        self._seen[0] = 0.0
 
     def copy(self) -> DynamicStepper:
         """An independent stepper in the same state."""

@@ -123,6 +123,19 @@ def checked_step(kernel, p):
     return step
 
 
+def checked_pair_step(kernel, p, q):
+    """:func:`checked_step` for a kernel over two packed systems: ``step(u) = kernel(p, q, u)``."""
+
+    def step(u):
+        if u.__class__ is float:
+            return kernel(p, q, u)
+        return kernel(p, q, _sample(u))
+
+    step.func = kernel
+    step.state = (p, q)
+    return step
+
+
 class Rebound(ABC):
     """Steppers whose fast ``step`` is a closure over their state, bound by ``_bind``.
 
