@@ -39,6 +39,9 @@ from hystcomp._kernels._jit import inner_kernel, kernel, step_kernel
 from hystcomp._kernels.chain import CLAMP_TOLERANCE
 
 N_FIR, N_CREEP, SCALE, DIRECT, LOW, HIGH, BIAS = range(7)
+#: Creep lag states smaller than this (µm) are set to 0: far below any displacement, and
+#: above the subnormal numbers they would otherwise decay through.
+TINY = 1e-200
 HEADER = 7
 #: Offsets from :func:`state_start` of the state slots: the head of the delay line (the index
 #: of its newest sample), the scratch slots of a one-sample run (its input, its output, 1 if
@@ -108,7 +111,10 @@ def inverse_block(p, u, out, cuts):
                     count += 1.0
                 y = min(max(y, low), high)
                 for i in range(n_creep):
-                    lags[i] = a[i] * lags[i] + (1.0 - a[i]) * y
+                    lag = a[i] * lags[i] + (1.0 - a[i]) * y
+                    # a lag decaying towards 0 (a reference held at a rest of 0 µm) would
+                    # run through subnormal numbers, ten times slower to compute
+                    lags[i] = lag if abs(lag) > TINY else 0.0
             else:  # a huge finite reference overflowed: held downstream
                 y = math.nan
         out[k] = y

@@ -123,7 +123,9 @@ def add_dynamics(template: CTemplate, inverse) -> CTemplate:
     if n_creep:
         body += [
             f"    for (j = 0; j < {n_creep}; j++) {{",
-            "        s->dyn_lag[j] = {p}_dyn_a[j] * s->dyn_lag[j] + (1.0 - {p}_dyn_a[j]) * y;",
+            "        double lag = {p}_dyn_a[j] * s->dyn_lag[j] + (1.0 - {p}_dyn_a[j]) * y;",
+            "        /* a lag below 1e-200 um is 0, not a slow subnormal decay */",
+            f"        s->dyn_lag[j] = fabs(lag) > {c_double(dk.TINY)} ? lag : 0.0;",
             "    }",
         ]
     body += ["    *x = y;", "    return cut;", "}"]
