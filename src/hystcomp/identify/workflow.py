@@ -497,8 +497,8 @@ def identify_record(
     )
     if np.isfinite(tracking["held_out_rms_um"]):
         lines.append(
-            f"  held out:  {tracking['held_out_rms_um']:.4g} µm rms on reversal branches each "
-            "fit did not see (references that turn inside the range)"
+            f"  cross-validated: {tracking['held_out_rms_um']:.4g} µm rms on the reversal "
+            "branches each fit left out (references that turn inside the range)"
         )
     warnings = []
     unit = x_unit_warning(record.x, str(record.source)) if unit_check else None

@@ -123,7 +123,7 @@ def identify_best(record, *, families=FAMILIES, progress=None, **options) -> Aut
         times = est["tracking_rms_um"] / top if top > 0 else float("inf")
         note = "chosen" if i == 0 else f"{times:.3g}x the {LABELS[order[0]]}'s"
         held = est["held_out_rms_um"]
-        held_text = f", held out {held:.3g} µm" if math.isfinite(held) else ""
+        held_text = f", cross-validated {held:.3g} µm" if math.isfinite(held) else ""
         lines.append(
             f"  {LABELS[kind]:<9} {est['tracking_rms_um']:.4g} µm ({est['ratio']:.2g}x the "
             f"straight line{held_text}): {note}"
@@ -135,7 +135,7 @@ def identify_best(record, *, families=FAMILIES, progress=None, **options) -> Aut
         kind, held, winner_held = inside
         lines.append(
             f"  for references that turn inside the range the {LABELS[kind]} model is "
-            f"predicted better (held out {held:.3g} µm against {winner_held:.3g} µm): "
+            f"predicted better (cross-validated {held:.3g} µm against {winner_held:.3g} µm): "
             f"--model {kind}"
         )
     return AutoResult(best, ranking, skipped, results, lines)
