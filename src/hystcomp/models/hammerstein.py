@@ -99,9 +99,16 @@ class HammersteinModel:
         return self.hysteresis.voltage_range_
 
     def simulate(self, v) -> np.ndarray:
-        """``D[H[v]]`` (µm) for a voltage ``v`` (V) at :attr:`sample_rate`, from rest."""
-        u = np.asarray(self.hysteresis.simulate(as_signal(v, "v")), dtype=np.float64)
-        return self.dynamics.simulate(u)
+        """``D[H[v]]`` (µm) for a voltage ``v`` (V) at :attr:`sample_rate`, from rest.
+
+        At rest means where the compensator starts: ``H`` in its initial state and ``D``
+        settled at the hysteresis model's output for the low end of its voltage range (a
+        first sample elsewhere is a step from there)."""
+        v = as_signal(v, "v")
+        lo = self.hysteresis.voltage_range_[0]
+        rest = float(self.hysteresis.simulate(np.array([lo]))[0])
+        u = np.asarray(self.hysteresis.simulate(v), dtype=np.float64)
+        return self.dynamics.simulate(u, initial=rest)
 
     def reachable_range(self, voltage_range=None) -> tuple[float, float]:
         """The displacements (µm) the pair reaches at rest (those of the hysteresis model)."""

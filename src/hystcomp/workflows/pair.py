@@ -104,7 +104,10 @@ def tracking_estimates(pair, alone, v, x) -> dict:
     if not triangles:
         return {}
     lo, hi = pair.voltage_range_
-    bottom, top = (float(q) for q in pair.hysteresis.simulate(np.array([lo, hi])))
+    # the reach once swung over the range (a model whose loops stay open at rest no longer
+    # comes back to its first value)
+    swept = pair.hysteresis.simulate(np.array([lo, hi, lo, hi]))
+    bottom, top = float(swept[2]), float(swept[3])
     a, b = TRIANGLE_SPAN
     compensators = {
         "alone_um": alone.inverse(sample_rate=fs),
