@@ -147,6 +147,9 @@ def compensate(
                 f"{d_lo:.4g} .. {d_hi:.4g} µm, or drop --strict to accept the clamp."
             )
         click.echo(f"hystcomp: warning: {what}.", err=True)
+    beyond = _beyond_record(model, v)
+    if beyond is not None:
+        click.echo(f"hystcomp: warning: {beyond}", err=True)
     if getattr(getattr(compensator, "hysteresis", compensator), "method", None) == "multiplicative":
         spikes = _own_turns(v, table["x"], hi - lo)
         if spikes is not None:
@@ -196,6 +199,28 @@ def _own_turns(v, x, span: float):
         return None
     largest = int(np.argmax(np.where(own, size, 0.0)))
     return int(np.count_nonzero(own)), float(size[largest]), largest + 1
+
+
+def _beyond_record(model, v) -> str | None:
+    """Words for the samples of ``v`` beyond the input range the model's record covered
+    (:meth:`~hystcomp.models.base.HysteresisModel.covered_range`), or None: the model's
+    range was given wider than its record, and the model extrapolates there."""
+    covered = model.covered_range()
+    if covered is None:
+        return None
+    lo, hi = covered
+    slack = 1e-9 * (hi - lo)
+    beyond = int(np.count_nonzero((v < lo - slack) | (v > hi + slack)))
+    if not beyond:
+        return None
+    return (
+        f"{beyond} of {v.size} samples command voltages beyond {lo:.4g} .. {hi:.4g} V, the "
+        f"range that the model's record covered (v from {v.min():.4g} to {v.max():.4g} V; "
+        f"the model's range {model.voltage_range_[0]:.4g} .. {model.voltage_range_[1]:.4g} V "
+        "was given wider): the model extrapolates there. Check the tracking there, narrow "
+        f"the output with --voltage-range {lo:.6g} {hi:.6g}, or identify from a record "
+        "that covers the range."
+    )
 
 
 def _reach(model, lo: float, hi: float) -> tuple[str, tuple[float, float]]:

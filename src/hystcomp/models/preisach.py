@@ -28,6 +28,7 @@ from hystcomp.models.base import (
     DEFAULT_VOLTAGE_RANGE,
     HysteresisModel,
     compensator_rate,
+    input_range_report,
     slew_to_step,
 )
 from hystcomp.models.compensator import Compensator
@@ -295,7 +296,11 @@ class Preisach(HysteresisModel):
         self.output_offset_ = result.output_offset
         start = transient_end(v)
         # the same error figures as the PI and MPI reports, beside the fit's own
-        report = {**error_report(x, self.simulate(v), start), **result.report}
+        report = {
+            **error_report(x, self.simulate(v), start),
+            **input_range_report(v),
+            **result.report,
+        }
         est = compensation_error(self, v, x, start=start)
         report["tracking_rms_um"] = est["tracking_rms_um"]
         report["baseline_tracking_rms_um"] = est["baseline_rms_um"]
