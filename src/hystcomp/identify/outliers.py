@@ -55,10 +55,10 @@ def isolated_samples(v) -> np.ndarray:
 
     Examples
     --------
-    >>> v = np.r_[-30.0, np.linspace(0.0, 120.0, 1000)]
+    >>> v = np.r_[-30.0, np.linspace(0.0, 100.0, 1000)]
     >>> isolated_samples(v).tolist()
     [0]
-    >>> isolated_samples(np.linspace(0.0, 120.0, 1000)).tolist()
+    >>> isolated_samples(np.linspace(0.0, 100.0, 1000)).tolist()
     []
     """
     v = np.asarray(v, dtype=np.float64)
@@ -117,9 +117,9 @@ def bulk_range(v) -> tuple[float, float]:
 
     Examples
     --------
-    >>> v = np.r_[np.linspace(0.0, 120.0, 1000), 1000.0]
+    >>> v = np.r_[np.linspace(0.0, 100.0, 1000), 1000.0]
     >>> bulk_range(v)
-    (0.0, 120.0)
+    (0.0, 100.0)
     """
     v = np.asarray(v, dtype=np.float64)
     bad = isolated_samples(v)
@@ -150,10 +150,10 @@ def check_isolated(v, owner: str | None, *, row=None, source: str | None = None)
 
     Examples
     --------
-    >>> check_isolated(np.r_[np.linspace(0.0, 120.0, 1000), 1000.0], "fit")
+    >>> check_isolated(np.r_[np.linspace(0.0, 100.0, 1000), 1000.0], "fit")
     Traceback (most recent call last):
     ...
-    hystcomp.errors.InvalidSignalError: fit: the input 'v' has an isolated sample far outside the rest: v[1000] is 1000 V, while every other sample lies in 0 .. 120 V. ...
+    hystcomp.errors.InvalidSignalError: fit: the input 'v' has an isolated sample far outside the rest: v[1000] is 1000 V, while every other sample lies in 0 .. 100 V. ...
     """
     v = np.asarray(v, dtype=np.float64)
     bad = isolated_samples(v)
