@@ -7,6 +7,7 @@ from typing import Any
 import click
 import numpy as np
 
+from hystcomp._validation import MAX_MAGNITUDE
 from hystcomp.cli import main
 from hystcomp.cli._dynamics import dynamics_for, load_dynamics, refuse_dynamics_as_model
 from hystcomp.cli._options import (
@@ -15,12 +16,13 @@ from hystcomp.cli._options import (
     fs_option,
     method_option,
     method_options,
+    narrow_range_option,
+    narrowed,
     output_option,
     positive,
     progress,
     quiet_option,
     read_options,
-    voltage_range,
     warn_x_unit,
     x_unit_option,
 )
@@ -29,7 +31,7 @@ from hystcomp.io.models import load_model
 from hystcomp.io.records import read_table, write_table
 
 
-def inverse_options(model, table, *, slew_rate, narrow_range) -> dict:
+def inverse_options(model, table, *, slew_rate, narrow_range, path="the reference") -> dict:
     """Keyword arguments of ``model.inverse`` for the command's options.
 
     The slew-rate limit is per sample, so it needs the reference's own sample rate. With
@@ -37,18 +39,8 @@ def inverse_options(model, table, *, slew_rate, narrow_range) -> dict:
     """
     options: dict[str, Any] = {}
     if slew_rate is not None:
-        shortest = float(np.min(np.diff(table["t"])))
-        options.update(slew_rate=slew_rate, sample_rate=1.0 / shortest)
-    if narrow_range is not None:
-        (lo, hi), (low, high) = model.voltage_range_, narrow_range
-        if low < lo or high > hi:
-            raise click.BadParameter(
-                f"may only narrow the model's voltage range {lo:g} .. {hi:g} V: the model was "
-                f"identified inside it and would command voltages it never saw. Got {low:g} "
-                f"{high:g}; choose limits within it, or identify over a wider range.",
-                param_hint="'--voltage-range'",
-            )
-        options["voltage_range"] = narrow_range
+        options.update(slew_rate=slew_rate, sample_rate=_slew_sample_rate(table["t"], path))
+    options.update(narrowed(model, narrow_range))
     return options
 
 
@@ -69,17 +61,7 @@ def inverse_options(model, table, *, slew_rate, narrow_range) -> dict:
     help="Largest voltage slew rate of the output, in V/s, at the reference's own sample "
     "rate (none by default).",
 )
-@click.option(
-    "--voltage-range",
-    "narrow_range",
-    nargs=2,
-    type=float,
-    default=None,
-    metavar="LO HI",
-    callback=voltage_range,
-    help="Clamp the output to this range in V, inside the model's range (it may only "
-    "narrow it) [the model's range].",
-)
+@narrow_range_option
 @method_option
 @click.option(
     "--dynamics",
@@ -125,7 +107,9 @@ def compensate(
     options = read_options(columns, sample_rate, x_unit, quiet, reference_file, reads=("x",))
     table = read_table(reference_file, ("x",), **options)
     warn_x_unit(table["x"], reference_file, quiet, x_unit)
-    options = inverse_options(model, table, slew_rate=slew_rate, narrow_range=narrow_range)
+    options = inverse_options(
+        model, table, slew_rate=slew_rate, narrow_range=narrow_range, path=reference_file
+    )
     if dynamics_file is not None:
         options["dynamics"] = dynamics_for(load_dynamics(dynamics_file), table)
     compensator = model.inverse(**options, **chosen)
@@ -176,6 +160,29 @@ def compensate(
             f"  with the inverse of the dynamics of {dynamics_file}: "
             f"{compensator.preview} samples of look-ahead in the reference"
         )
+
+
+#: A step of the reference's time column shorter than this share of its median step is a
+#: fault of the column, not jitter: at its rate the slew-rate limit would all but hold the
+#: voltage still on every sample.
+SHORTEST_STEP = 1e-3
+
+
+def _slew_sample_rate(t, path) -> float:
+    """The rate (Hz) of the shortest step of ``t``, at which the slew-rate limit holds on
+    every step; refused, naming the row, if that step is a fault of the time column."""
+    steps = np.diff(t)
+    k = int(np.argmin(steps))
+    shortest, median = float(steps[k]), float(np.median(steps))
+    if not shortest >= SHORTEST_STEP * median or not 1.0 / shortest <= MAX_MAGNITUDE:
+        raise InvalidSignalError(
+            f"--slew-rate limits the voltage's change per sample at the reference's shortest "
+            f"time step, but the time column 't' of {str(path)!r} steps by only "
+            f"{shortest:.3g} s from t = {float(t[k])!r} to {float(t[k + 1])!r} s (data row "
+            f"{k + 2}), against a median step of {median:.3g} s: the limit would hold the "
+            "voltage nearly still. Correct the time column there, or drop it and give --fs."
+        )
+    return 1.0 / shortest
 
 
 #: A turn of the voltage larger than this fraction of the range, where the reference does
