@@ -35,6 +35,7 @@ from hystcomp.errors import (
 )
 from hystcomp.io import models as model_io
 from hystcomp.io.records import read_record, read_table
+from hystcomp.models.dynamics import LinearDynamics
 from hystcomp.models.preisach import Preisach
 from tests.conftest import examples
 
@@ -340,6 +341,11 @@ SIGNALS = st.lists(st.floats(-MAX_MAGNITUDE, MAX_MAGNITUDE), min_size=1, max_siz
 
 def _exercise(model, signal) -> None:
     """An accepted model gives finite outputs; its inverse stays finite and in range."""
+    if isinstance(model, LinearDynamics):
+        _exercise_dynamics(model, signal)
+        return
+    covered = model.covered_range()  # from the fit report, which no check has read
+    assert covered is None or (np.all(np.isfinite(covered)) and covered[0] < covered[1])
     if isinstance(model, Preisach):
         _exercise_preisach(model, signal, np.linspace(-1.5, 1.5, 7), [(2, np.nan)])
         return
@@ -352,6 +358,25 @@ def _exercise(model, signal) -> None:
     for v in (comp.simulate(signal), comp.stepper().step_block(signal)):
         assert np.all(np.isfinite(v))
         assert np.all((v >= lo) & (v <= hi))
+
+
+def _exercise_dynamics(model, signal) -> None:
+    """Accepted linear dynamics: a finite response, and a compensator in series with them
+    whose voltage is finite and in range, in Python and as C (or a clean refusal)."""
+    assert np.all(np.isfinite(model.simulate(signal)))
+    try:
+        comp = presets.paper_mpi().inverse(dynamics=model)
+    except HystcompError:  # e.g. dynamics the inverse cannot be designed for
+        return
+    lo, hi = comp.voltage_range
+    reference = np.concatenate([np.linspace(-10.0, 50.0, 60), np.clip(signal, -1e3, 1e3)])
+    run = comp.run(reference)
+    assert np.array_equal(run.v, comp.simulate(reference))
+    assert np.all(np.isfinite(run.v))
+    assert np.all((run.v >= lo) & (run.v <= hi))
+    assert 0 <= run.clamped <= reference.size
+    header, _ = generate_c(comp)  # the look-ahead of the C is the compensator's
+    assert f"#define HYSTCOMP_COMPENSATOR_PREVIEW {comp.preview}\n" in header
 
 
 @FUZZ
@@ -652,6 +677,16 @@ BASE_MODELS = {
         output_offset=-3.0,
     ),
 }
+BASE_MODELS["dynamics"] = LinearDynamics.from_parameters(
+    sample_rate=20_000.0,
+    resonance_hz=630.0,
+    damping_ratio=0.08,
+    creep_time_constants=[0.01, 0.1, 1.0],
+    creep_weights=[0.01, 0.01, 0.01],
+    delay_samples=1,
+)
+# a fit report too, as identify writes it: mutations reach the input range compensate reads
+BASE_MODELS["pi"].fit_report_ = {"input_range_v": [0.0, 120.0], "rms_error_um": 0.1}
 BASE_DOCUMENTS = [model_io.model_to_dict(m) for m in BASE_MODELS.values()]
 
 
