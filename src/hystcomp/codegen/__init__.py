@@ -14,7 +14,6 @@ Preisach compensators (both methods of ``Preisach.inverse``) have their own.
 
 from __future__ import annotations
 
-import contextlib
 import os
 from collections.abc import Callable
 from pathlib import Path
@@ -25,7 +24,7 @@ from hystcomp.codegen.c99 import CTemplate, check_prefix, render
 from hystcomp.codegen.chain import chain_template
 from hystcomp.codegen.preisach import preisach_template
 from hystcomp.errors import InvalidParameterError, InvalidTypeError
-from hystcomp.io.atomic import atomic_paths, check_output_path
+from hystcomp.io.atomic import atomic_paths, check_output_path, forget_folder, track_new_folder
 
 DEFAULT_PREFIX = "hystcomp_compensator"
 
@@ -159,6 +158,7 @@ def export_c(
             )
         directory.mkdir()
         made = directory
+        track_new_folder(made)  # removed (if empty) should a signal end the command
     else:
         made = None
     paths = (directory / f"{prefix}.h", directory / f"{prefix}.c")
@@ -171,7 +171,8 @@ def export_c(
             tmp_c.write_text(source_text, encoding="ascii")
     except BaseException:
         if made is not None:  # a failed export leaves no empty folder behind
-            with contextlib.suppress(OSError):
-                made.rmdir()
+            forget_folder(made, remove=True)
         raise
+    if made is not None:
+        forget_folder(made, remove=False)
     return paths
