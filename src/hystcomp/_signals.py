@@ -185,9 +185,11 @@ def commit(*, final: bool = True):
 
 
 def done() -> None:
-    """The command has returned: it completes whatever signal comes now."""
-    with LOCK:
-        _state.committed = True
+    """The program's command has returned: it completes whatever signal comes now (called
+    as a library, nothing: :func:`installed` ends with the command)."""
+    if _state.program:
+        with LOCK:
+            _state.committed = True
 
 
 def line(signum: int) -> str:

@@ -191,13 +191,12 @@ def run() -> None:
     exit path runs and reports it.
     """
     code: int | str | None
-    _signals.install(program=True)  # (done already when started as the program)
     try:
         result = main(prog_name="hystcomp")  # --help and --version return 0
         code = result if isinstance(result, int) else 0
     except SystemExit as exc:
         code = exc.code
-    _signals.done()  # returned: a signal from now on changes nothing
+    _signals.done()  # returned: in the program, a signal from now on changes nothing
     if code is not None and not isinstance(code, int):
         sys.exit(code)  # a message: printed and exit status 1, as Python does
     try:
