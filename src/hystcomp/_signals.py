@@ -26,18 +26,17 @@ temporary file takes (so none is under way, and none starts after it), it remove
 temporaries, ends the forked helper processes, writes the one line and calls
 :func:`os._exit`. Either way the exit status is 128 + the signal's number (130 for
 SIGINT, 143 for SIGTERM, 129 for SIGHUP), standard error has one line, no output is
-replaced and no temporary is left. :func:`os._exit` skips the interpreter's teardown,
-which, with numba's and llvmlite's state half way through something, is where crashes
-such as a double free came from.
+replaced and no temporary is left. :func:`os._exit` also skips the interpreter's
+teardown, which would deallocate numba's and llvmlite's state half way through a
+computation (an interrupted run once ended in a double free).
 
 Called as a library (``main([...])`` in a test or a notebook), the handlers are installed
 for the command's duration only, without the watcher: a signal stops the command at its
 next safe point, and :class:`Interrupted` becomes ``SystemExit(128 + n)``.
 
-A leaf: the standard library only, imported before anything else by the program
-(:mod:`hystcomp._program`), so that the handlers are in place within milliseconds of the
-start; only Python's own start-up (before any line of hystcomp runs) keeps Python's
-behaviour.
+A leaf: the standard library only. The program (:func:`hystcomp._program.run`) records
+signals from its first line and hands them over here, so that only Python's own
+start-up, before any line of hystcomp runs, keeps Python's behaviour.
 """
 
 from __future__ import annotations
