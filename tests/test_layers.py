@@ -18,6 +18,7 @@ SRC = Path(hystcomp.__file__).parent
 LAYERS = {
     "hystcomp.errors": 0,
     "hystcomp.paper": 0,
+    "hystcomp._signals": 0,  # the standard library only: the program imports it first
     "hystcomp._validation": 1,
     "hystcomp._hyperparameters": 1,
     "hystcomp._progress": 1,
@@ -36,6 +37,7 @@ LAYERS = {
     "hystcomp.experiment": 5,
     "hystcomp.cli": 6,
     "hystcomp.__main__": 6,
+    "hystcomp._program": 6,
 }
 
 

@@ -15,10 +15,9 @@ command line's ``--help`` do not load numba and SciPy before anything is asked o
 True
 """
 
-from __future__ import annotations
-
-import importlib
-from typing import TYPE_CHECKING
+# No import at all up to here (nor __future__'s): the program's first lines come next
+# (hystcomp._program, its signal handling). As typing.TYPE_CHECKING, to mypy too:
+TYPE_CHECKING = False
 
 __version__ = "0.1.0"
 
@@ -74,6 +73,8 @@ def __getattr__(name: str):
         module, attribute = _LAZY[name]
     except KeyError:
         raise AttributeError(f"module 'hystcomp' has no attribute {name!r}") from None
+    import importlib  # here: the program's first lines import nothing (hystcomp._program)
+
     value = importlib.import_module(module)
     if attribute is not None:
         value = getattr(value, attribute)

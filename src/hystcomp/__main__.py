@@ -1,5 +1,5 @@
 """``python -m hystcomp``: the ``hystcomp`` command."""
 
-from hystcomp.cli import run
+from hystcomp._program import run
 
 run()

@@ -4,7 +4,9 @@ Rules (the same for every command): nothing is shown for a step shorter than
 :data:`DELAY` seconds; after that one line is redrawn in place (``\\r``) at most every
 :data:`INTERVAL` seconds and erased when the step ends. It is shown only when standard
 error is a terminal: in a log file or a pipe, redrawn lines are noise, and the command's
-own summary lines say what was done. ``--quiet`` turns it off.
+own summary lines say what was done. ``--quiet`` turns it off. Each step reported (a
+chunk read or written) is a safe point where a signal stops the command
+(:func:`hystcomp._signals.check`), shown or not.
 """
 
 from __future__ import annotations
@@ -12,6 +14,8 @@ from __future__ import annotations
 import sys
 import threading
 import time
+
+from hystcomp import _signals
 
 #: Seconds a step runs before its progress line appears.
 DELAY = 2.0
@@ -60,6 +64,7 @@ class Progress:
         if fraction >= 1.0:
             self.__exit__()  # done: erase the line
         else:
+            _signals.check()  # a step of a chunked read or write: a safe point to stop
             self._draw(f"{100 * max(fraction, 0.0):.0f} %")
 
     def _draw(self, status: str, *, force: bool = False) -> None:

@@ -66,9 +66,13 @@ def check_real(
 
 
 def check_range(value, name: str, owner: str) -> tuple[float, float]:
-    """Return ``(low, high)`` with finite ``low < high`` or raise."""
+    """Return ``(low, high)`` with finite ``low < high`` or raise (booleans and text are not
+    numbers here: ``(False, True)`` is not 0 .. 1 V)."""
     try:
-        low, high = (float(v) for v in value)
+        low, high = value
+        if not all(isinstance(v, numbers.Real) and not isinstance(v, bool) for v in (low, high)):
+            raise TypeError
+        low, high = float(low), float(high)
     except (TypeError, ValueError, OverflowError):
         raise InvalidParameterError(
             f"The {name!r} parameter of {owner} must be a pair (low, high) of numbers. "

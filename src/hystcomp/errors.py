@@ -25,15 +25,17 @@ class InvalidSignalError(HystcompError, ValueError):
 
 
 class NotInvertibleError(HystcompError, ValueError):
-    """A model has no inverse: a partial sum of its weights is not positive.
+    """A model has no inverse: a partial sum of its weights is not positive (PI, MPI), or
+    a branch of a Preisach model falls.
 
     Attributes
     ----------
-    index : int
-        The first index ``i`` at which ``w_0 + ... + w_i <= 0``.
+    index : int or None
+        The first index ``i`` at which ``w_0 + ... + w_i <= 0``; None for a Preisach model
+        (the message names the table's entries or the voltages).
     """
 
-    def __init__(self, message: str, index: int):
+    def __init__(self, message: str, index: int | None = None):
         super().__init__(message)
         self.index = index
 

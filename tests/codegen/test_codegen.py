@@ -18,7 +18,7 @@ from hystcomp.codegen import export_c, generate_c
 from hystcomp.errors import InvalidParameterError
 from hystcomp.identify.excitation import sinusoid_sequence
 from hystcomp.models.hammerstein import HammersteinModel
-from tests.conftest import invertible_weights, random_walk
+from tests.conftest import invertible_weights, monotone_theta, random_walk
 
 CC = shutil.which("cc")
 STRICT = ["-std=c99", "-O2", "-Wall", "-Wextra", "-Werror", "-pedantic"]
@@ -464,8 +464,7 @@ def test_preisach_source_is_freestanding_c99(tmp_path):
 
 @pytest.mark.parametrize("degree", [1, 2, 3, 5])
 def test_preisach_coefficients_are_baked_in_with_full_precision(degree, rng):
-    powers = np.array([i + j for i, j in pk.monomial_exponents(degree)])
-    theta = rng.normal(size=powers.size) / 100.0**powers  # X of tens of um on 0..120 V
+    theta = monotone_theta(rng, degree, 120.0, 30.0)  # invertible: every branch rises
     model = hystcomp.Preisach.from_parameters(
         theta=theta, voltage_range=(-20.0, 100.0), output_offset=-3.5, max_extrema=64
     )

@@ -4,14 +4,55 @@ Every kernel is cached on disk (``cache=True``) and compiled lazily, on its firs
 importing hystcomp compiles nothing. All kernels share the fast-math flags of
 :data:`FASTMATH`, so that a streaming step and the batch run it mirrors (and the kernels that
 inline each other) are compiled under the same rules and agree bit for bit.
+
+Where numba finds no folder to cache in (a read-only install and an unwritable home
+folder, with ``NUMBA_CACHE_DIR`` unset), numba refuses ``cache=True`` at the decoration;
+the kernels are then compiled without the cache on every run (:func:`caching`), and one
+note on standard error says so and names ``NUMBA_CACHE_DIR``.
 """
 
 from __future__ import annotations
 
 import functools
+import sys
 from collections import namedtuple
 
 import numba
+
+#: The note on standard error when kernels cannot be cached (one line).
+NO_CACHE_NOTE = (
+    "hystcomp: note: numba finds no writable folder for its cache of compiled kernels "
+    "(the install is read-only and so is the home folder's cache), so they are compiled "
+    "anew in every run (seconds); set NUMBA_CACHE_DIR to a writable folder to keep them.\n"
+)
+
+
+def _probe() -> int:  # pragma: no cover - never called, only decorated
+    return 0
+
+
+@functools.cache
+def caching() -> bool:
+    """Whether numba can cache kernels on disk here; if not, write :data:`NO_CACHE_NOTE`
+    once to standard error and compile every kernel without the cache.
+
+    Numba looks for a folder when a function is decorated with ``cache=True`` (beside the
+    source, in the user's cache folder, or ``NUMBA_CACHE_DIR``), and raises if it finds
+    none: this module's own file stands for every kernel of the package.
+    """
+    try:
+        numba.njit(cache=True)(_probe)
+    except RuntimeError as exc:
+        if "no locator available" not in str(exc):
+            raise
+        try:
+            sys.stderr.write(NO_CACHE_NOTE)
+            sys.stderr.flush()
+        except (OSError, ValueError, AttributeError):  # no standard error to write to
+            pass
+        return False
+    return True
+
 
 #: Fast-math without 'nnan'/'ninf': reassociation lets the reductions vectorise, while the
 #: finiteness tests on the input must survive compilation.
@@ -20,7 +61,7 @@ FASTMATH = {"reassoc", "contract", "nsz", "arcp"}
 
 def kernel(func):
     """Compile ``func`` as a batch kernel: cached, :data:`FASTMATH`, the GIL released."""
-    return numba.njit(cache=True, fastmath=FASTMATH, nogil=True)(func)
+    return numba.njit(cache=caching(), fastmath=FASTMATH, nogil=True)(func)
 
 
 def inline_kernel(func):
@@ -31,7 +72,7 @@ def inline_kernel(func):
     sites: each inlined copy is typed and compiled again, and the first run's compile time
     grows with every copy. A small :func:`inner_kernel` is often the better choice.
     """
-    return numba.njit(cache=True, fastmath=FASTMATH, nogil=True, inline="always")(func)
+    return numba.njit(cache=caching(), fastmath=FASTMATH, nogil=True, inline="always")(func)
 
 
 def inner_kernel(func):
@@ -47,7 +88,11 @@ def inner_kernel(func):
     a third of that of a small kernel.
     """
     return numba.njit(
-        cache=True, fastmath=FASTMATH, _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True
+        cache=caching(),
+        fastmath=FASTMATH,
+        _nrt=False,
+        no_cpython_wrapper=True,
+        no_cfunc_wrapper=True,
     )(func)
 
 
@@ -62,7 +107,7 @@ def step_kernel(func):
     that a step and the batch run it mirrors agree bit for bit. :func:`step_function` gives
     its fast entry point.
     """
-    return numba.njit(cache=True, fastmath=FASTMATH, _nrt=False)(func)
+    return numba.njit(cache=caching(), fastmath=FASTMATH, _nrt=False)(func)
 
 
 @functools.cache

@@ -3,9 +3,10 @@
 Each subcommand lives in its own module of this package and registers itself on
 :data:`main`. Exit status: 0 on success, 2 on bad usage or bad input (one line on
 standard error that names the problem and the fix, no traceback), 1 on an internal fault,
-141 when standard output is closed early (``| head``), 130 on Ctrl-C (SIGINT) and 143 on
-SIGTERM; an interrupted command removes its temporary files and leaves its outputs as
-they were. ``hystcomp`` alone prints its usage and commands on standard error (exit 2).
+141 when standard output is closed early (``| head``), 130 on Ctrl-C (SIGINT), 143 on
+SIGTERM and 129 on SIGHUP (the terminal closed); an interrupted command removes its
+temporary files and leaves its outputs as they were (:mod:`hystcomp._signals`).
+``hystcomp`` alone prints its usage and commands on standard error (exit 2).
 """
 
 from __future__ import annotations
@@ -18,42 +19,22 @@ import sys
 
 import click
 
+from hystcomp import _signals
 from hystcomp.errors import HystcompError
 
 EXIT_BAD_INPUT = 2
 EXIT_INTERNAL = 1
 EXIT_BROKEN_PIPE = 141  # 128 + SIGPIPE, as a shell reports a command killed by it
-EXIT_SIGINT = 130  # 128 + SIGINT
-EXIT_SIGTERM = 143  # 128 + SIGTERM
+EXIT_SIGINT = 128 + signal.SIGINT  # 130
+EXIT_SIGTERM = 128 + signal.SIGTERM  # 143
+EXIT_SIGHUP = 129  # 128 + SIGHUP (POSIX)
 
 
 def remove_pending() -> None:
-    """Remove the temporary outputs of an interrupted write (none if no file module ran)."""
+    """Remove the temporary outputs of a failed write (none if no file module ran)."""
     atomic = sys.modules.get("hystcomp.io.atomic")  # not imported here if no file was written
     if atomic is not None:
         atomic.remove_pending()
-
-
-class _Terminated(BaseException):
-    """SIGTERM, raised in the main thread so that cleanup code (finally) runs."""
-
-
-def _on_sigterm(signum, frame):
-    raise _Terminated
-
-
-@contextlib.contextmanager
-def _sigterm_unwinds():
-    """While a command runs, SIGTERM unwinds the stack (removing temporaries) as Ctrl-C does."""
-    try:
-        previous = signal.signal(signal.SIGTERM, _on_sigterm)
-    except ValueError:  # not the main thread: leave signals alone
-        yield
-        return
-    try:
-        yield
-    finally:
-        signal.signal(signal.SIGTERM, previous)
 
 
 def _one_line(text: str) -> str:
@@ -141,17 +122,14 @@ class _Group(click.Group):
 
     def main(self, args=None, prog_name=None, complete_var=None, standalone_mode=True, **extra):
         try:
-            with _sigterm_unwinds():
+            with _signals.installed():  # signals recorded; the command stops at a safe point
                 return super().main(args, prog_name, complete_var, standalone_mode=False, **extra)
-        except _Terminated:
-            remove_pending()
-            click.echo("hystcomp: terminated", err=True)
-            sys.exit(EXIT_SIGTERM)
+        except _signals.Interrupted as exc:  # (its temporaries are removed by then)
+            sys.exit(_signals.finish(exc))
         except click.exceptions.Abort as exc:
-            remove_pending()
             if isinstance(exc.__cause__, KeyboardInterrupt):  # click's wrapping of Ctrl-C
-                click.echo("hystcomp: interrupted", err=True)
-                sys.exit(EXIT_SIGINT)
+                sys.exit(_signals.finish(_signals.Interrupted(signal.SIGINT)))
+            remove_pending()
             click.echo("hystcomp: aborted", err=True)
             sys.exit(EXIT_INTERNAL)
         except click.exceptions.NoArgsIsHelpError as exc:  # plain `hystcomp`: usage, commands
@@ -178,10 +156,8 @@ class _Group(click.Group):
             with contextlib.suppress(OSError, ValueError):  # no flush error at exit either
                 os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
             sys.exit(EXIT_BROKEN_PIPE)
-        except KeyboardInterrupt:
-            remove_pending()
-            click.echo("hystcomp: interrupted", err=True)
-            sys.exit(EXIT_SIGINT)
+        except KeyboardInterrupt:  # raised by code, or Python's handler before ours
+            sys.exit(_signals.finish(_signals.Interrupted(signal.SIGINT)))
         except OSError as exc:  # the system refused a path or a write: bad input, not a fault
             remove_pending()
             where = f" {os.fsdecode(exc.filename)[:120]!r}" if exc.filename else ""
@@ -204,13 +180,15 @@ class _Group(click.Group):
 def run() -> None:
     """The ``hystcomp`` program: :data:`main`, then the process ends without tearing down.
 
-    The console script and ``python -m hystcomp`` call this, never a test (which calls
-    :data:`main`). Once a command has returned, its outputs are written, closed and renamed
-    into place, and standard output and error are flushed here; what is left is the
-    interpreter's teardown, which deallocates every module and compiled kernel one by one:
-    0.4 to 0.6 s of a 4 s ``hystcomp compare``, measured in alternated runs. So the
-    process ends with :func:`os._exit` and the command's exit status. If a flush fails
-    (standard output closed early), the normal exit path runs and reports it.
+    The console script and ``python -m hystcomp`` call this (through
+    :mod:`hystcomp._program`, which installs the signal handling before anything else is
+    imported), never a test (which calls :data:`main`). Once a command has returned, its
+    outputs are written, closed and renamed into place, and standard output and error are
+    flushed here; what is left is the interpreter's teardown, which deallocates every
+    module and compiled kernel one by one: 0.4 to 0.6 s of a 4 s ``hystcomp compare``,
+    measured in alternated runs. So the process ends with :func:`os._exit` and the
+    command's exit status. If a flush fails (standard output closed early), the normal
+    exit path runs and reports it.
     """
     code: int | str | None
     try:
@@ -218,6 +196,7 @@ def run() -> None:
         code = result if isinstance(result, int) else 0
     except SystemExit as exc:
         code = exc.code
+    _signals.done()  # returned: in the program, a signal from now on changes nothing
     if code is not None and not isinstance(code, int):
         sys.exit(code)  # a message: printed and exit status 1, as Python does
     try:

@@ -86,6 +86,36 @@ def voltage_range(ctx, param, value):
     return (lo, hi)
 
 
+#: ``--voltage-range LO HI`` of compensate and export-c: a clamp inside the model's range.
+narrow_range_option = click.option(
+    "--voltage-range",
+    "narrow_range",
+    nargs=2,
+    type=float,
+    default=None,
+    metavar="LO HI",
+    callback=voltage_range,
+    help="Clamp the output to this range in V, inside the model's range (it may only "
+    "narrow it) [the model's range].",
+)
+
+
+def narrowed(model, narrow_range) -> dict:
+    """``{"voltage_range": narrow_range}`` for ``model.inverse``, or ``{}`` if not given;
+    a range reaching beyond the model's is refused as the option's error."""
+    if narrow_range is None:
+        return {}
+    (lo, hi), (low, high) = model.voltage_range_, narrow_range
+    if low < lo or high > hi:
+        raise click.BadParameter(
+            f"may only narrow the model's voltage range {lo:g} .. {hi:g} V: the model was "
+            f"identified inside it and would command voltages it never saw. Got {low:g} "
+            f"{high:g}; choose limits within it, or identify over a wider range.",
+            param_hint="'--voltage-range'",
+        )
+    return {"voltage_range": narrow_range}
+
+
 def columns(ctx, param, value):
     """A callback: a column mapping such as ``v=1,x=5`` (see :func:`parse_columns`)."""
     from hystcomp.io.records import parse_columns

@@ -7,11 +7,14 @@ import functools
 import gc
 import os
 import time
+from pathlib import Path
 from typing import Any
 
 import click
 
+from hystcomp import _signals
 from hystcomp.cli import main
+from hystcomp.io.atomic import forget_folder, track_new_folder
 
 
 @main.command("compare")
@@ -67,6 +70,9 @@ def compare(out_dir: str, seed: int, periods: int | None, quick: bool, quiet: bo
     )
     config = CompareConfig.quick(**changes) if quick else CompareConfig(**changes)
     jobs: dict[str, BackgroundJob | None] = {}
+    # a folder made for the outputs goes again if the run fails or is interrupted
+    made = None if not out_dir or os.path.exists(out_dir) else Path(out_dir)
+    failed = True
     try:
         # the second core: on a first run the kernels needed later, then on every run the
         # twin's dynamics (SciPy's optimisers and the fits), before matplotlib's import here
@@ -79,8 +85,11 @@ def compare(out_dir: str, seed: int, periods: int | None, quick: bool, quiet: bo
 
         with _collecting_garbage_less():  # after the imports: they stay frozen
             prepare_output_dir(out_dir)  # refuse a bad --out before the work
+            if made is not None:
+                track_new_folder(made)
 
             def progress(line: str) -> None:
+                _signals.check()  # between the steps: a safe point to stop
                 if not quiet:
                     click.echo(f"hystcomp compare: {line}", err=True)
 
@@ -101,10 +110,13 @@ def compare(out_dir: str, seed: int, periods: int | None, quick: bool, quiet: bo
             click.echo(format_table(comparison))
             seconds = time.perf_counter() - start
             progress(f"done in {seconds:.1f} s; wrote {len(files)} files into {out_dir}")
+            failed = False
     finally:  # collected by now, unless the run failed: then ended here
         for job in jobs.values():
             if job is not None:
                 job.cancel()
+        if made is not None:  # a failed run leaves no empty folder behind
+            forget_folder(made, remove=failed)
 
 
 @contextlib.contextmanager

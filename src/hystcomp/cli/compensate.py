@@ -8,6 +8,7 @@ from typing import Any
 import click
 import numpy as np
 
+from hystcomp._validation import MAX_MAGNITUDE
 from hystcomp.cli import main
 from hystcomp.cli._dynamics import dynamics_for, load_dynamics, refuse_dynamics_as_model
 from hystcomp.cli._options import (
@@ -16,12 +17,13 @@ from hystcomp.cli._options import (
     fs_option,
     method_option,
     method_options,
+    narrow_range_option,
+    narrowed,
     output_option,
     positive,
     progress,
     quiet_option,
     read_options,
-    voltage_range,
     warn_x_unit,
     x_unit_option,
 )
@@ -33,7 +35,7 @@ from hystcomp.models.hammerstein import HammersteinModel
 from hystcomp.workflows.pair import predicted_worse
 
 
-def inverse_options(model, table, *, slew_rate, narrow_range) -> dict:
+def inverse_options(model, table, *, slew_rate, narrow_range, path="the reference") -> dict:
     """Keyword arguments of ``model.inverse`` for the command's options.
 
     The slew-rate limit is per sample, so it needs the reference's own sample rate. With
@@ -41,18 +43,8 @@ def inverse_options(model, table, *, slew_rate, narrow_range) -> dict:
     """
     options: dict[str, Any] = {}
     if slew_rate is not None:
-        shortest = float(np.min(np.diff(table["t"])))
-        options.update(slew_rate=slew_rate, sample_rate=1.0 / shortest)
-    if narrow_range is not None:
-        (lo, hi), (low, high) = model.voltage_range_, narrow_range
-        if low < lo or high > hi:
-            raise click.BadParameter(
-                f"may only narrow the model's voltage range {lo:g} .. {hi:g} V: the model was "
-                f"identified inside it and would command voltages it never saw. Got {low:g} "
-                f"{high:g}; choose limits within it, or identify over a wider range.",
-                param_hint="'--voltage-range'",
-            )
-        options["voltage_range"] = narrow_range
+        options.update(slew_rate=slew_rate, sample_rate=_slew_sample_rate(table["t"], path))
+    options.update(narrowed(model, narrow_range))
     return options
 
 
@@ -73,17 +65,7 @@ def inverse_options(model, table, *, slew_rate, narrow_range) -> dict:
     help="Largest voltage slew rate of the output, in V/s, at the reference's own sample "
     "rate (none by default).",
 )
-@click.option(
-    "--voltage-range",
-    "narrow_range",
-    nargs=2,
-    type=float,
-    default=None,
-    metavar="LO HI",
-    callback=voltage_range,
-    help="Clamp the output to this range in V, inside the model's range (it may only "
-    "narrow it) [the model's range].",
-)
+@narrow_range_option
 @method_option
 @click.option(
     "--dynamics",
@@ -138,7 +120,9 @@ def compensate(
     options = read_options(columns, sample_rate, x_unit, quiet, reference_file, reads=("x",))
     table = read_table(reference_file, ("x",), **options)
     warn_x_unit(table["x"], reference_file, quiet, x_unit)
-    options = inverse_options(model, table, slew_rate=slew_rate, narrow_range=narrow_range)
+    options = inverse_options(
+        model, table, slew_rate=slew_rate, narrow_range=narrow_range, path=reference_file
+    )
     if pair:
         dynamics_for(model.dynamics, table)  # it runs at the dynamics' rate only
         options.pop("sample_rate", None)
@@ -188,6 +172,9 @@ def compensate(
                 f"{d_lo:.4g} .. {d_hi:.4g} µm, or drop --strict to accept the clamp."
             )
         click.echo(f"hystcomp: warning: {what}.", err=True)
+    beyond = _beyond_record(model, v)
+    if beyond is not None:
+        click.echo(f"hystcomp: warning: {beyond}", err=True)
     if getattr(getattr(compensator, "hysteresis", compensator), "method", None) == "multiplicative":
         spikes = _own_turns(v, table["x"], hi - lo)
         if spikes is not None:
@@ -216,6 +203,29 @@ def compensate(
         )
 
 
+#: A step of the reference's time column shorter than this share of its median step is a
+#: fault of the column, not jitter: at its rate the slew-rate limit would all but hold the
+#: voltage still on every sample.
+SHORTEST_STEP = 1e-3
+
+
+def _slew_sample_rate(t, path) -> float:
+    """The rate (Hz) of the shortest step of ``t``, at which the slew-rate limit holds on
+    every step; refused, naming the row, if that step is a fault of the time column."""
+    steps = np.diff(t)
+    k = int(np.argmin(steps))
+    shortest, median = float(steps[k]), float(np.median(steps))
+    if not shortest >= SHORTEST_STEP * median or not 1.0 / shortest <= MAX_MAGNITUDE:
+        raise InvalidSignalError(
+            f"--slew-rate limits the voltage's change per sample at the reference's shortest "
+            f"time step, but the time column 't' of {str(path)!r} steps by only "
+            f"{shortest:.3g} s from t = {float(t[k])!r} to {float(t[k + 1])!r} s (data row "
+            f"{k + 2}), against a median step of {median:.3g} s: the limit would hold the "
+            "voltage nearly still. Correct the time column there, or drop it and give --fs."
+        )
+    return 1.0 / shortest
+
+
 #: A turn of the voltage larger than this fraction of the range, where the reference does
 #: not turn, is eq. 10 overshooting: its recursion corrects with the constant gain rho, and
 #: where the model is steeper (a step, or a slope beyond 2 rho) it overshoots, or chatters.
@@ -237,6 +247,28 @@ def _own_turns(v, x, span: float):
         return None
     largest = int(np.argmax(np.where(own, size, 0.0)))
     return int(np.count_nonzero(own)), float(size[largest]), largest + 1
+
+
+def _beyond_record(model, v) -> str | None:
+    """Words for the samples of ``v`` beyond the input range the model's record covered
+    (:meth:`~hystcomp.models.base.HysteresisModel.covered_range`), or None: the model's
+    range was given wider than its record, and the model extrapolates there."""
+    covered = model.covered_range()
+    if covered is None:
+        return None
+    lo, hi = covered
+    slack = 1e-9 * (hi - lo)
+    beyond = int(np.count_nonzero((v < lo - slack) | (v > hi + slack)))
+    if not beyond:
+        return None
+    return (
+        f"{beyond} of {v.size} samples command voltages beyond {lo:.4g} .. {hi:.4g} V, the "
+        f"range that the model's record covered (v from {v.min():.4g} to {v.max():.4g} V; "
+        f"the model's range {model.voltage_range_[0]:.4g} .. {model.voltage_range_[1]:.4g} V "
+        "was given wider): the model extrapolates there. Check the tracking there, narrow "
+        f"the output with --voltage-range {lo:.6g} {hi:.6g}, or identify from a record "
+        "that covers the range."
+    )
 
 
 def _reach(model, lo: float, hi: float) -> tuple[str, tuple[float, float]]:

@@ -10,7 +10,13 @@ import click
 from hystcomp import paper
 from hystcomp.cli import main
 from hystcomp.cli._dynamics import load_dynamics, refuse_dynamics_as_model
-from hystcomp.cli._options import method_option, method_options, positive
+from hystcomp.cli._options import (
+    method_option,
+    method_options,
+    narrow_range_option,
+    narrowed,
+    positive,
+)
 from hystcomp.codegen import DEFAULT_PREFIX, check_prefix, export_c
 from hystcomp.errors import HystcompWarning, ModelFileError
 from hystcomp.io.atomic import check_output_path
@@ -53,6 +59,7 @@ from hystcomp.models.hammerstein import HammersteinModel
     callback=positive("Hz, the rate at which NAME_step is called"),
     help="Sample rate at which NAME_step is called; sets the slew step per sample.",
 )
+@narrow_range_option
 @method_option
 @click.option(
     "--dynamics",
@@ -62,11 +69,14 @@ from hystcomp.models.hammerstein import HammersteinModel
     help="Also invert the linear dynamics of this file (beyond the paper); NAME_step then "
     "takes the reference a fixed number of samples ahead (see the header).",
 )
-def export_c_command(model_file, directory, prefix, slew_rate, sample_rate, method, dynamics_file):
+def export_c_command(
+    model_file, directory, prefix, slew_rate, sample_rate, narrow_range, method, dynamics_file
+):
     """Write MODEL_FILE's compensator as C99 code: NAME.h and NAME.c in folder -o.
 
     The code has the identified parameters baked in, clamps its output to the model's
-    voltage range and holds the last output when the reference is not finite:
+    voltage range (or a narrower --voltage-range) and holds the last output when the
+    reference is not finite:
 
     \b
       void   NAME_init(NAME_state *s);
@@ -78,7 +88,7 @@ def export_c_command(model_file, directory, prefix, slew_rate, sample_rate, meth
         check_output_path(directory / f"{prefix}{suffix}", inputs=(model_file,))
     model = load_model(model_file)
     refuse_dynamics_as_model(model, model_file)
-    options = {"slew_rate": slew_rate, "sample_rate": sample_rate}
+    options = {"slew_rate": slew_rate, "sample_rate": sample_rate, **narrowed(model, narrow_range)}
     pair = isinstance(model, HammersteinModel)
     if pair and dynamics_file is not None:
         raise ModelFileError(

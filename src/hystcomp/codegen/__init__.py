@@ -24,7 +24,7 @@ from hystcomp.codegen.c99 import CTemplate, check_prefix, render
 from hystcomp.codegen.chain import chain_template
 from hystcomp.codegen.preisach import preisach_template
 from hystcomp.errors import InvalidParameterError, InvalidTypeError
-from hystcomp.io.atomic import atomic_paths, check_output_path
+from hystcomp.io.atomic import atomic_paths, check_output_path, forget_folder, track_new_folder
 
 DEFAULT_PREFIX = "hystcomp_compensator"
 
@@ -43,7 +43,7 @@ def generate_c(
     *,
     prefix: str = DEFAULT_PREFIX,
     source: str | None = None,
-    sample_rate: float = paper.SAMPLE_RATE,
+    sample_rate: float | None = None,
 ) -> tuple[str, str]:
     """The C99 header and source of ``compensator`` (see :func:`export_c`).
 
@@ -70,7 +70,7 @@ def generate_c(
             f"Got a compensator of kind {kind!r}."
         )
     check_prefix(prefix)
-    sample_rate = check_real(sample_rate, "sample_rate", "generate_c", positive=True)
+    sample_rate = _code_rate(compensator, sample_rate)
     inner = getattr(compensator, "hysteresis", compensator)  # a DynamicCompensator's
     template = TEMPLATES[kind](inner)
     if inner is not compensator:
@@ -80,13 +80,31 @@ def generate_c(
     return render(template, prefix, source=source, sample_rate=sample_rate)
 
 
+def _code_rate(compensator, sample_rate) -> float:
+    """The rate (Hz) the code is called at: ``sample_rate``, else the compensator's own
+    (the dynamics' rate of a compensator with them), else 20000. A compensator with
+    dynamics runs at their rate only: another ``sample_rate`` is refused."""
+    own = getattr(compensator, "sample_rate", None)
+    if sample_rate is None:
+        return paper.SAMPLE_RATE if own is None else float(own)
+    sample_rate = check_real(sample_rate, "sample_rate", "generate_c", positive=True)
+    if own is not None and abs(sample_rate - own) > 1e-9 * own:
+        raise InvalidParameterError(
+            f"The 'sample_rate' parameter of generate_c/export_c ({sample_rate:g} Hz) differs "
+            f"from the rate of the compensator's dynamics ({own:g} Hz): its inverse of the "
+            "dynamics, and so the code, runs at that rate only. Leave sample_rate out, or "
+            "identify the dynamics at the rate the code is called."
+        )
+    return sample_rate
+
+
 def export_c(
     compensator,
     directory: str | os.PathLike,
     *,
     prefix: str = DEFAULT_PREFIX,
     source: str | None = None,
-    sample_rate: float = paper.SAMPLE_RATE,
+    sample_rate: float | None = None,
     inputs=(),
 ) -> tuple[Path, Path]:
     """Write ``PREFIX.h`` and ``PREFIX.c``, a C99 version of ``compensator``, into ``directory``.
@@ -106,15 +124,18 @@ def export_c(
         Names the files, the state type ``PREFIX_state`` and the functions; a C identifier.
     source : str, optional
         The model file, named in the header comment.
-    sample_rate : float, default 20000
-        Hz at which the code is meant to be called, for the header comment (finite, > 0).
+    sample_rate : float, optional
+        Hz at which the code is meant to be called, for the header comment (finite, > 0);
+        by default the compensator's own (that of its dynamics), else 20000. A compensator
+        with dynamics runs at their rate only: another rate is refused.
     inputs : sequence of path, optional
         Files the caller read (the model file): refused as outputs, never overwritten.
 
     Returns
     -------
     (Path, Path)
-        The header and source written. Nothing is written if anything fails, and existing
+        The header and source written. Nothing is written if anything fails (a folder
+        made for them is removed again), and existing
         files are replaced only once both new files are complete (both, or neither). The
         header defines ``PREFIX_PAIR_ID``, a hash of both files, which the source checks
         with ``#error``: a pair mixed from two exports does not compile.
@@ -136,11 +157,22 @@ def export_c(
                 "choose another output folder."
             )
         directory.mkdir()
+        made = directory
+        track_new_folder(made)  # removed (if empty) should a signal end the command
+    else:
+        made = None
     paths = (directory / f"{prefix}.h", directory / f"{prefix}.c")
-    for path in paths:
-        check_output_path(path, inputs=inputs)
-    # both files checked before anything is written, renamed into place only once both are
-    with atomic_paths(*paths) as (tmp_h, tmp_c):
-        tmp_h.write_text(header, encoding="ascii")
-        tmp_c.write_text(source_text, encoding="ascii")
+    try:
+        for path in paths:
+            check_output_path(path, inputs=inputs)
+        # both files checked before anything is written, renamed into place only once both are
+        with atomic_paths(*paths) as (tmp_h, tmp_c):
+            tmp_h.write_text(header, encoding="ascii")
+            tmp_c.write_text(source_text, encoding="ascii")
+    except BaseException:
+        if made is not None:  # a failed export leaves no empty folder behind
+            forget_folder(made, remove=True)
+        raise
+    if made is not None:
+        forget_folder(made, remove=False)
     return paths

@@ -92,6 +92,10 @@ def start(config) -> BackgroundJob | None:
 
 def _in_cache(kernel) -> bool:
     """Whether numba's on-disk cache holds compiled code of ``kernel`` (a data file named
-    after it, as numba names them: ``<module>.<name>-<line>.py<version>.<n>.nbc``)."""
-    folder = Path(kernel.stats.cache_path)
+    after it, as numba names them: ``<module>.<name>-<line>.py<version>.<n>.nbc``); never
+    where kernels are not cached (:func:`hystcomp._kernels._jit.caching`)."""
+    path = kernel.stats.cache_path
+    if path is None:
+        return False
+    folder = Path(path)
     return any(folder.glob(f"*.{kernel.py_func.__name__}-*.nbc"))

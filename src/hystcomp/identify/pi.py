@@ -63,6 +63,7 @@ from hystcomp._validation import as_signal, check_int, check_real
 from hystcomp.errors import IdentificationError, InvalidParameterError, InvalidSignalError
 from hystcomp.identify import scoring
 from hystcomp.identify.lsq import constrained_lsq, held_out_fits, normal_equations
+from hystcomp.identify.outliers import check_isolated
 from hystcomp.identify.scoring import (
     check_response,
     check_transient,
@@ -181,6 +182,7 @@ def prepare_record(
             f"{owner}: 'v' and 'x' must have one sample each per instant. Got {v.size} "
             f"voltage samples and {x.size} displacement samples."
         )
+    check_isolated(v, owner)  # one glitch would set the range and the transient's end
     start = check_transient(transient, v, owner, min_used=2 * n_weights)
     keep = thin(v, start, scoring.MAX_SAMPLES)
     if keep.size < v.size:

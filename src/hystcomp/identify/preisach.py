@@ -31,6 +31,7 @@ from hystcomp.errors import (
     InvalidSignalError,
 )
 from hystcomp.identify.compensation import CV_FOLDS
+from hystcomp.identify.outliers import check_isolated
 from hystcomp.identify.preisach_lsq import MAX_LSQ_GRID, fit_preisach_lsq
 from hystcomp.identify.scoring import (
     check_response,
@@ -369,6 +370,7 @@ def identify_preisach(
         )
     v = as_signal(v, "v", min_samples=3)  # writable: the kernels compile for one array type
     x = as_signal(x, "x", min_samples=3)
+    check_isolated(v, owner)  # one glitch would set the Preisach plane
     curves = find_reversal_curves(v, x, tolerance=tolerance)
     check_response(v, x, owner)  # rising, and more than noise
     data_range = (float(v.min()), float(v.max()))

@@ -11,6 +11,7 @@ import numpy as np
 from hystcomp._kernels.reversals import turning_points
 from hystcomp._validation import as_signal, as_signal_pair, check_int
 from hystcomp.errors import IdentificationError
+from hystcomp.identify.outliers import bulk_range
 
 #: How close (as a fraction of the input span) the input must come to an end of its range.
 END_TOLERANCE = 0.01
@@ -27,7 +28,9 @@ def transient_end(v) -> int:
     (wipe-out), the fast part of the transient is over, and from there on the record is
     the periodic hysteresis loop the model describes. A record that starts at an end of its
     range, like the paper's identification signal (eq. 18: relaxed at ``v_min``), loses no
-    sample.
+    sample. The range is that of the record without its isolated samples
+    (:func:`~hystcomp.identify.outliers.isolated_samples`): a single glitch far outside
+    the rest does not stand for an end, and the end it would set is never reached.
 
     Parameters
     ----------
@@ -45,6 +48,9 @@ def transient_end(v) -> int:
     0
     >>> transient_end([1.0, 1.5, 2.0, 1.0, 0.0])
     2
+    >>> v = np.r_[np.linspace(60, 90, 50), -60, np.linspace(90, 120, 51), np.linspace(120, 0, 200)]
+    >>> transient_end(v)  # near 120 V, not the glitch at -60 V (sample 50)
+    99
     """
     v = as_signal(v, "v", min_samples=1)
     return _first_near_an_end(v)
@@ -56,13 +62,14 @@ _SCAN_BLOCK = 1 << 16
 
 
 def _first_near_an_end(v: np.ndarray) -> int:
-    """:func:`transient_end` of a validated signal: two passes for the range, then a scan
-    block by block that stops at the first block holding a sample near an end."""
-    lo, hi = float(v.min()), float(v.max())
+    """:func:`transient_end` of a validated signal: the range without isolated samples,
+    then a scan block by block that stops at the first block holding a sample near an end
+    (within the range: an isolated sample beyond it is not)."""
+    lo, hi = bulk_range(v)
     tol = END_TOLERANCE * (hi - lo)
     for begin in range(0, v.size, _SCAN_BLOCK):
         part = v[begin : begin + _SCAN_BLOCK]
-        near = (part <= lo + tol) | (part >= hi - tol)
+        near = ((part <= lo + tol) & (part >= lo)) | ((part >= hi - tol) & (part <= hi))
         if near.any():
             return begin + int(np.argmax(near))
     return 0  # not reached: the extremes are samples

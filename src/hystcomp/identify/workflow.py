@@ -24,6 +24,7 @@ from hystcomp import paper
 from hystcomp._hyperparameters import check_constraints
 from hystcomp.errors import IdentificationError, InvalidParameterError, InvalidTypeError
 from hystcomp.identify.compensation import tracking_estimate
+from hystcomp.identify.outliers import check_isolated
 from hystcomp.identify.scoring import (
     check_transient,
     coverage_warning,
@@ -425,6 +426,8 @@ def identify_record(
             f"The 'holdout' argument of {_OWNER}, {holdout}, leaves {n_fit} of {n} samples to "
             "fit on; choose a fraction that keeps samples on both sides."
         )
+    # the whole record, rows named as the user counts them (the fit would name v[k])
+    check_isolated(record.v, None, row=lambda k: _data_row(record, k), source=record.source)
     v, x = record.v[:n_fit], record.x[:n_fit]
     chosen_range = model.get_params().get("voltage_range")
     if chosen_range is not None and not allow_extrapolation:
@@ -568,6 +571,11 @@ def identify_record(
         lines=lines,
         warnings=warnings,
     )
+
+
+def _data_row(record, k: int) -> str:
+    """Sample ``k`` of ``record`` as the user finds it: its data row (1-based) and time."""
+    return f"data row {k + 1} (t = {float(record.t[k]):.6g} s)"
 
 
 def _verdict(improvement: float) -> str:

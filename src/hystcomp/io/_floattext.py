@@ -29,6 +29,8 @@ from fractions import Fraction
 import numba
 import numpy as np
 
+from hystcomp._kernels._jit import caching
+
 #: Bytes kept per formatted value (the longest repr of a float64 has 24 characters).
 WIDTH = 32
 _KMIN, _KMAX = -280, 280
@@ -53,7 +55,7 @@ _EPS = 1e-9
 
 def _kernel(func):
     # No fastmath: the error-free transformations need IEEE arithmetic as written.
-    return numba.njit(cache=True, nogil=True)(func)
+    return numba.njit(cache=caching(), nogil=True)(func)  # off where nowhere is writable
 
 
 @_kernel

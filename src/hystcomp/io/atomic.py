@@ -3,22 +3,29 @@
 Every file hystcomp writes goes through here. A command checks its output paths before
 any work (:func:`check_output_path`), writes to temporary files beside them
 (:func:`atomic_paths`, :func:`atomic_path`, or :func:`staging_folder` for a set of files)
-and renames them into place only on success, all or none (:func:`replace_all`). A signal
-handler removes the temporaries of an interrupted write with :func:`remove_pending`.
+and renames them into place only on success, all or none (:func:`replace_all`).
 
-A leaf: this module imports only the standard library, :mod:`hystcomp.errors` and
-:mod:`hystcomp._validation`, never a model or a record reader, so that writing a file
-loads nothing else.
+Signals (:mod:`hystcomp._signals`): every temporary is made and registered under the
+signals' lock, after a check that no signal is pending, and :func:`replace_all` renames
+under that lock only while none is (:func:`hystcomp._signals.commit`); a signal that ends
+the command removes what is registered (:func:`remove_pending`), so an interrupted
+command leaves no temporary and replaces no output, whatever the moment.
+
+A leaf: this module imports only the standard library, :mod:`hystcomp.errors`,
+:mod:`hystcomp._signals` and :mod:`hystcomp._validation`, never a model or a record
+reader, so that writing a file loads nothing else.
 """
 
 from __future__ import annotations
 
 import contextlib
+import functools
 import os
 import shutil
 import tempfile
 from pathlib import Path
 
+from hystcomp import _signals
 from hystcomp._validation import as_path
 from hystcomp.errors import InvalidParameterError, OutputPathError
 
@@ -86,20 +93,74 @@ def write_target(path: Path) -> Path:
     return Path(os.path.realpath(path)) if path.is_symlink() else path
 
 
-#: Temporary files being written now (see :func:`atomic_paths`), for a signal handler that
-#: must remove them before the process ends (:func:`remove_pending`).
+#: Temporary files and folders being written now (see :func:`atomic_paths`), removed by
+#: :func:`remove_pending` if a signal ends the command first.
 _PENDING: set[Path] = set()
+#: Folders made for a command's outputs, removed (if still empty) with the temporaries.
+_MADE: set[Path] = set()
 
 
 def remove_pending() -> None:
-    """Remove every temporary output not yet renamed into place (for signal handlers)."""
-    for tmp in list(_PENDING):
-        with contextlib.suppress(OSError):
-            if tmp.is_dir() and not tmp.is_symlink():
-                shutil.rmtree(tmp)
-            else:
-                os.unlink(tmp)
-        _PENDING.discard(tmp)
+    """Remove every temporary output not yet renamed into place, and the folders made for
+    outputs that are still empty (when a signal ends the command)."""
+    with _signals.lock():
+        for tmp in list(_PENDING):
+            with contextlib.suppress(OSError):
+                if tmp.is_dir() and not tmp.is_symlink():
+                    shutil.rmtree(tmp)
+                else:
+                    os.unlink(tmp)
+            _PENDING.discard(tmp)
+        for folder in sorted(_MADE, key=lambda p: len(p.parts), reverse=True):
+            with contextlib.suppress(OSError):
+                folder.rmdir()  # only if empty
+            _MADE.discard(folder)
+
+
+_signals.add_cleanup(remove_pending)
+
+
+def _new_temporary(make) -> Path:
+    """``make()`` (a new temporary file or folder, its path) under the signals' lock,
+    registered before the lock is let go; refused if a signal is pending."""
+    with _signals.lock():
+        _signals.check()
+        path = Path(make())
+        _PENDING.add(path)
+    return path
+
+
+def new_temporary_folder(prefix: str) -> Path:
+    """A new folder in the system's temporary folder, registered as a pending temporary
+    (removed if a signal ends the command); :func:`discard_temporary` removes it."""
+    return _new_temporary(lambda: tempfile.mkdtemp(prefix=prefix))
+
+
+def discard_temporary(path: Path) -> None:
+    """Remove a temporary of :func:`new_temporary_folder` (or file) and forget it."""
+    with contextlib.suppress(OSError):
+        if path.is_dir() and not path.is_symlink():
+            shutil.rmtree(path)
+        else:
+            os.unlink(path)
+    _PENDING.discard(path)
+
+
+def track_new_folder(path: Path) -> None:
+    """Remember that ``path`` was made for a command's outputs: :func:`remove_pending`
+    removes it if it is still empty (see :func:`forget_folder`)."""
+    with _signals.lock():
+        _MADE.add(Path(path))
+
+
+def forget_folder(path: Path, *, remove: bool) -> None:
+    """Stop tracking ``path`` (:func:`track_new_folder`); ``remove``: remove it now if it
+    is empty (the command failed)."""
+    with _signals.lock():
+        _MADE.discard(Path(path))
+        if remove:
+            with contextlib.suppress(OSError):
+                Path(path).rmdir()
 
 
 @contextlib.contextmanager
@@ -109,8 +170,9 @@ def staging_folder(directory: Path):
     For a command that writes a set of files: write them there, then move them into place
     with :func:`replace_all`.
     """
-    stage = Path(tempfile.mkdtemp(prefix=".hystcomp-", suffix=".tmp", dir=directory))
-    _PENDING.add(stage)
+    stage = _new_temporary(
+        lambda: tempfile.mkdtemp(prefix=".hystcomp-", suffix=".tmp", dir=directory)
+    )
     try:
         yield stage
     finally:
@@ -157,12 +219,8 @@ def atomic_paths(*paths: str | os.PathLike):
         try:
             for target in targets:
                 current = target
-                fd, name = tempfile.mkstemp(
-                    prefix=f".{target.stem}.", suffix=f".tmp{target.suffix}", dir=target.parent
-                )
-                os.close(fd)
-                tmps.append(Path(name))
-                _PENDING.add(Path(name))
+                name = _new_temporary(functools.partial(_temporary_file, target))
+                tmps.append(name)
                 os.chmod(name, _mode_for(target))
             current = None  # the caller writes any of them
             yield list(tmps)
@@ -186,19 +244,39 @@ def atomic_paths(*paths: str | os.PathLike):
             _PENDING.discard(tmp)
 
 
+def _temporary_file(target: Path) -> str:
+    """A new empty hidden file beside ``target`` that keeps its suffix; its path."""
+    fd, name = tempfile.mkstemp(
+        prefix=f".{target.stem}.", suffix=f".tmp{target.suffix}", dir=target.parent
+    )
+    os.close(fd)
+    return name
+
+
 def replace_all(moves: list[tuple[Path, Path]]) -> None:
     """Rename each ``(new, path)`` onto ``path``, all or none.
 
     Each existing ``path`` is first kept under a hidden hard link (a copy where the file
-    system has no links); if any rename fails, or the process is interrupted, every
-    ``path`` already replaced gets its old file back (or is removed if it had none), so
-    the set of files is either all new or all as it was.
+    system has no links); if any rename fails, every ``path`` already replaced gets its
+    old file back (or is removed if it had none), so the set of files is either all new
+    or all as it was. The renames are a commit (:func:`hystcomp._signals.commit`):
+    refused, before the first, once a signal is pending, and not interrupted by one;
+    renames onto temporary files (a writer inside another's atomic output) are not the
+    command's own commit.
 
     Raises
     ------
     OSError
         From the rename that failed, after the rollback.
+    hystcomp._signals.Interrupted
+        A signal is pending: nothing renamed.
     """
+    final = not all(path in _PENDING for _new, path in moves)
+    with _signals.commit(final=final):
+        _replace_all(moves)
+
+
+def _replace_all(moves: list[tuple[Path, Path]]) -> None:
     backups: dict[Path, Path | None] = {}
     done: list[Path] = []
     try:

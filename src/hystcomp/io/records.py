@@ -522,7 +522,16 @@ def _time(path: Path, t, n: int, sample_rate):
                 f"Data file {str(path)!r} has no time column 't': give the sample rate, "
                 "--fs HZ on the command line (sample_rate=HZ in Python)."
             )
-        return np.arange(n) / sample_rate
+        with np.errstate(over="ignore"):
+            t = np.arange(n) / sample_rate
+        if not t[-1] <= MAX_MAGNITUDE:  # inf, or times that no reader here takes back
+            raise InvalidParameterError(
+                f"The sample rate {sample_rate:g} Hz (--fs; sample_rate in Python) makes the "
+                f"time of the last of the {n} samples of {str(path)!r} {float(t[-1]):g} s, "
+                f"beyond the {MAX_MAGNITUDE:g} s a time column may hold. Give the sample "
+                "rate in Hz."
+            )
+        return t
     with np.errstate(over="ignore", invalid="ignore"):
         steps = np.diff(t)
         span = t[-1] - t[0]

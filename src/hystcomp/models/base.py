@@ -19,6 +19,8 @@ from hystcomp.models.estimator import Estimator
 from hystcomp.models.system import PackedSystem
 
 DEFAULT_VOLTAGE_RANGE = paper.VOLTAGE_RANGE  # V, the paper's piezo voltage v_px
+#: The fit report's entry for the input range (V) that the fitted record covered.
+INPUT_RANGE_KEY = "input_range_v"
 
 
 class HysteresisModel(PackedSystem, Estimator):
@@ -58,6 +60,23 @@ class HysteresisModel(PackedSystem, Estimator):
                 f"within {lo:g} .. {hi:g} V, or identify the model over a wider range."
             )
         return low, high
+
+    def covered_range(self) -> tuple[float, float] | None:
+        """The input range (V) that the record the model was fitted on covered, or None.
+
+        ``voltage_range_`` is the amplifier's range, the compensator's clamp: the fitted
+        record's by default, or one given wider (``allow_extrapolation`` of
+        :func:`~hystcomp.identify.workflow.identify_record`) or narrower. This is what the
+        record really covered, from the fit report (``fit_report_["input_range_v"]``); a
+        model built from parameters, or read from a file without it, returns None.
+        """
+        report = getattr(self, "fit_report_", None)
+        value = report.get(INPUT_RANGE_KEY) if isinstance(report, dict) else None
+        try:  # a model file's report is not validated: anything else is "unknown"
+            lo, hi = (float(b) for b in value)  # type: ignore[union-attr]
+        except (TypeError, ValueError):
+            return None
+        return (lo, hi) if np.isfinite(lo) and np.isfinite(hi) and lo < hi else None
 
     def reachable_range(self, voltage_range=None) -> tuple[float, float]:
         """The displacements (µm) the model reaches with voltages inside a range.
@@ -107,6 +126,12 @@ def compensator_rate(sample_rate, dynamics, owner) -> float:
             "sample_rate out, or identify the dynamics at the compensator's rate."
         )
     return sample_rate
+
+
+def input_range_report(v) -> dict[str, list[float]]:
+    """The fit report's entry for the input range (V) that ``v`` covers."""
+    v = np.asarray(v, dtype=np.float64)
+    return {INPUT_RANGE_KEY: [float(v.min()), float(v.max())]}
 
 
 def fit_voltage_range(voltage_range, v, owner) -> tuple[float, float]:

@@ -212,7 +212,10 @@ class DynamicsInverseStepper(Rebound):
                 f"filter's look-ahead. Got {u.size}; pass x_ref[:{self.preview}], then step "
                 f"from x_ref[{self.preview}]."
             )
+        slot = dk.clamped_slot.py_func(self._p)
+        counted = self._p[slot]
         self.step_block(u)
+        self._p[slot] = counted  # outputs before time 0 are never applied: none clamped
 
     def reset(self) -> None:
         """Back to rest."""

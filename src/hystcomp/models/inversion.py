@@ -1,4 +1,8 @@
-"""Analytic inversion of Prandtl-Ishlinskii superpositions (paper eqs. 24-26).
+"""When a hysteresis model has an inverse, and the analytic inversion of PI superpositions.
+
+:func:`check_invertible` (PI and MPI: every partial sum of the weights positive) and
+:func:`check_rising_everett` (Preisach: every branch rises) are the checks every
+compensator of a model goes through, whatever its method, and so C export too.
 
 The same transform inverts a superposition of play operators (the PI model, eq. 12) and a
 superposition of one-sided dead-zones (the saturation operator, eq. 14): both are piecewise
@@ -55,6 +59,85 @@ def check_invertible(weights: np.ndarray, what: str) -> None:
             f"or change weights[{i}].",
             index=i,
         )
+
+
+#: A branch may fall by this share of the largest ``|X|`` (rounding), no more.
+EVERETT_TOLERANCE = 1e-9
+
+
+def check_rising_everett(table: np.ndarray, voltages: np.ndarray, what: str, *, cells: str):
+    """Raise :class:`NotInvertibleError` unless every branch of a Preisach model rises.
+
+    ``table[i, j] = X(voltages[i], voltages[j])`` (eq. 2) on a grid (``j <= i`` read). A
+    branch rising from a minimum ``beta`` is ``X(v, beta)`` plus a constant, one falling
+    from a maximum ``alpha`` is a constant minus ``X(alpha, v)`` (eqs. 3-4): all rise with
+    ``v`` when ``X`` never falls as ``alpha`` rises nor as ``beta`` falls, which on the
+    grid's nodes is enough for a bilinear table. And the major loop must rise:
+    ``X(v_max, v_min) > 0``. A compensator (eq. 10 or the exact inverse) needs both: where
+    a branch falls, eq. (10)'s recursion amplifies its error (its factor ``1 - s / rho``
+    exceeds 1 for a slope ``s < 0``), and the exact inverse jumps over the fall on a slow
+    ramp; a model that does not rise has nothing to invert. A fall within
+    :data:`EVERETT_TOLERANCE` of the largest ``|X|`` is rounding and passes.
+
+    ``cells`` says how the message names a node: ``"table"`` as ``table[i, j]`` (the
+    model file's entry), else as its voltages.
+
+    Examples
+    --------
+    >>> nodes = np.array([0.0, 1.0, 2.0])
+    >>> X = np.array([[0.0, 0, 0], [1.0, 0, 0], [3.0, 2.0, 0]])
+    >>> check_rising_everett(X, nodes, "the model", cells="table")
+    >>> X[1, 0] = 4.0
+    >>> check_rising_everett(X, nodes, "the model", cells="table")
+    Traceback (most recent call last):
+    ...
+    hystcomp.errors.NotInvertibleError: the model is not invertible: its ascending branch \
+from 0 V turns back down by 1 µm as the voltage rises from 1 to 2 V (table[1, 0] = 4, \
+table[2, 0] = 3), ...
+    """
+    n = table.shape[0]
+    stroke = float(table[-1, 0])
+    if not stroke > 0:
+        raise NotInvertibleError(
+            f"{what} is not invertible: its major loop does not rise from "
+            f"{voltages[0]:.6g} to {voltages[-1]:.6g} V: X(v_max, v_min) = {stroke:.6g} µm"
+            + (f" (table[{n - 1}, 0])" if cells == "table" else "")
+            + ", where it must be > 0 (eq. 2). No compensator can follow a reference with "
+            "it. Identify the model again from a record of the stage.",
+            index=None,
+        )
+    tol = EVERETT_TOLERANCE * float(np.abs(np.tril(table)).max())
+    lower = np.tril(np.ones((n, n), dtype=bool))
+    rise_alpha = np.where(lower[:-1], table[1:] - table[:-1], np.inf)  # [i, j] -> [i+1, j]
+    rise_beta = np.where(lower[:, 1:], table[:, :-1] - table[:, 1:], np.inf)  # [i, j+1] -> [i, j]
+    worst_a, worst_b = float(rise_alpha.min()), float(rise_beta.min())
+    if min(worst_a, worst_b) >= -tol:
+        return
+    if worst_a <= worst_b:  # an ascending branch from beta_j, between alpha_i and alpha_i+1
+        i, j = np.unravel_index(int(np.argmin(rise_alpha)), rise_alpha.shape)
+        a, b = (int(i), int(j)), (int(i) + 1, int(j))
+        branch = f"its ascending branch from {voltages[j]:.6g} V turns back down by {-worst_a:.3g}"
+        span = f"as the voltage rises from {voltages[i]:.6g} to {voltages[i + 1]:.6g} V"
+    else:  # a descending branch from alpha_i, between beta_j+1 and beta_j
+        i, j = np.unravel_index(int(np.argmin(rise_beta)), rise_beta.shape)
+        a, b = (int(i), int(j) + 1), (int(i), int(j))
+        branch = f"its descending branch from {voltages[i]:.6g} V turns back up by {-worst_b:.3g}"
+        span = f"as the voltage falls from {voltages[j + 1]:.6g} to {voltages[j]:.6g} V"
+    if cells == "table":
+        where = f"table[{a[0]}, {a[1]}] = {table[a]:.6g}, table[{b[0]}, {b[1]}] = {table[b]:.6g}"
+    else:
+        where = (
+            f"X({voltages[a[0]]:.6g}, {voltages[a[1]]:.6g}) = {table[a]:.6g}, "
+            f"X({voltages[b[0]]:.6g}, {voltages[b[1]]:.6g}) = {table[b]:.6g}"
+        )
+    raise NotInvertibleError(
+        f"{what} is not invertible: {branch} µm {span} ({where}), where every branch must "
+        "move with the voltage: eq. (10) amplifies its error there and the exact inverse "
+        "jumps over it. Identify the model again by least squares (the default fit, whose "
+        "non-negative density makes every branch rise)"
+        + (f", or correct table[{b[0]}, {b[1]}]." if cells == "table" else "."),
+        index=None,
+    )
 
 
 def _partial_sum(i: int) -> str:

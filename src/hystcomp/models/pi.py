@@ -31,6 +31,7 @@ from hystcomp.models.base import (
     HysteresisModel,
     compensator_rate,
     fit_voltage_range,
+    input_range_report,
     slew_to_step,
 )
 from hystcomp.models.compensator import Compensator
@@ -203,6 +204,7 @@ class PrandtlIshlinskii(HysteresisModel):
         errors of :func:`~hystcomp.identify.scoring.error_report`, then ``extra``, then the
         estimated tracking errors ``est`` of its compensator and of a straight line."""
         report = error_report(x_k, fitted.simulate(v_k), first)
+        report.update(input_range_report(v_k))  # (the thinned record keeps the extremes)
         report.update(extra)
         report["tracking_rms_um"] = est["tracking_rms_um"]
         report["baseline_tracking_rms_um"] = est["baseline_rms_um"]
