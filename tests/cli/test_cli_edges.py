@@ -13,6 +13,7 @@ from hystcomp.codegen import export_c, generate_c
 from hystcomp.errors import InvalidParameterError
 from hystcomp.io.records import read_table, write_table
 from hystcomp.models.dynamics import LinearDynamics
+from hystcomp.models.hammerstein import HammersteinModel
 
 FS = 20_000.0
 
@@ -109,7 +110,7 @@ def test_the_look_ahead_is_not_counted_as_clamped(files):
     assert result.exit_code == 0, result.output
     assert "2000 of 2000 samples (100 %) are out of reach" in result.output
     assert "2000 clamped" in result.output
-    compensator = presets.paper_mpi().inverse(dynamics=dyn)
+    compensator = HammersteinModel(presets.paper_mpi(), dyn).inverse()
     stepper = compensator.stepper()
     stepper.prime(np.full(compensator.preview, 100.0))
     assert stepper.clamped_count == 0  # outputs before time 0 are never applied
@@ -145,14 +146,14 @@ def test_identify_s_advice_for_a_narrow_preisach_clamp_is_an_option_that_exists(
 
 def test_python_export_refuses_a_rate_other_than_the_dynamics(tmp_path):
     dyn = LinearDynamics.from_parameters(sample_rate=FS, resonance_hz=630.0, damping_ratio=0.1)
-    compensator = presets.paper_mpi().inverse(dynamics=dyn)
+    compensator = HammersteinModel(presets.paper_mpi(), dyn).inverse()
     with pytest.raises(
         InvalidParameterError, match=r"\(1000 Hz\) differs from the rate of .* \(20000 Hz\)"
     ):
         export_c(compensator, tmp_path / "fw", sample_rate=1000)
     assert not (tmp_path / "fw").exists()
     slow = LinearDynamics.from_parameters(sample_rate=5000.0, resonance_hz=600.0, damping_ratio=0.1)
-    header, _ = generate_c(presets.paper_mpi().inverse(dynamics=slow, slew_rate=5e3))
+    header, _ = generate_c(HammersteinModel(presets.paper_mpi(), slow).inverse(slew_rate=5e3))
     assert "(5000 V/s at 5000 Hz)" in header  # the rate by default: the dynamics'
 
 

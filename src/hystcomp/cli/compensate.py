@@ -159,7 +159,7 @@ def compensate(
     v = result.v
     lo, hi = compensator.voltage_range
     if result.clamped:
-        reach, (d_lo, d_hi) = _reach(model, lo, hi)
+        reach, (d_lo, d_hi) = _reach(model.hysteresis if pair else model, lo, hi)
         x = table["x"]
         what = (
             f"{result.clamped} of {v.size} samples ({100 * result.clamped_share:.3g} %) are "
@@ -172,7 +172,7 @@ def compensate(
                 f"{d_lo:.4g} .. {d_hi:.4g} µm, or drop --strict to accept the clamp."
             )
         click.echo(f"hystcomp: warning: {what}.", err=True)
-    beyond = _beyond_record(model, v)
+    beyond = _beyond_record(model.hysteresis if pair else model, v)
     if beyond is not None:
         click.echo(f"hystcomp: warning: {beyond}", err=True)
     if getattr(getattr(compensator, "hysteresis", compensator), "method", None) == "multiplicative":
