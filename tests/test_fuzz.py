@@ -36,7 +36,9 @@ from hystcomp.errors import (
 from hystcomp.io import models as model_io
 from hystcomp.io.records import read_record, read_table
 from hystcomp.models.dynamics import LinearDynamics
+from hystcomp.models.hammerstein import HammersteinModel
 from hystcomp.models.preisach import Preisach
+from hystcomp.workflows.pair import predicted_worse
 from tests.conftest import examples
 
 # Boundary fuzzing needs many examples to reach the odd corners, and each one is cheap.
@@ -344,6 +346,11 @@ def _exercise(model, signal) -> None:
     if isinstance(model, LinearDynamics):
         _exercise_dynamics(model, signal)
         return
+    if isinstance(model, HammersteinModel):  # both parts, each as it would be alone
+        predicted_worse(model, np.clip(signal, -1e3, 1e3), model.sample_rate)  # its report
+        _exercise(model.hysteresis, signal)
+        _exercise_dynamics(model.dynamics, signal, model.hysteresis)
+        return
     covered = model.covered_range()  # from the fit report, which no check has read
     assert covered is None or (np.all(np.isfinite(covered)) and covered[0] < covered[1])
     if isinstance(model, Preisach):
@@ -360,12 +367,13 @@ def _exercise(model, signal) -> None:
         assert np.all((v >= lo) & (v <= hi))
 
 
-def _exercise_dynamics(model, signal) -> None:
+def _exercise_dynamics(model, signal, hysteresis=None) -> None:
     """Accepted linear dynamics: a finite response, and a compensator in series with them
-    whose voltage is finite and in range, in Python and as C (or a clean refusal)."""
+    (as a pair, with ``hysteresis`` or the paper's MPI model) whose voltage is finite and in
+    range, in Python and as C (or a clean refusal)."""
     assert np.all(np.isfinite(model.simulate(signal)))
     try:
-        comp = presets.paper_mpi().inverse(dynamics=model)
+        comp = HammersteinModel(hysteresis or presets.paper_mpi(), model).inverse()
     except HystcompError:  # e.g. dynamics the inverse cannot be designed for
         return
     lo, hi = comp.voltage_range
@@ -685,6 +693,11 @@ BASE_MODELS["dynamics"] = LinearDynamics.from_parameters(
     creep_weights=[0.01, 0.01, 0.01],
     delay_samples=1,
 )
+BASE_MODELS["hammerstein"] = HammersteinModel(presets.paper_mpi(), BASE_MODELS["dynamics"])
+BASE_MODELS["hammerstein"].fit_report_ = {
+    "rounds": 2,
+    "tracking_estimates": {"1": {"alone_um": 0.1, "pair_um": 0.08}},
+}
 # a fit report too, as identify writes it: mutations reach the input range compensate reads
 BASE_MODELS["pi"].fit_report_ = {"input_range_v": [0.0, 120.0], "rms_error_um": 0.1}
 BASE_DOCUMENTS = [model_io.model_to_dict(m) for m in BASE_MODELS.values()]

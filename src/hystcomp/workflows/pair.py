@@ -379,6 +379,22 @@ def reference_rate(x_ref, sample_rate: float) -> float:
     return 0.5 * (turns.size - 1) * sample_rate / float(turns[-1] - turns[0])
 
 
+def _estimate_rows(report) -> list[tuple[float, float, float]]:
+    """``(frequency, alone, pair)`` of a fit report's tracking estimates, sorted; a model
+    file's report is not validated, so anything else than positive finite numbers is no
+    estimate."""
+    found = report.get("tracking_estimates") if isinstance(report, dict) else None
+    rows = []
+    for f, e in found.items() if isinstance(found, dict) else ():
+        try:
+            row = (float(f), float(e["alone_um"]), float(e["pair_um"]))
+        except (TypeError, ValueError, KeyError, OverflowError):
+            continue
+        if all(np.isfinite(row)) and min(row) > 0.0:
+            rows.append(row)
+    return sorted(rows)
+
+
 def predicted_worse(pair: HammersteinModel, x_ref, sample_rate: float):
     """``(rate, alone_um, pair_um)`` if the pair is predicted to track ``x_ref`` worse than
     its hysteresis model alone, else None.
@@ -387,10 +403,9 @@ def predicted_worse(pair: HammersteinModel, x_ref, sample_rate: float):
     the logarithm of the frequency at the reference's :func:`reference_rate`, held at the
     ends of the frequencies estimated (a step or a hold is the slowest).
     """
-    estimates = getattr(pair, "fit_report_", {}).get("tracking_estimates") or {}
-    if not estimates:
+    rows = _estimate_rows(getattr(pair, "fit_report_", None))
+    if not rows:
         return None
-    rows = sorted((float(f), e["alone_um"], e["pair_um"]) for f, e in estimates.items())
     f, alone, paired = (np.array(c) for c in zip(*rows, strict=True))
     rate = reference_rate(x_ref, sample_rate)
     at = np.log(np.clip(rate, f[0], f[-1]))
