@@ -33,6 +33,7 @@ LAYERS = {
     "hystcomp.control": 4,
     "hystcomp.codegen": 4,
     "hystcomp.experiment": 5,
+    "hystcomp.workflows": 5,  # the application layer, beside experiment
     "hystcomp.cli": 6,
     "hystcomp.__main__": 6,
 }

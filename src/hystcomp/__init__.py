@@ -32,6 +32,7 @@ _LAZY = {
     "Record": ("hystcomp.io.records", "Record"),
     "Stepper": ("hystcomp.models.system", "Stepper"),
     "errors": ("hystcomp.errors", None),
+    "evaluate": ("hystcomp.workflows.evaluate", "evaluate"),
     "load_model": ("hystcomp.io.models", "load_model"),
     "presets": ("hystcomp.presets", None),
     "read_record": ("hystcomp.io.records", "read_record"),
@@ -49,6 +50,7 @@ __all__ = [  # written out for static tools; tests/cli/test_cli_lazy.py checks i
     "Stepper",
     "__version__",
     "errors",
+    "evaluate",
     "load_model",
     "presets",
     "read_record",
@@ -67,6 +69,7 @@ if TYPE_CHECKING:  # what static tools see; at run time __getattr__ imports on f
     from hystcomp.models.pi import PrandtlIshlinskii
     from hystcomp.models.preisach import Preisach
     from hystcomp.models.system import Stepper
+    from hystcomp.workflows.evaluate import evaluate
 
 
 def __getattr__(name: str):
