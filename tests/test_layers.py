@@ -19,6 +19,7 @@ LAYERS = {
     "hystcomp.errors": 0,
     "hystcomp.paper": 0,
     "hystcomp._validation": 1,
+    "hystcomp._blas": 1,
     "hystcomp._hyperparameters": 1,
     "hystcomp._progress": 1,
     "hystcomp._lti": 1,

@@ -38,6 +38,7 @@ _LAZY = {
     "read_record": ("hystcomp.io.records", "read_record"),
     "save_model": ("hystcomp.io.models", "save_model"),
     "to_control": ("hystcomp.control", "to_control"),
+    "tracking_score": ("hystcomp.models.scorers", "tracking_score"),
 }
 
 __all__ = [  # written out for static tools; tests/cli/test_cli_lazy.py checks it against _LAZY
@@ -56,6 +57,7 @@ __all__ = [  # written out for static tools; tests/cli/test_cli_lazy.py checks i
     "read_record",
     "save_model",
     "to_control",
+    "tracking_score",
 ]
 
 if TYPE_CHECKING:  # what static tools see; at run time __getattr__ imports on first use
@@ -68,6 +70,7 @@ if TYPE_CHECKING:  # what static tools see; at run time __getattr__ imports on f
     from hystcomp.models.mpi import ModifiedPrandtlIshlinskii
     from hystcomp.models.pi import PrandtlIshlinskii
     from hystcomp.models.preisach import Preisach
+    from hystcomp.models.scorers import tracking_score
     from hystcomp.models.system import Stepper
     from hystcomp.workflows.evaluate import evaluate
 

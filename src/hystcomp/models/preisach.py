@@ -33,6 +33,7 @@ from hystcomp.models.base import (
 from hystcomp.models.compensator import Compensator
 from hystcomp.models.dynamic_compensator import DynamicCompensator
 from hystcomp.models.dynamics import with_dynamics
+from hystcomp.models.estimator import fit_signals
 from hystcomp.models.system import Stepper
 
 INVERSE_METHODS = ("multiplicative", "exact")
@@ -257,6 +258,7 @@ class Preisach(HysteresisModel):
                 )
         return model
 
+    @fit_signals
     def fit(self, v, x) -> Preisach:
         """Identify the model from a record (Section III-A); see
         :func:`~hystcomp.identify.preisach.identify_preisach`.
