@@ -158,7 +158,9 @@ class TwinStepper(Stepper):
     def _bind(self) -> None:
         super()._bind()
         self._kernel = step_function(self.kernels.step)
-        del self.step  # the base class binds a step without the sensor; use the method below
+        # the base class binds a step and a step_block without the sensor; use the methods below
+        del self.step
+        self.__dict__.pop("step_block", None)
 
     def step(self, v: float) -> float:
         """Apply one command sample (V) and return the measured displacement (µm)."""
