@@ -167,12 +167,13 @@ class TwinStepper(Stepper):
         v = check_real(v, "v", "TwinStepper.step")
         return self._kernel(self._p, v) + self._offset + self._sigma * self._rng.normal()
 
-    def step_block(self, v) -> np.ndarray:
-        """Apply a block of command samples and return the measured displacements."""
+    def step_block(self, v, out=None) -> np.ndarray:
+        """Apply a block of command samples and return the measured displacements (into
+        ``out`` if given, as :meth:`Stepper.step_block <hystcomp.models.system.Stepper.step_block>`)."""
         u = as_signal(v, "v")
-        return (
-            super().step_block(u) + self._offset + self._sigma * self._rng.standard_normal(u.size)
-        )
+        x = super().step_block(u, out)
+        x += self._offset + self._sigma * self._rng.standard_normal(u.size)
+        return x
 
     def copy(self) -> TwinStepper:
         """An independent stepper in the same state, with a noise generator spawned from this
