@@ -7,7 +7,7 @@ import scipy.io
 from hystcomp.errors import DataFileError, InvalidParameterError
 from hystcomp.io.records import Record, parse_columns, read_record, read_table, write_table
 
-# every test twice: text read by numpy.loadtxt, then by the compiled parser
+# every test twice: text written by repr, then by the compiled formatter (read by pandas)
 pytestmark = pytest.mark.usefixtures("text_reader")
 
 
@@ -55,8 +55,22 @@ def test_bad_column_mappings_in_python(tmp_path, record):
     path = tmp_path / "rec.csv"
     write_table(path, record)
     for bad in ({"v": 0}, {"y": 1}, {"v": True}, {"v": ""}):
-        with pytest.raises(InvalidParameterError, match=r"'columns' parameter of read_table"):
+        with pytest.raises(InvalidParameterError, match=r"'columns' parameter of read_record"):
             read_record(path, columns=bad)
+        with pytest.raises(InvalidParameterError, match=r"'columns' parameter of read_table"):
+            read_table(path, columns=bad)
+    with pytest.raises(InvalidParameterError, match=r"'columns' option must look like v=1"):
+        read_record(path, columns="v=1,y=2")
+
+
+def test_read_record_takes_the_command_line_s_columns_text(tmp_path, record):
+    path = tmp_path / "rec.csv"
+    write_table(path, {"v": record["v"], "t": record["t"], "x": record["x"]})
+    by_text = read_record(path, columns="t=2,v=1,x=3")
+    by_dict = read_record(path, columns={"t": 2, "v": 1, "x": 3})
+    for key in "tvx":
+        np.testing.assert_array_equal(getattr(by_text, key), record[key])
+        np.testing.assert_array_equal(getattr(by_dict, key), record[key])
 
 
 def test_csv_columns_by_name_extra_columns_ignored(tmp_path):
