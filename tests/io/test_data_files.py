@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 import scipy.io
 
-from hystcomp.errors import DataFileError, InvalidParameterError
+from hystcomp.errors import DataFileError, InvalidParameterError, InvalidSignalError
 from hystcomp.io.records import Record, parse_columns, read_record, read_table, write_table
 
 # every test twice: text written by repr, then by the compiled formatter (read by pandas)
@@ -175,3 +175,10 @@ def test_failed_write_never_touches_an_existing_file(tmp_path, record):
 def test_record_sample_rate_from_time():
     rec = Record(np.array([0.0, 0.5, 1.0]), np.zeros(3), np.zeros(3))
     assert rec.sample_rate == 2.0
+
+
+def test_a_time_column_beyond_the_largest_magnitude_is_refused_as_a_record_is(tmp_path):
+    path = tmp_path / "rec.csv"
+    path.write_text("t,v,x\n0.5,1,2\n1.5,2,3\n4.0e16,3,4\n")
+    with pytest.raises(InvalidSignalError, match=r"Record 't'.*magnitude at most 1e\+12"):
+        read_record(path)

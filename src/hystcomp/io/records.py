@@ -102,6 +102,8 @@ class Record:
         """A record of arrays that :func:`read_table` checked (finite, equally long, ``t``
         increasing) and made read-only, taken as they are: a copy of a long record would
         double the memory its reading needs."""
+        if t.size and max(-float(t[0]), float(t[-1])) > MAX_MAGNITUDE:  # (t increases)
+            return cls(t, v, x, source)  # refused there, as a Record of such times is
         rec = object.__new__(cls)
         for key, arr in (("t", t), ("v", v), ("x", x)):
             if not arr.flags.c_contiguous:  # a column of a matrix file: an own copy
