@@ -35,6 +35,7 @@ import tempfile
 import time
 from pathlib import Path
 
+import numba
 import numpy as np
 
 import hystcomp
@@ -236,13 +237,18 @@ BLOCK_TARGET_NS = 600.0
 BLOCK = 20
 
 
-@_jit.step_kernel
+# Compiled as the step kernels are (_jit.step_kernel) but not cached on disk: a kernel of a
+# module loaded from its file would be cached under a name the next run cannot import.
+_STEP_FLAGS = {"fastmath": _jit.FASTMATH, "_nrt": False}
+
+
+@numba.njit(**_STEP_FLAGS)
 def _empty_step(p, u):
     """The reference of a step: a compiled call that does nothing, called as a step is."""
     return u
 
 
-@_jit.step_kernel
+@numba.njit(**_STEP_FLAGS)
 def _empty_block(p, u, out, work):
     """The reference of a block call: a compiled block call that does nothing."""
     return 0
@@ -275,7 +281,7 @@ def stepper_rows(comp, x: np.ndarray) -> list[dict]:
     out = np.empty(BLOCK)
     empty_p = np.zeros(4)
     empty_step = checked_step(_jit.step_function(_empty_step), empty_p)
-    empty_block = fast_block(_jit.block_function(_empty_block), empty_p, empty_p, None)
+    empty_block = fast_block(_empty_block, empty_p, empty_p, None)
     funcs = {
         "empty step": _step_loop(empty_step, references),
         "empty block": _block_loop(empty_block, references, out),

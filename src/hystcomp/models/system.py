@@ -158,16 +158,20 @@ def checked_step(kernel, p):
 
 
 def fast_block(kernel, p, work, checked):
-    """``step_block(u, out=None)`` bound to block kernel ``kernel`` (its compiled entry point,
-    :func:`~hystcomp._kernels._jit.block_function`), state ``p`` and scratch ``work``.
+    """``step_block(u, out=None)`` bound to block kernel ``kernel`` (a
+    :func:`~hystcomp._kernels._jit.step_kernel`, compiled for four arrays on the first call
+    that needs it, :func:`~hystcomp._kernels._jit.block_function`), state ``p`` and scratch
+    ``work``.
 
     The trusted path: with ``u`` and ``out`` contiguous float64 arrays (``out`` writeable),
     a few type tests in Python and one compiled call, which checks the lengths and the
     overlap itself (status 0: done). Anything else goes to ``checked(u, out)``, which
     converts or refuses it with a message.
     """
+    compiled = None  # a stepper that never takes this path compiles nothing for it
 
     def step_block(u, out=None):
+        nonlocal compiled
         if (
             out is not None
             and u.__class__ is _NDARRAY
@@ -177,9 +181,11 @@ def fast_block(kernel, p, work, checked):
             and u.strides == _UNIT_STRIDE
             and out.strides == _UNIT_STRIDE
             and out.flags.writeable
-            and kernel(p, u, out, work) == 0
         ):
-            return out
+            if compiled is None:
+                compiled = block_function(kernel)
+            if compiled(p, u, out, work) == 0:
+                return out
         return checked(u, out)
 
     return step_block
@@ -231,7 +237,7 @@ class Stepper(Rebound):
 
     kernels = chain.CHAIN_KERNELS
     # _kernel: the twin's stepper binds one too
-    _bound = ("step", "step_block", "_run", "_kernel", "_block")
+    _bound = ("step", "step_block", "_run", "_kernel")
 
     def __init__(self, packed: np.ndarray):
         packed = self._checked(packed)
@@ -249,11 +255,9 @@ class Stepper(Rebound):
     def _bind(self) -> None:
         """Bind the fast :meth:`step` and the block kernels to this stepper's state."""
         self._run = self.kernels.run  # looked up once: a block call is short too
-        block_kernel = self.kernels.block
-        self._block = None if block_kernel is None else block_function(block_kernel)
-        if self._block is not None:  # as step: an instance attribute over the method below
+        if self.kernels.block is not None:  # as step: an instance attribute over the method
             self.step_block = fast_block(  # type: ignore[method-assign]
-                self._block, self._p, self._work, self._checked_block
+                self.kernels.block, self._p, self._work, self._checked_block
             )
         # an instance attribute hides the method below, which documents it
         self.step = checked_step(  # type: ignore[method-assign]
@@ -312,8 +316,8 @@ class Stepper(Rebound):
         """:meth:`step_block` with every argument checked (and converted where it can be)."""
         u = block(u, "Stepper.step_block")
         out = np.empty_like(u) if out is None else output_block(out, u, "Stepper.step_block")
-        if self._block is not None:
-            self._block(self._p, u, out, self._work)
+        if self.kernels.block is not None:
+            block_function(self.kernels.block)(self._p, u, out, self._work)
         else:
             self._run(self._p, u, out)
         return out
