@@ -376,7 +376,6 @@ def read_table(
     x_unit=None,
     progress=None,
     optional=(),
-    _owner="read_table",
 ):
     """Read time and the columns ``keys`` from a data file, validated.
 
@@ -417,7 +416,13 @@ def read_table(
     DataFileError
         Naming the file, the column, the problem and the fix.
     """
-    owner = _owner
+    return _read_table(
+        path, keys, columns, sample_rate, min_samples, x_unit, progress, optional, "read_table"
+    )
+
+
+def _read_table(path, keys, columns, sample_rate, min_samples, x_unit, progress, optional, owner):
+    """:func:`read_table`, its messages naming ``owner`` (the public function called)."""
     path = as_path(path, "path", owner)
     keys = tuple(keys) if not isinstance(keys, str) else (keys,)
     optional = tuple(optional) if not isinstance(optional, str) else (optional,)
@@ -584,14 +589,8 @@ def read_record(path, *, columns=None, sample_rate=None, x_unit=None, progress=N
     -------
     Record
     """
-    table = read_table(
-        path,
-        ("v", "x"),
-        columns=columns,
-        sample_rate=sample_rate,
-        x_unit=x_unit,
-        progress=progress,
-        _owner="read_record",
+    table = _read_table(
+        path, ("v", "x"), columns, sample_rate, 2, x_unit, progress, (), "read_record"
     )
     v = table["v"]
     if v.max() <= v.min():
