@@ -43,6 +43,7 @@ words the error with the data row and the column.
 
 from __future__ import annotations
 
+import functools
 import re
 import warnings
 from dataclasses import dataclass
@@ -429,6 +430,13 @@ def _parse_rows(path: Path, layout: Layout, limit: int, marks: tuple[bool, bool]
     return out[:, :n], suspect, failure
 
 
+@functools.cache
+def _pandas_major() -> int:
+    import pandas as pd
+
+    return int(pd.__version__.split(".")[0])
+
+
 def _read_options(layout: Layout, comments: bool, quotes: bool, rows: int) -> dict:
     """The options of :func:`pandas.read_csv` for the data rows of ``layout``: nothing
     guessed (separator, decimal comma and columns from the layout), and its defaults where
@@ -446,6 +454,8 @@ def _read_options(layout: Layout, comments: bool, quotes: bool, rows: int) -> di
     }
     if layout.trailing:  # the empty field after the last separator: not a column
         options["usecols"] = list(range(layout.n_columns))
+    if _pandas_major() < 3:  # pandas 2 rounds a few values a unit off unless told to round-trip
+        options["float_precision"] = "round_trip"
     if comments:
         options["comment"] = "#"
     if quotes:
