@@ -55,11 +55,10 @@ from hystcomp.errors import DataFileError
 
 #: Bytes of data rows worded at once when a row is wrong (and written at once).
 CHUNK_BYTES = 1 << 21
-#: Rows that pandas parses at once at least, copied into the preallocated array; a long
-#: table is read in about :data:`CHUNKS` chunks (each costs about four times its values in
-#: pandas' buffers, so the read needs the record's values and half as much again).
+#: Rows that pandas parses at once, copied into the preallocated array: the rows its C reader
+#: tokenises at once anyway (larger chunks are concatenated from such pieces: slower, and
+#: more memory).
 CHUNK_ROWS = 1 << 18
-CHUNKS = 8
 #: Values up to which CSV is formatted by ``repr`` in the interpreter, in one piece: loading
 #: the compiled formatter costs about as much as formatting this many values so.
 SMALL_TABLE = 200_000
@@ -92,6 +91,7 @@ class Layout:
     encoding: str = "utf-8"
     leading: bool = False  # a separator starts each row: an empty first column, never read
     data_line: int = 0  # lines (blank ones too) above the first data row
+    line_above: bool = False  # the line right above the data has as many fields (a header)
 
 
 def _split(line: str, delimiter: str | None) -> list[str]:
@@ -175,8 +175,10 @@ def _layout(path: Path, head: bytes, whole: bool) -> Layout | None:
     text = text[1:] if bom else text
     offset, chars = bom, 0
     above: list[tuple[bool, str]] = []  # (is a comment, text) of the lines above the data
+    previous = ""  # the line above, blank or not
     for line in text.splitlines(keepends=True):
-        stripped = line.strip()
+        stripped, before = line.strip(), previous
+        previous = stripped
         start, offset = offset, offset + len(line.encode(encoding))
         first, chars = chars, chars + len(line)
         if not stripped:
@@ -202,6 +204,10 @@ def _layout(path: Path, head: bytes, whole: bool) -> Layout | None:
             names, units = _header(path, above, delimiter, len(tokens))
             n = len(tokens)
             line_number = len(_LINE_END.findall(head[:start]))
+            # a line of as many fields right above the data (the header, a units row), which
+            # pandas' reader may take as its header: it reads faster so than skipping it
+            fields = len(_split(before, delimiter)) - (1 if trailing else 0)
+            named = bool(before) and not before.startswith("#") and fields == n
             return Layout(
                 names,
                 units,
@@ -213,6 +219,7 @@ def _layout(path: Path, head: bytes, whole: bool) -> Layout | None:
                 encoding,
                 leading,
                 line_number,
+                named,
             )
         above.append((False, stripped))
     if not above and not text.strip():
@@ -390,7 +397,7 @@ def _parse_rows(path: Path, layout: Layout, limit: int, marks: tuple[bool, bool]
     out = np.empty((layout.n_columns, bound))  # pages are taken as they are written
     first = 1 if layout.leading else 0  # an empty first column: never read, NaN
     comments, quotes = marks
-    options = _read_options(layout, comments, quotes, max(CHUNK_ROWS, bound // CHUNKS))
+    options = _read_options(layout, comments, quotes, CHUNK_ROWS)
     n, suspect, failure, numbers = 0, False, None, True
     try:
         with pd.read_csv(path, **options) as reader:  # closed on any error too
@@ -446,8 +453,9 @@ def _read_options(layout: Layout, comments: bool, quotes: bool, rows: int) -> di
     options: dict[str, object] = {
         "sep": r"\s+" if layout.delimiter is None else layout.delimiter,
         "decimal": "," if layout.decimal_comma else ".",
-        "header": None,
-        "skiprows": layout.data_line,
+        # the line above as pandas' header (its names unused), else no header
+        "header": 0 if layout.line_above else None,
+        "skiprows": layout.data_line - 1 if layout.line_above else layout.data_line,
         "encoding": layout.encoding,
         "engine": "c",
         "chunksize": rows,
