@@ -70,13 +70,9 @@ def test_lab_text_layouts_read_as_the_canonical_csv(tmp_path, record, name, head
 
 
 @pytest.mark.parametrize("newline", ["\n", "\r\n", "\r"])
-@pytest.mark.parametrize("chunk_rows", [7, 1 << 18])
-def test_long_tables_with_blank_lines_and_old_mac_line_ends_are_read(
-    tmp_path, rng, monkeypatch, newline, chunk_rows
-):
+def test_long_tables_with_blank_lines_and_old_mac_line_ends_are_read(tmp_path, rng, newline):
     import hystcomp.io._text as text
 
-    monkeypatch.setattr(text, "CHUNK_ROWS", chunk_rows)  # chunks of pandas' reading
     t = np.arange(6000) / 2000.0  # longer than the head that the layout is read from
     big = {"t": t, "v": 60.0 + 50.0 * np.sin(t), "x": rng.standard_normal(t.size)}
     rows = _rows(big)
@@ -273,7 +269,6 @@ def test_chunked_read_and_write_round_trip_across_chunks(tmp_path, rng, monkeypa
 
     monkeypatch.setattr(text, "CHUNK_BYTES", 1000)  # many chunks, rows cut anywhere
     monkeypatch.setattr(text, "SMALL_TABLE", 0)  # the compiled formatter, even for few rows
-    monkeypatch.setattr(text, "CHUNK_ROWS", 300)  # and pandas reads in chunks of rows
     n = 2000
     table = {
         "t": np.arange(n) / 3e3,
@@ -457,3 +452,29 @@ def test_a_first_line_longer_than_the_head_is_read_or_named(tmp_path, monkeypatc
     along.write_text(",".join(repr(float(k)) for k in range(3000)) + "\n")  # along a line
     with pytest.raises(DataFileError, match=r"first line of more than \d+ bytes.*transpose"):
         read_table(along, ("x",), columns={"x": 1}, sample_rate=1.0)
+
+
+def test_a_pandas_without_the_reader_engine_reads_the_same_through_a_dataframe(
+    tmp_path, record, monkeypatch
+):
+    import pandas as pd
+
+    real = pd.read_csv
+
+    class Reader:  # what a pandas whose reader has no engine to ask would hand over
+        def __init__(self, *args, **kwargs):
+            self._reader = real(*args, **kwargs)
+
+        def __enter__(self):
+            return self
+
+        def __exit__(self, *exc):
+            self._reader.close()
+
+        def read(self):
+            return self._reader.read()
+
+    path = tmp_path / "rec.csv"
+    write_table(path, record)
+    monkeypatch.setattr(pd, "read_csv", Reader)
+    _same(path, record)

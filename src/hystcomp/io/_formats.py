@@ -114,10 +114,10 @@ def _check_npz_headers(path: Path, file, limit: int) -> None:
 def _read_text(path: Path, progress=None):
     """Header names (or None), units (or None) and the columns of a text table."""
     layout = sniff(path)
-    table = read_rows(path, layout, max_samples(), progress)
-    if table.shape[1] == 0:
+    columns = read_rows(path, layout, max_samples(), progress)
+    if not columns or columns[0].size == 0:
         raise DataFileError(f"Data file {str(path)!r} has a header but no data rows.")
-    return layout.names, list(table), layout.units
+    return layout.names, columns, layout.units
 
 
 def _read_npz(path: Path):

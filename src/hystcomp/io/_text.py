@@ -32,11 +32,12 @@ guessing from statistics, unlike :class:`csv.Sniffer`):
    is the first number) and is never read.
 
 The data rows are parsed by pandas' C reader (:func:`pandas.read_csv`, the separator, the
-decimal comma, quotes and comments given from the layout above, never guessed), in chunks of
-:data:`CHUNK_ROWS` rows into one preallocated array: a read needs about the memory of the
-values (8 bytes each) and a chunk. Rows are counted first and a file with more than the
-limit of samples (:func:`hystcomp.io._formats.max_samples`) is refused before any large
-allocation. Where pandas stops (text in a row, a row of more fields) or fills a gap with
+decimal comma, quotes and comments given from the layout above, never guessed) in one pass,
+its column arrays taken from the reader's engine as they are, without the DataFrame that
+would copy them: a read needs about 1.4 times the memory of the values (8 bytes each),
+against 4 times for ``pandas.read_csv``. A file that may hold more rows than the limit of
+samples (:func:`hystcomp.io._formats.max_samples`) by its size has its lines counted first,
+and is refused before it is read. Where pandas stops (text in a row, a row of more fields) or fills a gap with
 NaN (a row of fewer fields), the data rows are parsed again by :func:`numpy.loadtxt`, which
 words the error with the data row and the column.
 """
@@ -55,10 +56,6 @@ from hystcomp.errors import DataFileError
 
 #: Bytes of data rows worded at once when a row is wrong (and written at once).
 CHUNK_BYTES = 1 << 21
-#: Rows that pandas parses at once, copied into the preallocated array: the rows its C reader
-#: tokenises at once anyway (larger chunks are concatenated from such pieces: slower, and
-#: more memory).
-CHUNK_ROWS = 1 << 18
 #: Values up to which CSV is formatted by ``repr`` in the interpreter, in one piece: loading
 #: the compiled formatter costs about as much as formatting this many values so.
 SMALL_TABLE = 200_000
@@ -361,8 +358,8 @@ def row_bound(path: Path, layout: Layout) -> int:
     return int(data / (shortest + 1) * 1.25) + 8
 
 
-def read_rows(path: Path, layout: Layout, limit: int, progress=None) -> np.ndarray:
-    """The data rows of ``path`` as an array of shape (columns, rows), parsed by pandas.
+def read_rows(path: Path, layout: Layout, limit: int, progress=None) -> list[np.ndarray]:
+    """The data rows of ``path`` as columns (1-D float64 arrays), parsed by pandas.
 
     Raises
     ------
@@ -387,54 +384,76 @@ def read_rows(path: Path, layout: Layout, limit: int, progress=None) -> np.ndarr
 
 
 def _parse_rows(path: Path, layout: Layout, limit: int, marks: tuple[bool, bool], progress):
-    """pandas' reading of the data rows into one array: ``(values, suspect, failure)``,
-    ``suspect`` where a row may be wrong (text, a row of fewer fields filled with NaN),
-    ``failure`` the text of pandas' error, if any."""
+    """pandas' reading of the data rows: ``(columns, suspect, failure)``, the columns as 1-D
+    float64 arrays, ``suspect`` where a row may be wrong (text, a row of fewer fields filled
+    with NaN), ``failure`` the text of pandas' error, if any."""
     import pandas as pd  # loaded by a text table's reading only
 
     where = f"Data file {str(path)!r}"
-    bound = min(row_bound(path, layout), limit + 1)
-    out = np.empty((layout.n_columns, bound))  # pages are taken as they are written
+    if row_bound(path, layout) > limit and count_rows(path, layout.data_offset, limit) > limit:
+        raise DataFileError(
+            f"{where} has more than {limit} rows, the most a record may have "
+            "(HYSTCOMP_MAX_SAMPLES raises the limit). Split the record or lower its sample "
+            "rate."
+        )
     first = 1 if layout.leading else 0  # an empty first column: never read, NaN
-    comments, quotes = marks
-    options = _read_options(layout, comments, quotes, CHUNK_ROWS)
-    n, suspect, failure, numbers = 0, False, None, True
+    options = _read_options(layout, *marks)
+    if progress is not None:
+        progress(0.0)
     try:
-        with pd.read_csv(path, **options) as reader:  # closed on any error too
-            for chunk in reader:
-                rows, columns = chunk.shape
-                if n + rows > limit:
-                    raise DataFileError(
-                        f"{where} has more than {limit} rows, the most a record may have "
-                        "(HYSTCOMP_MAX_SAMPLES raises the limit). Split the record or lower "
-                        "its sample rate."
-                    )
-                if n + rows > out.shape[1]:  # shorter lines further on: a larger array
-                    grown = np.empty((out.shape[0], max(2 * out.shape[1], n + rows)))
-                    grown[:, :n] = out[:, :n]
-                    out = grown
-                suspect = suspect or columns != out.shape[0]
-                for j in range(min(columns, out.shape[0])):  # column by column: no copy
-                    column = chunk.iloc[:, j].to_numpy()
-                    if column.dtype.kind not in "iuf":  # text among the numbers
-                        numbers = numbers and j < first
-                        suspect = True
-                        continue
-                    part = out[j, n : n + rows]
-                    np.copyto(part, column)
-                    # a row of fewer fields is filled with NaN (min propagates it): worded later
-                    suspect = suspect or (j >= first and bool(np.isnan(part.min())))
-                n += rows
-                if progress is not None:
-                    progress(min(1.0, n / max(bound, 1) * 0.8))
-    except DataFileError:
-        raise
+        raw = _read_columns(pd, path, options)
     except (ValueError, pd.errors.ParserError, pd.errors.EmptyDataError) as exc:
-        if not isinstance(exc, pd.errors.EmptyDataError):  # empty: no rows, said elsewhere
-            suspect, failure = True, str(exc).strip() or type(exc).__name__
-    if failure is None and suspect and not numbers:
-        failure = "text among the numbers"
-    return out[:, :n], suspect, failure
+        if isinstance(exc, pd.errors.EmptyDataError):  # no rows: said by the caller
+            return [np.empty(0) for _ in range(layout.n_columns)], False, None
+        return [], True, str(exc).strip() or type(exc).__name__
+    suspect, numbers, columns = len(raw) != layout.n_columns, True, []
+    for j, column in enumerate(raw):
+        if column.dtype.kind not in "iuf":  # text among the numbers
+            numbers = numbers and j < first
+            suspect = True
+            column = np.full(column.size, np.nan)
+        column = np.asarray(column, dtype=np.float64)  # (integers converted; floats as they are)
+        # a row of fewer fields is filled with NaN (min propagates it): worded later
+        suspect = suspect or (j >= first and column.size > 0 and bool(np.isnan(column.min())))
+        columns.append(column)
+    if columns and columns[0].size > limit:
+        raise DataFileError(
+            f"{where} has more than {limit} rows, the most a record may have "
+            "(HYSTCOMP_MAX_SAMPLES raises the limit). Split the record or lower its sample "
+            "rate."
+        )
+    failure = "text among the numbers" if suspect and not numbers else None
+    return columns, suspect, failure
+
+
+def _read_columns(pd, path: Path, options: dict) -> list[np.ndarray]:
+    """The columns of the data rows, read by pandas' C reader in one pass.
+
+    Through the reader's engine where pandas has it (the arrays its parser makes, about the
+    memory of the values); a DataFrame (four times the values, at the peak) only where not.
+    """
+    with pd.read_csv(path, iterator=True, **options) as reader:
+        read = getattr(getattr(reader, "_engine", None), "read", None)
+        result = read() if read is not None else None
+        if isinstance(result, tuple) and len(result) == 3 and isinstance(result[2], dict):
+            _, names, data = result
+            return [np.asarray(data[name]) for name in names]
+        frame = reader.read()
+    return [frame.iloc[:, j].to_numpy() for j in range(frame.shape[1])]
+
+
+def count_rows(path: Path, offset: int, limit: int) -> int:
+    """Lines from ``offset`` on (an upper bound of the data rows); counting stops past
+    ``limit``."""
+    rows, last = 0, b"\n"
+    with path.open("rb") as f:
+        f.seek(offset)
+        while block := f.read(CHUNK_BYTES):
+            rows += block.count(b"\n")
+            last = block[-1:]
+            if rows > limit:
+                break
+    return rows + (last != b"\n")
 
 
 @functools.cache
@@ -444,7 +463,7 @@ def _pandas_major() -> int:
     return int(pd.__version__.split(".")[0])
 
 
-def _read_options(layout: Layout, comments: bool, quotes: bool, rows: int) -> dict:
+def _read_options(layout: Layout, comments: bool, quotes: bool) -> dict:
     """The options of :func:`pandas.read_csv` for the data rows of ``layout``: nothing
     guessed (separator, decimal comma and columns from the layout), and its defaults where
     they do (comments and quotes are looked for only where the data hold ``#`` or ``"``:
@@ -458,7 +477,6 @@ def _read_options(layout: Layout, comments: bool, quotes: bool, rows: int) -> di
         "skiprows": layout.data_line - 1 if layout.line_above else layout.data_line,
         "encoding": layout.encoding,
         "engine": "c",
-        "chunksize": rows,
     }
     if layout.trailing:  # the empty field after the last separator: not a column
         options["usecols"] = list(range(layout.n_columns))
