@@ -3,13 +3,13 @@
 Each step runs in a fresh process that reads the same table from a raw file (in place, no
 temporaries) and measures its own wall time and peak resident memory (``VmHWM``, Linux);
 memory is given as the growth over a process that only imports (and, for writing, reads the
-table). The steps run twice, alternating, and the faster run counts (the machine may be
-shared). The references run in the same benchmark on the same array and file:
+table). The steps run three times, alternating, and the fastest run counts (the machine
+may be shared). The references run in the same benchmark on the same array and file:
 
 * reading: :func:`pandas.read_csv` of the same file, every option left at its default (the
   C reader that ``read_record`` drives, without the layout rules, the checks and the
   record). Target: ``read_record`` within 1.2x of its time, and a peak memory of at most
-  2x the values (8 bytes each: the record's arrays, and pandas' chunks).
+  2x the values (8 bytes each: the record's arrays, and the parser's pieces of them).
 * writing: ``DataFrame.to_csv`` (pandas' writer, the shortest round-trip text too; on a
   tenth of the samples, as it is slow, scaled per sample) and :func:`numpy.savetxt` with
   ``%.17g``. hystcomp keeps its compiled formatter (``hystcomp.io._floattext``) only while
@@ -105,7 +105,7 @@ def run() -> list[dict]:
         _, base_mb = _step("baseline", n, ours, source)  # imports and the table
         _, imports_mb = _step("imports", n, ours, source)
         best = {}
-        for _ in range(2):  # the faster of two runs, alternating, against a busy machine
+        for _ in range(3):  # the fastest of three runs, alternating, against a busy machine
             for name in ("write", "read", "read_csv", "to_csv"):
                 length = n // 10 if name == "to_csv" else n
                 out = theirs if name == "to_csv" else ours
