@@ -174,3 +174,42 @@ def test_compensator_with_dynamics_as_a_system_equals_its_stepper():
     lo, hi = comp.voltage_range
     assert lo <= response.min()
     assert response.max() <= hi
+
+
+def test_systems_and_states_are_named_after_what_they_are():
+    from hystcomp.plant import Twin
+
+    model = presets.paper_mpi()
+    sys = hystcomp.to_control(model, DT)
+    csys = hystcomp.to_control(model.inverse(), DT)
+    assert (sys.name, csys.name) == ("mpi", "inverse_mpi")
+    for system in (sys, csys):
+        labels = system.state_labels
+        assert labels[:3] == ["last_output", "held_count", "clamped_count"]
+        assert "play[0]" in labels
+        assert not [s for s in labels if s.startswith("x")]  # nothing reads as the output x
+    # the state named last_output holds the last output
+    out = control.input_output_response(sys, DT * np.arange(3), [0.0, 60.0, 90.0], X0=sys.x0)
+    assert out.states[sys.state_labels.index("last_output"), -1] == pytest.approx(
+        model.simulate([0.0, 60.0])[-1]
+    )
+    pre = hystcomp.to_control(presets.paper_preisach(), DT)
+    assert pre.name == "preisach"
+    assert pre.state_labels[0] == "stack_top"
+    assert pre.state_labels.count("extremum[0]") == 1
+    assert sum(s.startswith("extremum[") for s in pre.state_labels) == sum(
+        s.startswith("prefix_sum[") for s in pre.state_labels
+    )
+    twin = hystcomp.to_control(Twin(), DT)
+    assert twin.name == "twin"
+    assert twin.state_labels[:4] == ["input", "bouc_wen", "position", "velocity"]
+    dyn = hystcomp.to_control(_dynamics(), DT)
+    assert dyn.name == "dynamics"
+    assert dyn.state_labels[:2] == ["creep[0]", "creep[1]"]
+    dcomp = hystcomp.to_control(model.inverse(dynamics=_dynamics()), DT)
+    assert dcomp.name == "inverse_dynamics_mpi"
+    # a compensator and its model interconnect without a renaming (and so without a warning)
+    series = control.interconnect([csys, sys], inplist=["x_ref"], outlist=["x"])
+    assert "inverse_mpi_play[0]" in series.state_labels or "inverse_mpi.play[0]" in (
+        series.state_labels
+    )

@@ -29,15 +29,25 @@ def _env() -> dict:
     return env
 
 
-def test_readme_python_block_runs_as_written(tmp_path, monkeypatch):
-    (code,) = [b for b in blocks(ROOT / "README.md", "python") if "import hystcomp" in b]
+def test_readme_python_blocks_run_each_on_its_own(tmp_path, monkeypatch):
+    codes = blocks(ROOT / "README.md", "python")
+    assert len(codes) >= 3
     monkeypatch.chdir(tmp_path)
-    namespace: dict = {}
-    exec(compile(code, "README.md", "exec"), namespace)  # noqa: S102 - our own README
+    spaces = []
+    for i, code in enumerate(codes):
+        namespace: dict = {}  # a fresh namespace: no block leans on another's names
+        exec(compile(code, f"README.md, Python block {i + 1}", "exec"), namespace)  # noqa: S102
+        spaces.append(namespace)
+    first = next(ns for ns in spaces if "comp" in ns)
     assert (tmp_path / "model.json").is_file()
-    x_ref, v = namespace["x_ref"], namespace["v"]
+    x_ref, v = first["x_ref"], first["v"]
     assert v.shape == x_ref.shape
-    assert namespace["model"].fit_report_["rms_error_um"] >= 0.0
+    assert first["model"].fit_report_["rms_error_um"] >= 0.0
+    scored = next(ns for ns in spaces if "run" in ns)
+    assert 0.0 < scored["run"].rms_um < 0.2 < scored["run"].max_um < 1.0  # µm, as in docs/cli.md
+    twin = next(ns for ns in spaces if "twin" in ns)
+    assert twin["x"].shape == twin["v"].shape
+    assert 10.0 < np.ptp(twin["x"]) < 40.0  # µm: the axis's stroke over 0..120 V
 
 
 def test_user_guide_first_python_block_runs(tmp_path, monkeypatch):

@@ -20,6 +20,7 @@ LAYERS = {
     "hystcomp.paper": 0,
     "hystcomp._signals": 0,  # the standard library only: the program imports it first
     "hystcomp._validation": 1,
+    "hystcomp._blas": 1,
     "hystcomp._hyperparameters": 1,
     "hystcomp._progress": 1,
     "hystcomp._lti": 1,
@@ -35,6 +36,7 @@ LAYERS = {
     "hystcomp.control": 4,
     "hystcomp.codegen": 4,
     "hystcomp.experiment": 5,
+    "hystcomp.workflows": 5,  # the application layer, beside experiment
     "hystcomp.cli": 6,
     "hystcomp.__main__": 6,
     "hystcomp._program": 6,

@@ -31,11 +31,13 @@ _LAZY = {
     "Record": ("hystcomp.io.records", "Record"),
     "Stepper": ("hystcomp.models.system", "Stepper"),
     "errors": ("hystcomp.errors", None),
+    "evaluate": ("hystcomp.workflows.evaluate", "evaluate"),
     "load_model": ("hystcomp.io.models", "load_model"),
     "presets": ("hystcomp.presets", None),
     "read_record": ("hystcomp.io.records", "read_record"),
     "save_model": ("hystcomp.io.models", "save_model"),
     "to_control": ("hystcomp.control", "to_control"),
+    "tracking_score": ("hystcomp.models.scorers", "tracking_score"),
 }
 
 __all__ = [  # written out for static tools; tests/cli/test_cli_lazy.py checks it against _LAZY
@@ -48,11 +50,13 @@ __all__ = [  # written out for static tools; tests/cli/test_cli_lazy.py checks i
     "Stepper",
     "__version__",
     "errors",
+    "evaluate",
     "load_model",
     "presets",
     "read_record",
     "save_model",
     "to_control",
+    "tracking_score",
 ]
 
 if TYPE_CHECKING:  # what static tools see; at run time __getattr__ imports on first use
@@ -65,7 +69,9 @@ if TYPE_CHECKING:  # what static tools see; at run time __getattr__ imports on f
     from hystcomp.models.mpi import ModifiedPrandtlIshlinskii
     from hystcomp.models.pi import PrandtlIshlinskii
     from hystcomp.models.preisach import Preisach
+    from hystcomp.models.scorers import tracking_score
     from hystcomp.models.system import Stepper
+    from hystcomp.workflows.evaluate import evaluate
 
 
 def __getattr__(name: str):

@@ -7,7 +7,10 @@ is the object's packed state, stepped by the same kernel as ``simulate``; so
 bit), and the system composes with python-control's linear controllers and plants in
 ``control.interconnect``. Signals are named as in the rest of the package: a model has input
 ``v`` and output ``x``, a compensator input ``x_ref`` and output ``v``, so a compensator and
-a model connect by name.
+a model connect by name. Systems and states are named after what they are: a model after its
+kind (``mpi``), a compensator after what it inverts (``inverse_mpi``), the simulated axis
+``twin`` and the linear dynamics ``dynamics``; states after their slot (``play[3]``,
+``last_output``, ``creep[0]``), never ``x[i]``, which would read as the displacement ``x``.
 
 python-control is an optional dependency (``pip install "hystcomp[control]"``), imported
 only when :func:`to_control` is called.
@@ -55,6 +58,10 @@ class DiscreteSystem:
         allowed).
     inputs, outputs : tuple of str
         Signal names.
+    name : str
+        The system's default name (``to_control``'s ``name`` overrides it).
+    states : tuple of str, optional
+        A name per state slot; by default ``state[0]``, ``state[1]``, ...
     """
 
     state: np.ndarray
@@ -62,6 +69,14 @@ class DiscreteSystem:
     output: Callable[[np.ndarray, np.ndarray], float]
     inputs: tuple[str, ...]
     outputs: tuple[str, ...]
+    name: str = "system"
+    states: tuple[str, ...] | None = None
+
+    def state_names(self) -> list[str]:
+        """The name of each state slot (``states``, or ``state[i]``)."""
+        if self.states is not None and len(self.states) == self.state.size:
+            return list(self.states)
+        return [f"state[{i}]" for i in range(self.state.size)]
 
 
 Adapter = Callable[[object, float], DiscreteSystem]
@@ -84,7 +99,42 @@ def register(cls: type):
     return decorate
 
 
-def _stepped(stepper, inputs: tuple[str, ...], outputs: tuple[str, ...]) -> DiscreteSystem:
+def _indexed(name: str, count: int) -> list[str]:
+    return [f"{name}[{i}]" for i in range(count)]
+
+
+#: Names of the counters and scratch slots that every packed state starts with.
+_CHAIN_SLOTS = ("last_output", "held_count", "clamped_count", "step_input", "step_output")
+_PREISACH_SLOTS = (
+    "stack_top",
+    "last_input",
+    "last_hysteresis",
+    "last_output",
+    "held_count",
+    "clamped_count",
+)
+_TWIN_SLOTS = ("input", "bouc_wen", "position", "velocity", "last_output", "held_count")
+
+
+def packed_state_names(stepper) -> tuple[str, ...]:
+    """A name for each slot of the state of a stepper's packed system (its layout's slots:
+    :mod:`hystcomp._kernels.chain`, :mod:`~hystcomp._kernels.preisach` or
+    :mod:`~hystcomp._kernels.twin`)."""
+    from hystcomp._kernels import chain, preisach
+
+    size = stepper._p.size - stepper._start
+    if stepper.kernels is chain.CHAIN_KERNELS:
+        fixed = [*_CHAIN_SLOTS, "step_work"]
+        return tuple(fixed + _indexed("play", size - len(fixed)))
+    if stepper.kernels is preisach.PREISACH_KERNELS:
+        depth = (size - len(_PREISACH_SLOTS)) // 2
+        return (*_PREISACH_SLOTS, *_indexed("extremum", depth), *_indexed("prefix_sum", depth))
+    return tuple(_indexed("state", size))
+
+
+def _stepped(
+    stepper, inputs: tuple[str, ...], outputs: tuple[str, ...], name: str
+) -> DiscreteSystem:
     """A packed system (any :class:`~hystcomp.models.system.Stepper`) as a DiscreteSystem.
 
     The state is the packed array's state part, from ``kernels.state_start`` to its end; one
@@ -110,6 +160,8 @@ def _stepped(stepper, inputs: tuple[str, ...], outputs: tuple[str, ...]) -> Disc
         output=output,
         inputs=inputs,
         outputs=outputs,
+        name=name,
+        states=packed_state_names(stepper),
     )
 
 
@@ -146,12 +198,15 @@ def _twin(twin, dt: float) -> DiscreteSystem:
         x = kernels.axis_step(twin._p, s[:-1].copy(), float(np.ravel(u)[0]))
         return x + params.sensor_offset + sigma * noise_at(int(s[-1]))
 
+    n_creep = twin._rest.size - kernels.S_CREEP
     return DiscreteSystem(
         state=np.append(twin._rest, 0.0),
         update=update,
         output=output,
         inputs=("v",),
         outputs=("x",),
+        name="twin",
+        states=(*_TWIN_SLOTS, "clamped_count", *_indexed("creep", n_creep), "sample"),
     )
 
 
@@ -183,6 +238,7 @@ def _linear_dynamics(dyn, dt: float) -> DiscreteSystem:
     b_col = np.r_[1.0 - lags, b_res[:, 0] * d_creep]
     c_row = np.r_[np.zeros(n), c_res[0]]
     delay = dyn.delay_samples_
+    names = (*_indexed("creep", n), *_indexed("resonance", 2))
     if delay < 0:  # the answer of the same sample: the output after this sample's update
         return DiscreteSystem(
             state=np.zeros(n + order),
@@ -190,6 +246,8 @@ def _linear_dynamics(dyn, dt: float) -> DiscreteSystem:
             output=lambda s, u: float(c_row @ (A @ s + b_col * float(np.ravel(u)[0]))),
             inputs=("v",),
             outputs=("x",),
+            name="dynamics",
+            states=names,
         )
     # the latency: the last `delay` outputs in a line after the states, the oldest out
     m = n + order
@@ -206,6 +264,8 @@ def _linear_dynamics(dyn, dt: float) -> DiscreteSystem:
         output=lambda s, u: float(s[-1] if delay else c_row @ s),
         inputs=("v",),
         outputs=("x",),
+        name="dynamics",
+        states=(*names, *_indexed("latency", delay)),
     )
 
 
@@ -236,6 +296,8 @@ def _dynamic_compensator(obj, dt: float) -> DiscreteSystem:
         output=step,
         inputs=("x_ref",),
         outputs=("v",),
+        name=f"inverse_dynamics_{obj.kind}",
+        states=(*_indexed("inverse_dynamics", n_dyn), *packed_state_names(hyst)),
     )
 
 
@@ -256,10 +318,10 @@ def _builtin_adapters() -> list[tuple[type, Adapter]]:
     from hystcomp.plant import Twin
 
     def _model(obj, dt) -> DiscreteSystem:
-        return _stepped(obj.stepper(), ("v",), ("x",))
+        return _stepped(obj.stepper(), ("v",), ("x",), obj.kind)
 
     def _compensator(obj, dt) -> DiscreteSystem:
-        return _stepped(obj.stepper(), ("x_ref",), ("v",))
+        return _stepped(obj.stepper(), ("x_ref",), ("v",), f"inverse_{obj.kind}")
 
     return [
         (HysteresisModel, _model),
@@ -309,7 +371,11 @@ def to_control(obj, dt, *, name=None, inputs=None, outputs=None):
         Sample time in s (``1 / sample_rate``; the twin's is 5e-5). A compensator built with
         a slew-rate limit should be given the ``sample_rate`` it was built for.
     name : str, optional
-        System name for ``control.interconnect``.
+        System name for ``control.interconnect``; by default what the system is: the
+        model's kind (``"pi"``, ``"mpi"``, ``"preisach"``), ``"inverse_"`` and the kind
+        for a compensator (``"inverse_dynamics_mpi"`` with the inverse of the dynamics),
+        ``"twin"`` or ``"dynamics"``. Two systems of one kind in one interconnection need
+        names of their own (python-control renames and warns).
     inputs, outputs : str, optional
         Other signal names than the defaults above.
 
@@ -318,7 +384,8 @@ def to_control(obj, dt, *, name=None, inputs=None, outputs=None):
     control.NonlinearIOSystem
         One input, one output; its state is the object's packed state, starting at the
         initial state (``sys.x0``), so ``control.input_output_response(sys, T, U, X0=sys.x0)``
-        equals ``obj.simulate(U)``.
+        equals ``obj.simulate(U)``. The states are named after their slots (``play[0]``,
+        ``last_output``, ``extremum[2]``, ``creep[0]``, ...).
 
     Raises
     ------
@@ -352,9 +419,9 @@ def to_control(obj, dt, *, name=None, inputs=None, outputs=None):
         lambda t, s, u, params: np.array([system.output(s, u)]),
         inputs=[inputs] if inputs else list(system.inputs),
         outputs=[outputs] if outputs else list(system.outputs),
-        states=system.state.size,
+        states=system.state_names(),
         dt=dt,
-        name=name,
+        name=name if name is not None else system.name,
     )
     sys.x0 = system.state.copy()
     return sys

@@ -48,6 +48,28 @@ def test_normal_equations_equal_the_explicit_design(rng):
     np.testing.assert_allclose(gram, full.T @ full, rtol=1e-11, atol=1e-6)
 
 
+def test_gram_blocks_run_on_one_blas_thread_and_the_setting_comes_back(rng, monkeypatch):
+    """On a busy machine a threaded BLAS woken for every 2048 x 34 block made a fit many
+    times slower: the products run on one thread, whatever the process's setting."""
+    from threadpoolctl import threadpool_info, threadpool_limits
+
+    seen = []
+    rows = chain.regressor_rows
+
+    def watched(*args):
+        seen.append([lib["num_threads"] for lib in threadpool_info() if lib["user_api"] == "blas"])
+        return rows(*args)
+
+    monkeypatch.setattr(chain, "regressor_rows", watched)
+    u = random_walk(rng, 5000, 0.0, 10.0, 0.8)
+    with threadpool_limits(limits=2, user_api="blas"):
+        normal_equations(u, np.array([0.0, 2.0]), np.zeros(2), 3.0 * u, np.array([4.0]), 0)
+        after = [lib["num_threads"] for lib in threadpool_info() if lib["user_api"] == "blas"]
+    assert len(seen) >= 3  # every block was watched
+    assert all(threads and set(threads) == {1} for threads in seen)
+    assert set(after) == {2}  # the caller's setting is back
+
+
 def test_weighted_normal_equations_equal_the_explicit_weighted_design(rng):
     u = random_walk(rng, 2500, 0.0, 10.0, 0.8)
     z = 3.0 * u + rng.normal(size=u.size)

@@ -4,10 +4,10 @@ import numpy as np
 import pytest
 import scipy.io
 
-from hystcomp.errors import DataFileError, InvalidParameterError
+from hystcomp.errors import DataFileError, InvalidParameterError, InvalidSignalError
 from hystcomp.io.records import Record, parse_columns, read_record, read_table, write_table
 
-# every test twice: text read by numpy.loadtxt, then by the compiled parser
+# every test twice: text written by repr, then by the compiled formatter (read by pandas)
 pytestmark = pytest.mark.usefixtures("text_reader")
 
 
@@ -55,8 +55,22 @@ def test_bad_column_mappings_in_python(tmp_path, record):
     path = tmp_path / "rec.csv"
     write_table(path, record)
     for bad in ({"v": 0}, {"y": 1}, {"v": True}, {"v": ""}):
-        with pytest.raises(InvalidParameterError, match=r"'columns' parameter of read_table"):
+        with pytest.raises(InvalidParameterError, match=r"'columns' parameter of read_record"):
             read_record(path, columns=bad)
+        with pytest.raises(InvalidParameterError, match=r"'columns' parameter of read_table"):
+            read_table(path, columns=bad)
+    with pytest.raises(InvalidParameterError, match=r"'columns' option must look like v=1"):
+        read_record(path, columns="v=1,y=2")
+
+
+def test_read_record_takes_the_command_line_s_columns_text(tmp_path, record):
+    path = tmp_path / "rec.csv"
+    write_table(path, {"v": record["v"], "t": record["t"], "x": record["x"]})
+    by_text = read_record(path, columns="t=2,v=1,x=3")
+    by_dict = read_record(path, columns={"t": 2, "v": 1, "x": 3})
+    for key in "tvx":
+        np.testing.assert_array_equal(getattr(by_text, key), record[key])
+        np.testing.assert_array_equal(getattr(by_dict, key), record[key])
 
 
 def test_csv_columns_by_name_extra_columns_ignored(tmp_path):
@@ -161,3 +175,10 @@ def test_failed_write_never_touches_an_existing_file(tmp_path, record):
 def test_record_sample_rate_from_time():
     rec = Record(np.array([0.0, 0.5, 1.0]), np.zeros(3), np.zeros(3))
     assert rec.sample_rate == 2.0
+
+
+def test_a_time_column_beyond_the_largest_magnitude_is_refused_as_a_record_is(tmp_path):
+    path = tmp_path / "rec.csv"
+    path.write_text("t,v,x\n0.5,1,2\n1.5,2,3\n4.0e16,3,4\n")
+    with pytest.raises(InvalidSignalError, match=r"Record 't'.*magnitude at most 1e\+12"):
+        read_record(path)

@@ -15,7 +15,7 @@ from hystcomp.errors import DataFileError, InvalidParameterError
 from hystcomp.io._formats import MAX_SAMPLES, max_samples
 from hystcomp.io.records import read_record, read_table, write_table, x_unit_warning
 
-# every test twice: text read by numpy.loadtxt, then by the compiled parser
+# every test twice: text written by repr, then by the compiled formatter (read by pandas)
 pytestmark = pytest.mark.usefixtures("text_reader")
 
 
@@ -56,6 +56,8 @@ def _same(path, record, **kwargs):
         ("names-units.csv", ["t [s];V (V);x [µm]"], ";", ","),
         ("mixed.csv", ['"Time","v","X"'], ",", "."),
         ("crlf.csv", ["t,v,x"], ",", "."),
+        ("spaces-decimal-comma.txt", ["t v x"], " ", ","),
+        ("spaces-decimal-comma-runs.dat", ["t    v    x"], "    ", ","),
         ("cr.csv", ["t,v,x"], ",", "."),
     ],
 )
@@ -68,14 +70,9 @@ def test_lab_text_layouts_read_as_the_canonical_csv(tmp_path, record, name, head
 
 
 @pytest.mark.parametrize("newline", ["\n", "\r\n", "\r"])
-@pytest.mark.parametrize("compiled", [False, True])
-def test_long_tables_with_blank_lines_and_old_mac_line_ends_are_read(
-    tmp_path, rng, monkeypatch, newline, compiled
-):
+def test_long_tables_with_blank_lines_and_old_mac_line_ends_are_read(tmp_path, rng, newline):
     import hystcomp.io._text as text
 
-    if compiled:  # the compiled parser, not numpy's, for the chunks it takes
-        monkeypatch.setattr(text, "SMALL_READ", 0)
     t = np.arange(6000) / 2000.0  # longer than the head that the layout is read from
     big = {"t": t, "v": 60.0 + 50.0 * np.sin(t), "x": rng.standard_normal(t.size)}
     rows = _rows(big)
@@ -272,7 +269,6 @@ def test_chunked_read_and_write_round_trip_across_chunks(tmp_path, rng, monkeypa
 
     monkeypatch.setattr(text, "CHUNK_BYTES", 1000)  # many chunks, rows cut anywhere
     monkeypatch.setattr(text, "SMALL_TABLE", 0)  # the compiled formatter, even for few rows
-    monkeypatch.setattr(text, "SMALL_READ", 0)  # and the compiled parser
     n = 2000
     table = {
         "t": np.arange(n) / 3e3,
@@ -327,8 +323,8 @@ def test_writing_and_reading_stay_in_bounded_memory(tmp_path):
     # the table (12 MB), chunk buffers and loading the compiled formatter (~40 MB); writing
     # whole lists of Python floats and strings took about 190 MB
     assert _growth(make + "write_table(sys.argv[1], table)", path) < 100
-    # the parsed table and the record's own copies (2 x 12 MB), chunk buffers (2 MB of text)
-    # and loading the compiled parser (~40 MB, as the formatter)
+    # the parsed table, which the record keeps (12 MB), pandas' buffers for a chunk and
+    # loading pandas (~40 MB)
     assert _growth("rec = read_record(sys.argv[1])", path) < 100
 
 
@@ -377,3 +373,108 @@ def test_one_column_is_not_read_as_two_signals(tmp_path, record):
     write_table(path, record)
     with pytest.raises(DataFileError, match=r"read both as 'v'.*and as 'x'"):
         read_table(path, columns={"x": "v"})
+
+
+def test_a_headerless_table_with_a_leading_separator_keeps_its_column_numbers(tmp_path, record):
+    """``,0,-1.617,0`` as some acquisition scripts write it: the empty first column keeps
+    its number, so the numbers a spreadsheet shows (t=2, v=4, x=3) name the columns."""
+    path = tmp_path / "acquisition.csv"
+    columns = (record[k].tolist() for k in "tvx")
+    rows = [f",{t!r},{x!r},{v!r}" for t, v, x in zip(*columns, strict=True)]
+    path.write_text("\n".join(rows) + "\n")
+    _same(path, record, columns="t=2,v=4,x=3")
+    out = tmp_path / "m.json"  # the same spec on the command line
+    cli = CliRunner().invoke(
+        main,
+        ["identify", str(path), "--model", "pi", "--columns", "t=2,v=4,x=3", "-o", str(out)],
+    )
+    assert cli.exit_code == 0, cli.output
+    assert out.is_file()
+    # a row of other length is still refused, with its data row
+    path.write_text("\n".join([*rows[:4], ",1,2", *rows[4:]]) + "\n")
+    with pytest.raises(DataFileError, match=r"data row 5 has 3 columns, not 4"):
+        read_record(path, columns="t=2,v=4,x=3")
+
+
+def test_decimal_commas_in_one_headerless_column_are_read_or_refused_never_misread(tmp_path):
+    x = np.array([0.046, 0.067, 0.5, 1.25, 0.003])
+    path = tmp_path / "x.csv"
+    # "0,046": a leading zero in the second field, which no integer column writes
+    path.write_text("".join(repr(value).replace(".", ",") + "\n" for value in x.tolist()))
+    got = read_table(path, ("x",), columns="x=1", sample_rate=20_000.0)["x"]
+    np.testing.assert_array_equal(got, x)
+    result = CliRunner().invoke(
+        main,
+        ["compensate", str(_model(tmp_path)), str(path), "--columns", "x=1", "--fs", "20000",
+         "-o", str(tmp_path / "v.csv")],
+    )  # fmt: skip
+    assert result.exit_code == 0, result.output
+    written = (tmp_path / "v.csv").read_text().splitlines()
+    assert written[0] == "t,v,x_ref"
+    assert [float(line.split(",")[2]) for line in written[1:]] == x.tolist()  # not 0, 0, 0, 1
+    # with a header of one name: one column, whatever the digits
+    path.write_text("x\n1,5\n2,25\n3,5\n")
+    one = read_table(path, ("x",), sample_rate=1.0)["x"]
+    np.testing.assert_array_equal(one, [1.5, 2.25, 3.5])
+    # a header of two names: two columns of integers
+    path.write_text("t,x\n1,5\n2,25\n3,5\n")
+    np.testing.assert_array_equal(read_table(path, ("x",))["x"], [5.0, 25.0, 5.0])
+    # neither: the two readings differ, so it is refused with the fix
+    path.write_text("1,5\n2,25\n3,5\n")
+    with pytest.raises(DataFileError, match=r"two whole numbers split by a comma.*header row"):
+        read_table(path, ("x",), columns={"x": 1}, sample_rate=1.0)
+
+
+def _model(folder):
+    from hystcomp import presets, save_model
+
+    path = folder / "model.json"
+    save_model(presets.paper_mpi(), path)
+    return path
+
+
+def test_a_first_line_longer_than_the_head_is_read_or_named(tmp_path, monkeypatch):
+    import hystcomp.io._text as text
+
+    # (the head and the longest line made small, so that a small file shows what a header
+    # of 1e5 columns does with the real sizes, 64 KiB and 1 MiB)
+    monkeypatch.setattr(text, "HEAD_BYTES", 512)
+    monkeypatch.setattr(text, "MAX_LINE_BYTES", 8192)
+    wide = tmp_path / "wide.csv"
+    names = ["t", "v", "x", *(f"c{i}" for i in range(300))]  # a header over the head
+    values = np.arange(len(names), dtype=float)
+    rows = [",".join(map(repr, (values + k).tolist())) for k in (0, 1)]
+    wide.write_text("\n".join([",".join(names), *rows]) + "\n")
+    assert len(wide.read_text().splitlines()[0]) > text.HEAD_BYTES
+    table = read_table(wide, ("v", "x"))
+    np.testing.assert_array_equal(table["x"], [2.0, 3.0])
+    along = tmp_path / "along.csv"
+    along.write_text(",".join(repr(float(k)) for k in range(3000)) + "\n")  # along a line
+    with pytest.raises(DataFileError, match=r"first line of more than \d+ bytes.*transpose"):
+        read_table(along, ("x",), columns={"x": 1}, sample_rate=1.0)
+
+
+def test_a_pandas_without_the_reader_engine_reads_the_same_through_a_dataframe(
+    tmp_path, record, monkeypatch
+):
+    import pandas as pd
+
+    real = pd.read_csv
+
+    class Reader:  # what a pandas whose reader has no engine to ask would hand over
+        def __init__(self, *args, **kwargs):
+            self._reader = real(*args, **kwargs)
+
+        def __enter__(self):
+            return self
+
+        def __exit__(self, *exc):
+            self._reader.close()
+
+        def read(self):
+            return self._reader.read()
+
+    path = tmp_path / "rec.csv"
+    write_table(path, record)
+    monkeypatch.setattr(pd, "read_csv", Reader)
+    _same(path, record)

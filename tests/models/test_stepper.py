@@ -215,3 +215,61 @@ def test_a_compensator_is_built_only_with_the_clamp_its_packed_chain_holds():
     broken[chain.HEADER] = np.nan  # a parameter
     with pytest.raises(InvalidParameterError, match="non-finite"):
         hystcomp.Compensator(broken, kind="pi", voltage_range=(lo, hi))
+
+
+def test_step_block_into_a_preallocated_out_equals_the_batch_run_bit_for_bit(case):
+    system, u, expected = case
+    stepper = system.stepper()
+    out = np.empty(20)
+    got = []
+    for start in range(0, u.size - 20, 20):
+        result = stepper.step_block(u[start : start + 20], out)  # views, as a loop has them
+        assert result is out  # written in place, nothing allocated
+        got.append(out.copy())
+    n = len(got) * 20
+    assert np.array_equal(np.concatenate(got), expected[:n])
+    # a strided block and a list go the checked way, into the same out, with the same bits
+    strided = np.repeat(u[n : n + 10], 2)[::2]
+    assert not strided.flags.c_contiguous
+    rest = stepper.step_block(strided, np.empty(10))
+    assert np.array_equal(rest, expected[n : n + 10])
+    assert stepper.nonfinite_count == sum(k < n + 10 for k in NON_FINITE)
+
+
+def test_step_block_refuses_an_out_it_cannot_write_and_changes_nothing():
+    stepper = presets.paper_mpi().inverse().stepper()
+    u = np.linspace(0.0, 20.0, 20)
+    before = stepper._p.copy()
+    cases = [
+        (np.empty(19), InvalidParameterError, "block's length \\(20\\)"),
+        (np.empty(20, dtype=np.float32), InvalidTypeError, "float64 NumPy array"),
+        ([0.0] * 20, InvalidTypeError, "float64 NumPy array"),
+        (np.empty(40)[::2], InvalidParameterError, "not contiguous"),
+        (u, InvalidParameterError, "overlaps the input block"),
+    ]
+    read_only = np.empty(20)
+    read_only.setflags(write=False)
+    cases.append((read_only, InvalidParameterError, "read-only"))
+    for out, error, message in cases:
+        with pytest.raises(error, match=message):
+            stepper.step_block(u, out)
+    shared = np.empty(30)
+    with pytest.raises(InvalidParameterError, match="overlaps"):
+        stepper.step_block(shared[:20], shared[10:30])  # a partial overlap, found by the kernel
+    assert np.array_equal(stepper._p, before)  # no sample was run
+    fresh = presets.paper_mpi().inverse().stepper()
+    assert np.array_equal(stepper.step_block(u, np.empty(20)), fresh.step_block(u))
+
+
+def test_the_step_of_a_chain_with_dead_zones_is_folded_to_the_batch_bits(rng):
+    """The step sums its dead-zones in a register and stops at the first threshold the
+    sample does not pass; the bits are the batch run's (forward MPI: dead-zones after the
+    plays; inverse MPI: before)."""
+    for system in (presets.paper_mpi(), presets.paper_mpi().inverse()):
+        lo, hi = (-5.0, 125.0) if hasattr(system, "n_deadzones") else (-2.0, 38.0)
+        u = random_walk(rng, 5000, lo, hi, 3.0)
+        stepper = system.stepper()
+        assert np.array_equal([stepper.step(uk) for uk in u], system.simulate(u))
+    unsorted = chain.pack_chain(pre=(np.array([0.0, 2.0, 1.0]), np.array([1.0, 0.5, 0.5])))
+    with pytest.raises(InvalidParameterError, match="dead-zone thresholds that decrease"):
+        hystcomp.Stepper(unsorted)

@@ -122,14 +122,28 @@ def step_function(kernel, arrays: int = 1):
     return kernel.compile((*[numba.types.float64[::1]] * arrays, numba.types.float64))
 
 
-StepKernels = namedtuple("StepKernels", "step run state_start last nonfinite clamped")
+@functools.cache
+def block_function(kernel):
+    """Block kernel ``kernel(p, u, out, work) -> status`` compiled for four float64 arrays,
+    as a plain function (no dispatch on argument types): the trusted path of
+    ``Stepper.step_block(u, out=...)``. Its caller checks the arrays' types first."""
+    array = numba.types.float64[::1]
+    return kernel.compile((array, array, array, array))
+
+
+StepKernels = namedtuple(
+    "StepKernels", "step run state_start last nonfinite clamped block", defaults=(None,)
+)
 StepKernels.__doc__ = """What a streaming stepper needs to know of a kind of packed system.
 
 ``step`` is its :func:`step_kernel`, ``run(p, u, out)`` the batch kernel that the step equals
 bit for bit, ``state_start(p)`` a plain Python function giving the index of the first state
 slot, and ``last``, ``nonfinite`` and ``clamped`` the offsets from there of the last output,
 of the count of non-finite inputs and of the count of clamped outputs (named state slots of
-the kernel's module). :data:`~hystcomp._kernels.chain.CHAIN_KERNELS` is that of a packed
+the kernel's module). ``block``, if given, is a :func:`step_kernel` ``block(p, u, out,
+work) -> status`` over a block of samples (``run``'s loop, without reference counting, for
+short blocks from Python): status 0 when it ran, else nonzero and nothing done (``out``
+shorter than ``u``, or overlapping it). :data:`~hystcomp._kernels.chain.CHAIN_KERNELS` is that of a packed
 chain, :data:`~hystcomp._kernels.preisach.PREISACH_KERNELS` that of a Preisach system and
 :data:`~hystcomp._kernels.twin.TWIN_KERNELS` that of the simulated axis.
 """

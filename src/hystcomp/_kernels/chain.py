@@ -112,12 +112,30 @@ def play_update(v, r, y):
 def deadzone_block(x, shift, r, w, out):
     """Weighted one-sided dead-zones (eqs. 13-14) of every sample of a block.
 
-    ``out[k] = sum_j w_j s_{r_j}(x[k] - shift)``, with ``s_0(z) = z`` (``r[0]`` must be 0)
-    and ``s_r(z) = max(z - r, 0)``. The one dead-zone loop of the package. Operators are the
-    outer loop and samples the inner one, so the inner loop vectorises over samples without
-    a reduction, and each sample's sum is formed in the same order whatever the block length
-    (a one-sample block gives the same bits as a long one). ``out`` must not overlap ``x``.
+    ``out[k] = sum_j w_j s_{r_j}(x[k] - shift)``, with ``s_0(z) = z`` (``r[0]`` must be 0,
+    and the thresholds must not decrease) and ``s_r(z) = max(z - r, 0)``. The one dead-zone
+    loop of the package. Operators are the outer loop and samples the inner one, so the
+    inner loop vectorises over samples without a reduction, and each sample's sum is formed
+    in the same order whatever the block length (a one-sample block gives the same bits as a
+    long one). ``out`` must not overlap ``x``.
+
+    A one-sample block (a streaming step) is folded: its sum is kept in a register, not in
+    ``out`` (which a step's caller passes as a slot of the packed array beside ``r`` and
+    ``w``, so the compiler reloaded it after every term, 3.4 ns each), and it stops at the
+    first threshold the sample does not pass: every later term is ``w_j * 0``, which adds
+    nothing. The terms it adds are those of the block loop, in the same order, so the bits
+    are the same (the data-dependent exit also keeps the compiler from reordering the sum).
     """
+    if x.size == 1:
+        xk = x[0]
+        acc = w[0] * min(xk - shift, 0.0)
+        for j in range(r.size):
+            d = xk - (r[j] + shift)
+            if not d > 0.0:  # s_r = 0 here and at every later (larger) threshold
+                break
+            acc += w[j] * d
+        out[0] = acc
+        return
     w0 = w[0]
     for k in range(x.size):
         out[k] = w0 * min(x[k] - shift, 0.0)  # with the j = 0 term below: w_0 * (x - shift)
@@ -299,9 +317,39 @@ def chain_run(p, u, out):
     chain_blocks(p, u, out, work)
 
 
+@inline_kernel
+def block_status(u, out):
+    """0 if ``out`` can take the outputs of ``u`` (as long, not overlapping), else 1 (a
+    length) or 2 (an overlap): the checks of a block kernel called from Python."""
+    if out.size != u.size:
+        return 1
+    a, b = u.ctypes.data, out.ctypes.data
+    if u.size and a < b + out.nbytes and b < a + u.nbytes:
+        return 2
+    return 0
+
+
+@step_kernel
+def chain_step_block(p, u, out, work):
+    """:func:`chain_run` for a short block from Python (``Stepper.step_block``): the same
+    :func:`chain_blocks`, compiled as a step is, without reference counting, so a call of 20
+    samples costs little more than their samples; ``work`` holds at least :data:`BLOCK`
+    values. Returns :func:`block_status` (0: done; else nothing done)."""
+    status = block_status(u, out)
+    if status == 0:
+        chain_blocks(p, u, out, work)
+    return status
+
+
 #: The :class:`StepKernels` of a packed chain.
 CHAIN_KERNELS = StepKernels(
-    chain_step, chain_run, chain_state_start.py_func, STATE_LAST, STATE_NONFINITE, STATE_CLAMPED
+    chain_step,
+    chain_run,
+    chain_state_start.py_func,
+    STATE_LAST,
+    STATE_NONFINITE,
+    STATE_CLAMPED,
+    chain_step_block,
 )
 
 

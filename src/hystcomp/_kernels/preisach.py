@@ -48,7 +48,7 @@ from hystcomp._kernels._jit import (
     kernel,
     step_kernel,
 )
-from hystcomp._kernels.chain import CLAMP_TOLERANCE
+from hystcomp._kernels.chain import CLAMP_TOLERANCE, block_status
 
 # Modes of a packed system: what a step maps.
 FORWARD, MULTIPLICATIVE, EXACT = 0, 1, 2
@@ -457,9 +457,27 @@ def preisach_run(p, u, out):
         out[k] = preisach_step(p, u[k])
 
 
+@step_kernel
+def preisach_step_block(p, u, out, work):
+    """:func:`preisach_run` for a short block from Python (``Stepper.step_block``), compiled
+    as a step is; ``work`` is unused. Returns the chain's
+    :func:`~hystcomp._kernels.chain.block_status` (0: done; else nothing done)."""
+    status = block_status(u, out)
+    if status == 0:
+        for k in range(u.size):
+            out[k] = preisach_step(p, u[k])
+    return status
+
+
 #: The :class:`~hystcomp._kernels._jit.StepKernels` of a packed Preisach system.
 PREISACH_KERNELS = StepKernels(
-    preisach_step, preisach_run, state_start.py_func, ST_LAST, ST_NONFINITE, ST_CLAMPED
+    preisach_step,
+    preisach_run,
+    state_start.py_func,
+    ST_LAST,
+    ST_NONFINITE,
+    ST_CLAMPED,
+    preisach_step_block,
 )
 
 

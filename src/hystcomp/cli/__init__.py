@@ -58,6 +58,10 @@ COMMANDS = {
         "hystcomp.cli.compensate",
         "Voltage that makes the actuator of MODEL.json follow REFERENCE (columns t, x).",
     ),
+    "evaluate": (
+        "hystcomp.cli.evaluate",
+        "How well MEASURED (columns t, x; v too if there) tracked REFERENCE (columns t, x).",
+    ),
     "excite": (
         "hystcomp.cli.excite",
         "Write the identification input for MODEL: pi, mpi, preisach, rich or dynamics.",

@@ -29,7 +29,6 @@ from hystcomp.cli._options import (
 from hystcomp.errors import IdentificationError
 from hystcomp.identify.preisach import FIT_METHODS
 from hystcomp.identify.preisach_lsq import MAX_LSQ_GRID
-from hystcomp.identify.scoring import straight_line
 from hystcomp.identify.workflow import (
     LABELS,
     SIZE_OPTIONS,
@@ -257,7 +256,7 @@ def identify(
     inputs = (data,) if dynamics_record is None else (data, dynamics_record)
     check_output_path(output, inputs=inputs, what="model file")
     if plot is not None:  # matplotlib is imported only when a figure is asked for
-        from hystcomp.experiment.fig_identification import FORMATS, plot_identification
+        from hystcomp.experiment.fig_identification import FORMATS, plot_identification_result
 
         if Path(plot).suffix.lower() not in FORMATS:
             raise click.BadParameter(f"must end in {', '.join(FORMATS)}.", param_hint="--plot")
@@ -349,11 +348,7 @@ def identify(
     outputs = [output] if plot is None else [output, plot]
     with atomic_paths(*outputs) as (tmp_model, *tmp_plot):
         tmp_model.write_text(text, encoding="utf-8")
-        if plot is not None:
-            fitted = slice(result.start, result.n_fit)
-            v, x = rec.v[fitted], rec.x[fitted]
-            a, b = straight_line(v, x)
-            x_model = result.x_model[result.start :]
-            plot_identification(v, x, a * v + b, x_model, tmp_plot[0], model_name=result.label)
+        if plot is not None:  # the fitted part, and the hold-out as the model predicts it
+            plot_identification_result(rec, result, tmp_plot[0])
     for path in outputs[::-1]:
         click.echo(f"  wrote {path}")

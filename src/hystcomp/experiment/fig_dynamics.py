@@ -75,7 +75,9 @@ def plot_step(t, x_ref, runs: dict, path) -> None:
     Left, the first 10 ms (the resonance); right, 10 ms to the end on a log time axis,
     zoomed on the creep (each trace reduced to its envelope per pixel column,
     :func:`~hystcomp.experiment._layout.envelope`: it looks the same, drawn from a few
-    thousand points instead of every sample).
+    thousand points instead of every sample). Each panel has its legend. Runs with the
+    inverse of the dynamics are dashed; in the first 10 ms the resonance makes the runs of
+    one kind alike, so each run is drawn thinner than the one before and every one shows.
     """
     fig = new_figure((9.0, 4.0))
     fixed_layout(fig, left=0.746, right=0.15, top=0.683, bottom=0.61, wgap=0.786, cols=2)
@@ -85,10 +87,15 @@ def plot_step(t, x_ref, runs: dict, path) -> None:
     early = after <= 0.01
     late = after >= 0.01
     columns = pixel_columns(fig, slow, fig.dpi)
-    for label, x in runs.items():
+    for i, (label, x) in enumerate(runs.items()):
         e = (x - x_ref)[start:]
-        fast.plot(1e3 * after[early], e[early], label=label)
-        slow.semilogx(*envelope(after[late], e[late], columns, log=True), label=label)
+        style = {
+            "label": _label(label),
+            "ls": "--" if "dynamics" in label else "-",
+            "lw": max(3.2 - 0.7 * i, 0.9),
+        }
+        fast.plot(1e3 * after[early], e[early], **style)
+        slow.semilogx(*envelope(after[late], e[late], columns, log=True), **style)
     for ax in (fast, slow):
         ax.axhline(0.0, color="k", lw=0.5)
         ax.grid(True, which="both", alpha=0.3)
@@ -97,6 +104,14 @@ def plot_step(t, x_ref, runs: dict, path) -> None:
     slow.set_xlabel("time after the step (s)")
     fast.set_title("the first 10 ms", y=TITLE_Y)
     slow.set_title("creep: 10 ms to the end", y=TITLE_Y)
-    slow.legend()
+    fast.legend(loc="upper right", fontsize="small")
+    slow.legend(loc="lower right", fontsize="small")
     fig.suptitle("Step and hold on the simulated axis with creep")
     save_figure(fig, path, dpi=fig.dpi)
+
+
+def _label(key: str) -> str:
+    """A run's name as the other figures write it: ``"mpi + dynamics"`` -> ``"MPI +
+    dynamics"``."""
+    names = {"mpi": "MPI", "pi": "PI", "preisach": "Preisach"}
+    return " ".join(names.get(word, word) for word in key.split(" "))

@@ -69,8 +69,8 @@ def plot_preisach_loops(
         seg = slice(i * per_period, (i + 1) * per_period + 1)
         ax.plot(v[seg], x[seg], lw=1.2, label=f"model, {amplitude:g} V")
     # plain text, as in the other figures: mathtext would build its parser (0.4 s) for this
-    ax.set_xlabel("Voltage v_px (V)")
-    ax.set_ylabel("Displacement x_p (µm)")
+    ax.set_xlabel("voltage v_px (V)")
+    ax.set_ylabel("displacement x_p (µm)")
     ax.set_title(f"Preisach model, {frequency:g} Hz sinusoids of growing amplitude", y=TITLE_Y)
     ax.grid(True, alpha=0.3)
     ax.legend(loc="upper left")

@@ -28,6 +28,7 @@ from typing import NamedTuple
 import numpy as np
 import quadprog
 
+from hystcomp._blas import one_blas_thread
 from hystcomp._kernels import chain
 from hystcomp.errors import IdentificationError
 
@@ -67,7 +68,22 @@ def normal_equations(
     ndarray, shape (p + 1, p + 1), or (n_folds, p + 1, p + 1) with ``folds``
         ``[Phi | z]^T [Phi | z]`` with ``p = n + m + 1`` regressors (plays, negated
         dead-zones, constant) and the target last.
+
+    Notes
+    -----
+    The block products run on one BLAS thread (:func:`hystcomp._blas.one_blas_thread`):
+    they are too small to gain from more, and on a busy machine threads woken for every
+    block made a fit many times slower.
     """
+    with one_blas_thread():
+        return _normal_equations(
+            u, thresholds, initial_state, z, deadzone_thresholds, start, folds, n_folds, weights
+        )
+
+
+def _normal_equations(
+    u, thresholds, initial_state, z, deadzone_thresholds, start, folds, n_folds, weights
+) -> np.ndarray:
     n, m = len(thresholds), len(deadzone_thresholds)
     u = np.ascontiguousarray(u, dtype=np.float64)
     r = np.ascontiguousarray(thresholds, dtype=np.float64)

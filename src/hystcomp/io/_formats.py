@@ -1,6 +1,6 @@
 """Parsing data files into columns, treating every file as untrusted input.
 
-Text tables (:mod:`hystcomp.io._text`: layout rules, chunked ``np.loadtxt``), NPZ
+Text tables (:mod:`hystcomp.io._text`: layout rules, pandas' C reader in chunks), NPZ
 (``np.load`` without pickle) and MAT files. A MAT file is parsed by scipy in a child
 process: scipy's MAT reader is not hardened against corrupt files (a wrong type code in a
 numeric element crashes the interpreter), so a crash there becomes a
@@ -27,7 +27,8 @@ from hystcomp.io._text import read_rows, sniff
 MAT_TIMEOUT = 120.0
 #: The most samples (rows) a record may have, unless ``HYSTCOMP_MAX_SAMPLES`` says otherwise.
 #: Arrays are checked against it before they are loaded: NPZ members by their .npy header,
-#: MAT variables by :func:`scipy.io.whosmat`, text tables by counting lines.
+#: MAT variables by :func:`scipy.io.whosmat`, text tables as they are read (the reading stops
+#: at the limit; the array they are read into is sized from the file's size).
 MAX_SAMPLES = 100_000_000
 #: The most columns of a matrix in an NPZ or MAT file (its shorter side).
 MAX_MATRIX_COLUMNS = 64
@@ -113,10 +114,10 @@ def _check_npz_headers(path: Path, file, limit: int) -> None:
 def _read_text(path: Path, progress=None):
     """Header names (or None), units (or None) and the columns of a text table."""
     layout = sniff(path)
-    table = read_rows(path, layout, max_samples(), progress)
-    if table.shape[1] == 0:
+    columns = read_rows(path, layout, max_samples(), progress)
+    if not columns or columns[0].size == 0:
         raise DataFileError(f"Data file {str(path)!r} has a header but no data rows.")
-    return layout.names, list(table), layout.units
+    return layout.names, columns, layout.units
 
 
 def _read_npz(path: Path):

@@ -7,9 +7,14 @@ guessing from statistics, unlike :class:`csv.Sniffer`):
    with ``µm`` written by Windows software). Blank lines are skipped everywhere.
 2. The **first data row** is the first line, not starting with ``#``, whose fields are all
    numbers. Its **separator** is ``;`` if the line holds one, else a tab if it holds one,
-   else ``,`` if it holds one, else runs of spaces.
+   else ``,`` if it holds one, else runs of spaces; but a line whose fields are split by
+   spaces and hold decimal commas (``0,5 1,25``) is split by spaces.
 3. With a separator other than ``,``, a ``,`` inside the data rows is a **decimal comma**
-   (``0,5;1,25``): every ``,`` of the data is read as ``.``.
+   (``0,5;1,25``): every ``,`` of the data is read as ``.``. A table without a header whose
+   rows are two whole numbers split by a comma (``0,046``) is one column with decimal commas
+   when a second field starts with ``0`` (``046``, which no integer column writes), or when
+   the header names one column; two columns when the header names two; otherwise it is
+   refused, as the two readings differ.
 4. The **header** is the last line above the first data row that is not a comment; if that
    line is a **units row** (every field a unit such as ``s``, ``V``, ``um``, ``[µm]``,
    ``(mV)``, or empty), the header is the line above it. Without such a line, the last
@@ -21,20 +26,25 @@ guessing from statistics, unlike :class:`csv.Sniffer`):
    The header and the units row must have as many fields as the data rows.
 6. As spreadsheets and loggers write them: a number may be quoted (``"0.5"``), and a
    separator at the end of the first data row (``0,0.5,1,``) is a **trailing separator**,
-   its empty last field ignored in every row (and in the header and units row).
+   its empty last field ignored in every row (and in the header and units row). A separator
+   at the start of the first data row (``,0,-1.617,0``, as some acquisition scripts write)
+   is a **leading separator**: the empty first column keeps its number (``--columns t=2``
+   is the first number) and is never read.
 
-The data rows are parsed in chunks of :data:`CHUNK_BYTES` into one preallocated array: by the
-compiled parser of :mod:`hystcomp.io._floatparse` (plain decimal numbers, read exactly as
-``float`` reads them) in a table of more than :data:`SMALL_READ` values, and by
-:func:`numpy.loadtxt` (its C parser) in a smaller one and wherever the compiled parser gives
-up (quotes, comments, ``nan``, a row of the wrong length: numpy words the error). A read
-needs about the memory of the values (8 bytes each) and no more; rows are counted first and
-a file with more than the limit of samples (:func:`hystcomp.io._formats.max_samples`) is
-refused before any large allocation.
+The data rows are parsed by pandas' C reader (:func:`pandas.read_csv`, the separator, the
+decimal comma, quotes and comments given from the layout above, never guessed) in one pass,
+its column arrays taken from the reader's engine as they are, without the DataFrame that
+would copy them: a read needs about 1.4 times the memory of the values (8 bytes each),
+against 4 times for ``pandas.read_csv``. A file that may hold more rows than the limit of
+samples (:func:`hystcomp.io._formats.max_samples`) by its size has its lines counted first,
+and is refused before it is read. Where pandas stops (text in a row, a row of more fields) or fills a gap with
+NaN (a row of fewer fields), the data rows are parsed again by :func:`numpy.loadtxt`, which
+words the error with the data row and the column.
 """
 
 from __future__ import annotations
 
+import functools
 import re
 import warnings
 from dataclasses import dataclass
@@ -44,17 +54,15 @@ import numpy as np
 
 from hystcomp.errors import DataFileError
 
-#: Bytes of data rows parsed at once (and written at once).
+#: Bytes of data rows worded at once when a row is wrong (and written at once).
 CHUNK_BYTES = 1 << 21
 #: Values up to which CSV is formatted by ``repr`` in the interpreter, in one piece: loading
 #: the compiled formatter costs about as much as formatting this many values so.
 SMALL_TABLE = 200_000
-#: Values up to which a text table is read by :func:`numpy.loadtxt` alone: the first compiled
-#: kernel that a process loads costs about 0.25 s, what numpy takes for this many values
-#: (the compiled parser then reads 6x faster).
-SMALL_READ = 800_000
 #: Bytes read to recognise the layout; the header and first data row must lie within them.
 HEAD_BYTES = 1 << 16
+#: The longest first line read to find it whole (a line of many columns).
+MAX_LINE_BYTES = 1 << 20
 #: Units understood in a units row or ``--x-unit``, per column, as factors to s, V, µm.
 UNITS = {
     "t": {"s": 1.0, "sec": 1.0, "ms": 1e-3, "us": 1e-6, "µs": 1e-6, "μs": 1e-6},
@@ -78,6 +86,9 @@ class Layout:
     data_offset: int  # byte offset of the first data row
     trailing: bool = False  # a separator ends each row: an empty last field to ignore
     encoding: str = "utf-8"
+    leading: bool = False  # a separator starts each row: an empty first column, never read
+    data_line: int = 0  # lines (blank ones too) above the first data row
+    line_above: bool = False  # the line right above the data has as many fields (a header)
 
 
 def _split(line: str, delimiter: str | None) -> list[str]:
@@ -122,24 +133,49 @@ def _is_units(tokens: list[str]) -> bool:
 def sniff(path: Path) -> Layout:
     """The layout of the text table ``path`` by the module's rules.
 
+    The layout is read from the first :data:`HEAD_BYTES` of the file; where they hold no
+    complete data row (a header of many columns), from four times as many, up to
+    :data:`MAX_LINE_BYTES` per line.
+
     Raises
     ------
     DataFileError
         If the file has no data row, or its header or units row does not fit the data.
     """
-    with path.open("rb") as f:
-        head = f.read(HEAD_BYTES)
-    whole = len(head) < HEAD_BYTES
+    size = HEAD_BYTES
+    while True:
+        with path.open("rb") as f:
+            head = f.read(size)
+        whole = len(head) < size
+        if not whole and not (b"\n" in head or b"\r" in head) and size >= MAX_LINE_BYTES:
+            raise DataFileError(
+                f"Data file {str(path)!r} has a first line of more than {size} bytes: a table "
+                "of that many columns, or samples written along a line. A record holds one "
+                "sample per line (columns t, v, x): transpose the table."
+            )
+        layout = _layout(path, head, whole)
+        if layout is not None:
+            return layout
+        size *= 4  # a partial head without a data row: read more of the file
+
+
+def _layout(path: Path, head: bytes, whole: bool) -> Layout | None:
+    """The layout from ``head``, the file's first bytes (all of it if ``whole``); None if a
+    partial head holds no data row (and none of the errors of a header without data)."""
     if not whole:  # cut at the last complete line (ended by "\r" alone on old Macs)
         head = head[: max(head.rfind(b"\n"), head.rfind(b"\r")) + 1]
+        if len(head) * 2 < HEAD_BYTES:  # a first line of many columns, cut: read more
+            return None
     encoding = _encoding(head)
     text = head.decode(encoding)
     bom = 3 if head.startswith(b"\xef\xbb\xbf") else 0
     text = text[1:] if bom else text
     offset, chars = bom, 0
     above: list[tuple[bool, str]] = []  # (is a comment, text) of the lines above the data
+    previous = ""  # the line above, blank or not
     for line in text.splitlines(keepends=True):
-        stripped = line.strip()
+        stripped, before = line.strip(), previous
+        previous = stripped
         start, offset = offset, offset + len(line.encode(encoding))
         first, chars = chars, chars + len(line)
         if not stripped:
@@ -150,21 +186,82 @@ def sniff(path: Path) -> Layout:
         delimiter = _delimiter(stripped)
         decimal_comma = delimiter != "," and "," in text[first:]
         tokens = _split(stripped, delimiter)
+        if delimiter == "," and not _numbers(tokens, False) and _numbers(stripped.split(), True):
+            # spaces between the fields, decimal commas in them: "0,5 1,25" (rule 2)
+            delimiter, decimal_comma, tokens = None, True, stripped.split()
         # (a tab ending the line is gone from the stripped line: look at the line itself)
         trailing = delimiter is not None and line.rstrip("\r\n ").endswith(delimiter)
         if trailing and len(tokens) > 1 and tokens[-1] == "":
             tokens = tokens[:-1]
-        if _numbers(tokens, decimal_comma):
+        leading = delimiter is not None and len(tokens) > 1 and tokens[0] == ""
+        if _numbers(tokens[1:] if leading else tokens, decimal_comma):
+            pairs = delimiter == "," and _comma_pairs(tokens, text[first:])
+            if pairs and _one_column(path, above, text[first:]):  # "0,046": decimal commas
+                delimiter, decimal_comma, tokens = None, True, [stripped]
             names, units = _header(path, above, delimiter, len(tokens))
             n = len(tokens)
-            return Layout(names, units, delimiter, decimal_comma, n, start, trailing, encoding)
+            line_number = len(_LINE_END.findall(head[:start]))
+            # a line of as many fields right above the data (the header, a units row), which
+            # pandas' reader may take as its header: it reads faster so than skipping it
+            fields = len(_split(before, delimiter)) - (1 if trailing else 0)
+            named = bool(before) and not before.startswith("#") and fields == n
+            return Layout(
+                names,
+                units,
+                delimiter,
+                decimal_comma,
+                n,
+                start,
+                trailing,
+                encoding,
+                leading,
+                line_number,
+                named,
+            )
         above.append((False, stripped))
     if not above and not text.strip():
         raise DataFileError(f"Data file {str(path)!r} is empty: it has no data rows.")
+    if not whole and len(head) < MAX_LINE_BYTES:  # a long header: read more
+        return None
     raise DataFileError(
         f"Data file {str(path)!r} has a header but no data rows"
-        + ("" if whole else f" in its first {HEAD_BYTES} bytes")
+        + ("" if whole else f" in its first {len(head)} bytes")
         + ": a data row is a line of numbers only, separated by ',', ';', tabs or spaces."
+    )
+
+
+_LINE_END = re.compile(rb"\r\n|\r|\n")
+_PAIR = re.compile(r"[+-]?\d+,\d+")
+
+
+def _comma_pairs(tokens: list[str], text: str) -> bool:
+    """Whether the first data row and every data row in ``text`` are two whole numbers split
+    by a comma (``0,046``), which reads as one column with decimal commas or as two columns
+    of integers."""
+    if len(tokens) != 2:
+        return False
+    rows = [line.strip() for line in text.splitlines()]
+    return all(_PAIR.fullmatch(row) for row in rows if row and not row.startswith("#"))
+
+
+def _one_column(path: Path, above, text: str) -> bool:
+    """For a table of comma pairs (:func:`_comma_pairs`) in ``text``: True if it is one
+    column with decimal commas, False if two columns; raises if the file does not say (rule
+    3): by its header's count of names, else by a second field with a leading zero."""
+    plain = [line for comment, line in above if not comment]
+    header = [row for row in plain[-2:] if not _is_units(_split(row, ","))]
+    if header:
+        return len(_split(header[-1], ",")) == 1
+    rows = [line.strip() for line in text.splitlines()]
+    seconds = [row.split(",")[1] for row in rows if row and not row.startswith("#")]
+    if any(len(field) > 1 and field.startswith("0") for field in seconds):
+        return True
+    raise DataFileError(
+        f"Data file {str(path)!r} has no header, and its rows are two whole numbers split by "
+        "a comma (such as 0,5): one column with decimal commas, or two columns of integers? "
+        "The two readings differ, so it is not guessed. Give the file a header row (one "
+        "name per column, e.g. x or t,x), or write the decimals with '.', or separate the "
+        "columns with ';'."
     )
 
 
@@ -234,6 +331,117 @@ def _describe(delimiter: str | None) -> str:
     return {None: "spaces", "\t": "tabs"}.get(delimiter, repr(delimiter))
 
 
+def _marks(path: Path, offset: int, size: int = -1) -> tuple[bool, bool]:
+    """Whether the bytes of ``path`` from ``offset`` on (``size`` of them; -1: all) hold a
+    ``#`` (a comment) and a ``"`` (quotes)."""
+    hash_mark = quote = False
+    with path.open("rb") as f:
+        f.seek(offset)
+        left = size
+        while left and (block := f.read(CHUNK_BYTES if left < 0 else min(left, CHUNK_BYTES))):
+            hash_mark = hash_mark or b"#" in block
+            quote = quote or b'"' in block
+            left -= len(block) if left > 0 else 0
+    return hash_mark, quote
+
+
+def row_bound(path: Path, layout: Layout) -> int:
+    """An upper bound of the data rows of ``path``: its data bytes over the shortest data
+    line of the first :data:`HEAD_BYTES` (a line much shorter still, later, grows the
+    array as it is read)."""
+    with path.open("rb") as f:
+        f.seek(layout.data_offset)
+        head = f.read(HEAD_BYTES)
+    lines = [line for line in head.splitlines()[:-1] if line.strip()] or [head]
+    shortest = max(1, min(len(line) for line in lines))
+    data = path.stat().st_size - layout.data_offset
+    return int(data / (shortest + 1) * 1.25) + 8
+
+
+def read_rows(path: Path, layout: Layout, limit: int, progress=None) -> list[np.ndarray]:
+    """The data rows of ``path`` as columns (1-D float64 arrays), parsed by pandas.
+
+    Raises
+    ------
+    DataFileError
+        If a row does not hold ``layout.n_columns`` numbers, or the file holds more than
+        ``limit`` rows.
+    """
+    where = f"Data file {str(path)!r}"
+    marks = _marks(path, layout.data_offset, HEAD_BYTES)
+    values, suspect, failure = _parse_rows(path, layout, limit, marks, progress)
+    if suspect and marks != (True, True):  # a comment or a quote after the first lines?
+        more = _marks(path, layout.data_offset)
+        if more != marks:
+            values, suspect, failure = _parse_rows(path, layout, limit, more, progress)
+    if suspect:  # numpy reads the rows again and words what is wrong, with where
+        _word(path, layout, where)
+    if failure is not None:  # (numpy read them: say what pandas said)
+        raise DataFileError(
+            f"{where} is not a table of numbers ({failure.splitlines()[0][:160]})."
+        ) from None
+    return values
+
+
+def _parse_rows(path: Path, layout: Layout, limit: int, marks: tuple[bool, bool], progress):
+    """pandas' reading of the data rows: ``(columns, suspect, failure)``, the columns as 1-D
+    float64 arrays, ``suspect`` where a row may be wrong (text, a row of fewer fields filled
+    with NaN), ``failure`` the text of pandas' error, if any."""
+    import pandas as pd  # loaded by a text table's reading only
+
+    where = f"Data file {str(path)!r}"
+    if row_bound(path, layout) > limit and count_rows(path, layout.data_offset, limit) > limit:
+        raise DataFileError(
+            f"{where} has more than {limit} rows, the most a record may have "
+            "(HYSTCOMP_MAX_SAMPLES raises the limit). Split the record or lower its sample "
+            "rate."
+        )
+    first = 1 if layout.leading else 0  # an empty first column: never read, NaN
+    options = _read_options(layout, *marks)
+    if progress is not None:
+        progress(0.0)
+    try:
+        raw = _read_columns(pd, path, options)
+    except (ValueError, pd.errors.ParserError, pd.errors.EmptyDataError) as exc:
+        if isinstance(exc, pd.errors.EmptyDataError):  # no rows: said by the caller
+            return [np.empty(0) for _ in range(layout.n_columns)], False, None
+        return [], True, str(exc).strip() or type(exc).__name__
+    suspect, numbers, columns = len(raw) != layout.n_columns, True, []
+    for j, column in enumerate(raw):
+        if column.dtype.kind not in "iuf":  # text among the numbers
+            numbers = numbers and j < first
+            suspect = True
+            column = np.full(column.size, np.nan)
+        column = np.asarray(column, dtype=np.float64)  # (integers converted; floats as they are)
+        # a row of fewer fields is filled with NaN (min propagates it): worded later
+        suspect = suspect or (j >= first and column.size > 0 and bool(np.isnan(column.min())))
+        columns.append(column)
+    if columns and columns[0].size > limit:
+        raise DataFileError(
+            f"{where} has more than {limit} rows, the most a record may have "
+            "(HYSTCOMP_MAX_SAMPLES raises the limit). Split the record or lower its sample "
+            "rate."
+        )
+    failure = "text among the numbers" if suspect and not numbers else None
+    return columns, suspect, failure
+
+
+def _read_columns(pd, path: Path, options: dict) -> list[np.ndarray]:
+    """The columns of the data rows, read by pandas' C reader in one pass.
+
+    Through the reader's engine where pandas has it (the arrays its parser makes, about the
+    memory of the values); a DataFrame (four times the values, at the peak) only where not.
+    """
+    with pd.read_csv(path, iterator=True, **options) as reader:
+        read = getattr(getattr(reader, "_engine", None), "read", None)
+        result = read() if read is not None else None
+        if isinstance(result, tuple) and len(result) == 3 and isinstance(result[2], dict):
+            _, names, data = result
+            return [np.asarray(data[name]) for name in names]
+        frame = reader.read()
+    return [frame.iloc[:, j].to_numpy() for j in range(frame.shape[1])]
+
+
 def count_rows(path: Path, offset: int, limit: int) -> int:
     """Lines from ``offset`` on (an upper bound of the data rows); counting stops past
     ``limit``."""
@@ -245,74 +453,59 @@ def count_rows(path: Path, offset: int, limit: int) -> int:
             last = block[-1:]
             if rows > limit:
                 break
-    rows += last != b"\n"
-    return rows
+    return rows + (last != b"\n")
 
 
-def read_rows(path: Path, layout: Layout, limit: int, progress=None) -> np.ndarray:
-    """The data rows of ``path`` as an array of shape (columns, rows), parsed in chunks.
+@functools.cache
+def _pandas_major() -> int:
+    import pandas as pd
 
-    Raises
-    ------
-    DataFileError
-        If a row does not hold ``layout.n_columns`` numbers, or the file holds more than
-        ``limit`` rows.
-    """
-    where = f"Data file {str(path)!r}"
-    bound = count_rows(path, layout.data_offset, limit)
-    out = np.empty((layout.n_columns, min(bound, limit + 1)))
-    compiled = _compiled_reader(layout, out.size)
-    n, done = 0, 0
-    size = max(path.stat().st_size, 1)
+    return int(pd.__version__.split(".")[0])
+
+
+def _read_options(layout: Layout, comments: bool, quotes: bool) -> dict:
+    """The options of :func:`pandas.read_csv` for the data rows of ``layout``: nothing
+    guessed (separator, decimal comma and columns from the layout), and its defaults where
+    they do (comments and quotes are looked for only where the data hold ``#`` or ``"``:
+    either makes pandas' reader two to three times slower). The file is given by its path,
+    the lines above the data skipped: a file object would be decoded twice."""
+    options: dict[str, object] = {
+        "sep": r"\s+" if layout.delimiter is None else layout.delimiter,
+        "decimal": "," if layout.decimal_comma else ".",
+        # the line above as pandas' header (its names unused), else no header
+        "header": 0 if layout.line_above else None,
+        "skiprows": layout.data_line - 1 if layout.line_above else layout.data_line,
+        "encoding": layout.encoding,
+        "engine": "c",
+    }
+    if layout.trailing:  # the empty field after the last separator: not a column
+        options["usecols"] = list(range(layout.n_columns))
+    if _pandas_major() < 3:  # pandas 2 rounds a few values a unit off unless told to round-trip
+        options["float_precision"] = "round_trip"
+    if comments:
+        options["comment"] = "#"
+    if quotes:
+        options["skipinitialspace"] = True  # a quoted number after a space: read as a number
+    return options
+
+
+def _word(path: Path, layout: Layout, where: str) -> None:
+    """Parse the data rows again with :func:`numpy.loadtxt`, chunk by chunk, to word what is
+    wrong (a row of other length, text) with its data row; returns if numpy reads them all
+    (NaN or inf written as such: the caller's checks refuse them in the columns it reads)."""
+    before = 0
     with path.open("rb") as f:
         f.seek(layout.data_offset)
         rest = b""
         while True:
             block = f.read(CHUNK_BYTES)
             chunk = rest + block
-            cut = chunk.rfind(b"\n") + 1 if block else len(chunk)
+            cut = max(chunk.rfind(b"\n"), chunk.rfind(b"\r")) + 1 if block else len(chunk)
             chunk, rest = chunk[:cut], chunk[cut:]
-            if chunk and not chunk.isspace():  # (no copy, as strip makes)
-                read = compiled(chunk, out, n) if compiled is not None else -1
-                if read < 0:  # numpy reads what the compiled parser does not
-                    rows = _parse(chunk.decode(layout.encoding), layout, where, n)
-                    read = rows.shape[0]
-                    if n + read <= limit:
-                        if n + read > out.shape[1]:  # lines not ended by "\n" (old Macs)
-                            out = np.concatenate([out[:, :n], rows.T], axis=1)
-                        else:
-                            out[:, n : n + read] = rows.T
-                if n + read > limit:
-                    raise DataFileError(
-                        f"{where} has more than {limit} rows, the most a record may have "
-                        "(HYSTCOMP_MAX_SAMPLES raises the limit). Split the record or lower "
-                        "its sample rate."
-                    )
-                n += read
-            done += len(block)
-            if progress is not None:
-                progress(min(1.0, (layout.data_offset + done) / size))
+            if chunk and not chunk.isspace():
+                before += _parse(chunk.decode(layout.encoding), layout, where, before).shape[0]
             if not block:
-                break
-    return out[:, :n]
-
-
-def _compiled_reader(layout: Layout, values: int):
-    """``read(chunk, out, n)``: the rows of ``chunk`` (bytes) into ``out[:, n:]`` by the
-    compiled parser (:mod:`hystcomp.io._floatparse`), their number or -1 where
-    :func:`numpy.loadtxt` must read the chunk; None for a table too small to be worth
-    loading the parser (:data:`SMALL_READ` values)."""
-    if values <= SMALL_READ:
-        return None
-    from hystcomp.io._floatparse import parse_rows  # compiled: loaded for large tables
-
-    code = 0 if layout.delimiter is None else ord(layout.delimiter)
-    comma, trailing = layout.decimal_comma, layout.trailing
-
-    def read(chunk: bytes, out: np.ndarray, n: int) -> int:
-        return int(parse_rows(np.frombuffer(chunk, np.uint8), code, comma, trailing, out, n))
-
-    return read
+                return
 
 
 def _parse(text: str, layout: Layout, where: str, before: int) -> np.ndarray:
@@ -327,6 +520,7 @@ def _parse(text: str, layout: Layout, where: str, before: int) -> np.ndarray:
                 comments="#",
                 quotechar='"',
                 usecols=range(layout.n_columns) if layout.trailing else None,
+                converters=_empty if layout.leading else None,
                 ndmin=2,
             )
     except (ValueError, IndexError, OverflowError) as exc:
@@ -344,6 +538,11 @@ def _parse(text: str, layout: Layout, where: str, before: int) -> np.ndarray:
             "the header must hold the same number of numeric columns."
         )
     return rows
+
+
+def _empty(text: str) -> float:
+    """A field of a table with a leading separator: NaN for the empty first column."""
+    return float(text) if text.strip() else np.nan
 
 
 def _reason(exc: Exception, before: int) -> str:

@@ -97,6 +97,22 @@ class Record:
         for key, arr in arrays.items():
             object.__setattr__(self, key, arr)
 
+    @classmethod
+    def _checked(cls, t, v, x, source: str) -> Record:
+        """A record of arrays that :func:`read_table` checked (finite, equally long, ``t``
+        increasing) and made read-only, taken as they are: a copy of a long record would
+        double the memory its reading needs."""
+        if t.size and max(-float(t[0]), float(t[-1])) > MAX_MAGNITUDE:  # (t increases)
+            return cls(t, v, x, source)  # refused there, as a Record of such times is
+        rec = object.__new__(cls)
+        for key, arr in (("t", t), ("v", v), ("x", x)):
+            if not arr.flags.c_contiguous:  # a column of a matrix file: an own copy
+                arr = np.ascontiguousarray(arr)
+            arr.setflags(write=False)
+            object.__setattr__(rec, key, arr)
+        object.__setattr__(rec, "source", source)
+        return rec
+
     def __len__(self) -> int:
         return int(self.t.size)
 
@@ -108,16 +124,11 @@ class Record:
     def to_frame(self):
         """The record as a ``pandas.DataFrame`` with columns ``t`` (s), ``v`` (V), ``x`` (µm).
 
-        pandas is optional (``pip install "hystcomp[pandas]"``); the frame holds copies, and
-        its columns go back into ``fit``, ``simulate`` or ``score`` as they are.
+        The frame holds copies, and its columns go back into ``fit``, ``simulate`` or
+        ``score`` as they are.
         """
-        try:
-            import pandas as pd
-        except ImportError:
-            raise ImportError(
-                "Record.to_frame needs pandas, an optional dependency. Install it with: "
-                "pip install 'hystcomp[pandas]' (or pip install pandas)."
-            ) from None
+        import pandas as pd  # a dependency, loaded when used
+
         frame = pd.DataFrame({"t": self.t.copy(), "v": self.v.copy(), "x": self.x.copy()})
         frame.attrs["source"] = self.source
         return frame
@@ -182,22 +193,25 @@ def _distinct(mapping: dict, what: str) -> None:
         seen[ident] = key
 
 
-def _check_columns(columns) -> dict:
-    """A column mapping {key: 1-based number or name}, keys among t, v, x."""
+def _check_columns(columns, owner: str = "read_table") -> dict:
+    """A column mapping {key: 1-based number or name}, keys among t, v, x; the command
+    line's text (``"t=2,v=4,x=3"``, :func:`parse_columns`) is taken too."""
+    if isinstance(columns, str):
+        columns = parse_columns(columns)
     if columns is not None and not isinstance(columns, dict):
         raise InvalidParameterError(
-            "The 'columns' parameter of read_table must be a dict such as {'v': 1, 'x': 5}. "
-            f"Got {type(columns).__name__}."
+            f"The 'columns' parameter of {owner} must be a dict such as {{'v': 1, 'x': 5}} or "
+            f"text such as 'v=1,x=5'. Got {type(columns).__name__}."
         )
     columns = dict(columns or {})
     for key, spec in columns.items():
         number = isinstance(spec, int) and not isinstance(spec, bool) and spec >= 1
         if key not in MEANINGS or not (number or (isinstance(spec, str) and spec)):
             raise InvalidParameterError(
-                "The 'columns' parameter of read_table must map 't', 'v' or 'x' to a "
+                f"The 'columns' parameter of {owner} must map 't', 'v' or 'x' to a "
                 f"1-based column number or a column name. Got {key!r}: {spec!r}."
             )
-    _distinct(columns, "The 'columns' parameter of read_table")
+    _distinct(columns, f"The 'columns' parameter of {owner}")
     return columns
 
 
@@ -334,19 +348,21 @@ def _as_column(arr, path: Path, key: str, label: str) -> np.ndarray:
         raise DataFileError(
             f"{what} has shape {out.shape}; expected one value per sample (a vector)."
         )
-    bad = np.flatnonzero(~np.isfinite(out))
-    if bad.size:
+    if not out.size:
+        return out
+    lo, hi = float(out.min()), float(out.max())  # two passes, no copy (NaN propagates)
+    if not (np.isfinite(lo) and np.isfinite(hi)):
+        bad = np.flatnonzero(~np.isfinite(out))
         raise DataFileError(
             f"{what} has a non-finite value ({float(out[bad[0]])!r}) in data row "
             f"{bad[0] + 1}: remove or interpolate that row."
         )
-    if key != "t":
+    if key != "t" and (hi > MAX_MAGNITUDE or lo < -MAX_MAGNITUDE):
         big = np.flatnonzero(np.abs(out) > MAX_MAGNITUDE)
-        if big.size:
-            raise DataFileError(
-                f"{what} has the value {float(out[big[0]]):.6g} in data row {big[0] + 1}, "
-                f"beyond {MAX_MAGNITUDE:g}: check the units and the column."
-            )
+        raise DataFileError(
+            f"{what} has the value {float(out[big[0]]):.6g} in data row {big[0] + 1}, "
+            f"beyond {MAX_MAGNITUDE:g}: check the units and the column."
+        )
     return out
 
 
@@ -370,10 +386,11 @@ def read_table(
         and :mod:`hystcomp.io._text` for the text layouts understood).
     keys : sequence of str
         The columns needed besides time, among ``"v"`` and ``"x"``.
-    columns : dict, optional
+    columns : dict or str, optional
         Which column holds which key: 1-based numbers (text files, or the columns of the one
-        matrix of an NPZ/MAT file) or names. By default each key is the column of the same
-        name, in any case (``T``, ``V``, ``X`` do).
+        matrix of an NPZ/MAT file) or names, as a dict (``{"v": 1, "x": 5}``) or as the
+        command line's ``--columns`` text (``"v=1,x=5"``). By default each key is the
+        column of the same name, in any case (``T``, ``V``, ``X`` do).
     sample_rate : float, optional
         Samples per second (Hz). Needed when the file has no time column ``t``; if both are
         given they must agree within 1 %.
@@ -399,7 +416,14 @@ def read_table(
     DataFileError
         Naming the file, the column, the problem and the fix.
     """
-    path = as_path(path, "path", "read_table")
+    return _read_table(
+        path, keys, columns, sample_rate, min_samples, x_unit, progress, optional, "read_table"
+    )
+
+
+def _read_table(path, keys, columns, sample_rate, min_samples, x_unit, progress, optional, owner):
+    """:func:`read_table`, its messages naming ``owner`` (the public function called)."""
+    path = as_path(path, "path", owner)
     keys = tuple(keys) if not isinstance(keys, str) else (keys,)
     optional = tuple(optional) if not isinstance(optional, str) else (optional,)
     both = keys + optional
@@ -408,13 +432,13 @@ def read_table(
             f"The 'keys' and 'optional' parameters of read_table must name 'v' and/or 'x' "
             f"once each, 'keys' at least one. Got keys={keys!r}, optional={optional!r}."
         )
-    min_samples = check_int(min_samples, "min_samples", "read_table", minimum=1)
-    columns = _check_columns(columns)
+    min_samples = check_int(min_samples, "min_samples", owner, minimum=1)
+    columns = _check_columns(columns, owner)
     if sample_rate is not None:
-        sample_rate = check_real(sample_rate, "sample_rate", "read_table", positive=True)
+        sample_rate = check_real(sample_rate, "sample_rate", owner, positive=True)
     if x_unit is not None and x_unit not in X_UNITS:
         raise InvalidParameterError(
-            f"The 'x_unit' parameter of read_table must be one of {', '.join(X_UNITS)}. "
+            f"The 'x_unit' parameter of {owner} must be one of {', '.join(X_UNITS)}. "
             f"Got {x_unit!r} instead."
         )
     try:
@@ -439,6 +463,8 @@ def read_table(
             if factor != 1.0:
                 arr = _as_column(arr * factor, path, key, f"{label} (in {MEANINGS[key]})")
             out[key] = arr
+    if len(raw.arrays) > len(out):  # keep the columns read only, not the whole table
+        out = {key: np.array(arr) for key, arr in out.items()}
     raw = None  # the other columns are no longer needed
     lengths = {key: arr.size for key, arr in out.items()}
     if len(set(lengths.values())) > 1:
@@ -533,18 +559,22 @@ def _time(path: Path, t, n: int, sample_rate):
             )
         return t
     with np.errstate(over="ignore", invalid="ignore"):
-        steps = np.diff(t)
         span = t[-1] - t[0]
-    bad = np.flatnonzero(~(steps > 0))
-    if bad.size:
-        k = int(bad[0]) + 1
+        rising = t[1:] > t[:-1]  # (one byte a sample, not a copy of the steps; NaN fails)
+    if not rising.all():
+        k = int(np.flatnonzero(~rising)[0]) + 1
         raise DataFileError(
             f"The time column 't' of {str(path)!r} is not strictly increasing: data row "
             f"{k + 1} has t = {float(t[k])!r} s after t = {float(t[k - 1])!r} s. Sort the "
             "rows and remove duplicates, or drop the time column and give the sample rate "
             "(--fs)."
         )
-    rate = rate_of(t)
+    # the rate for these checks: the median step, of at most 100 000 steps spread over the
+    # record (the same to the checks' 1 % on a long record; Record.sample_rate is exact)
+    stride = max(1, (t.size - 1) // 100_000)
+    with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
+        sample = t[1::stride] - t[:-1:stride]
+        rate = float(1.0 / np.median(sample)) if sample.size else np.inf
     if not (np.isfinite(span) and 0.0 < rate < np.inf):
         raise DataFileError(
             f"The time column 't' of {str(path)!r} spans {float(t[0])!r} to {float(t[-1])!r} s, "
@@ -562,28 +592,24 @@ def _time(path: Path, t, n: int, sample_rate):
 def read_record(path, *, columns=None, sample_rate=None, x_unit=None, progress=None) -> Record:
     """Read an identification record ``(t, v, x)`` and check that its input varies.
 
-    Parameters are those of :func:`read_table`.
+    Parameters are those of :func:`read_table`; ``columns`` may be the command line's
+    text (``"t=2,v=4,x=3"``).
 
     Returns
     -------
     Record
     """
-    table = read_table(
-        path,
-        ("v", "x"),
-        columns=columns,
-        sample_rate=sample_rate,
-        x_unit=x_unit,
-        progress=progress,
+    table = _read_table(
+        path, ("v", "x"), columns, sample_rate, 2, x_unit, progress, (), "read_record"
     )
     v = table["v"]
-    if np.ptp(v) <= 0:
+    if v.max() <= v.min():
         raise DataFileError(
             f"The voltage column 'v' of {str(path)!r} is constant ({float(v[0])!r} V): an "
             "identification record needs an input that sweeps the actuator's range "
             "(see 'hystcomp excite'). Check that the right column is named."
         )
-    return Record(table["t"], v, table["x"], source=str(path))
+    return Record._checked(table["t"], v, table["x"], str(path))
 
 
 def _columns(table, owner: str) -> dict[str, np.ndarray]:

@@ -20,6 +20,7 @@ from hystcomp.identify.pi import INITIAL_MEMORIES
 from hystcomp.models.base import DEFAULT_VOLTAGE_RANGE, fit_voltage_range
 from hystcomp.models.compensator import Compensator
 from hystcomp.models.dynamic_compensator import DynamicCompensator
+from hystcomp.models.estimator import fit_signals
 from hystcomp.models.inversion import check_invertible, invert_superposition
 from hystcomp.models.pi import PrandtlIshlinskii, thinned_record
 
@@ -138,6 +139,7 @@ class ModifiedPrandtlIshlinskii(PrandtlIshlinskii):
         self.constraints = constraints
         self.initial_memory = initial_memory
 
+    @fit_signals
     def fit(self, v, x) -> Self:
         """Identify the model from a measured record by eq. (19) (Section IV-A).
 

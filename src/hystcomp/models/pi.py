@@ -37,6 +37,7 @@ from hystcomp.models.base import (
 from hystcomp.models.compensator import Compensator
 from hystcomp.models.dynamic_compensator import DynamicCompensator
 from hystcomp.models.dynamics import with_dynamics
+from hystcomp.models.estimator import fit_signals
 from hystcomp.models.inversion import (
     check_invertible,
     inverse_initial_state,
@@ -134,6 +135,7 @@ class PrandtlIshlinskii(HysteresisModel):
         self.margin = margin
         self.constraints = constraints
 
+    @fit_signals
     def fit(self, v, x) -> Self:
         """Identify the model from a measured record (Section IV-A, eqs. 12, 16, 18).
 

@@ -34,6 +34,7 @@ from hystcomp.models.base import (
 from hystcomp.models.compensator import Compensator
 from hystcomp.models.dynamic_compensator import DynamicCompensator
 from hystcomp.models.dynamics import with_dynamics
+from hystcomp.models.estimator import fit_signals
 from hystcomp.models.inversion import check_rising_everett
 from hystcomp.models.system import Stepper
 
@@ -269,6 +270,7 @@ class Preisach(HysteresisModel):
                 )
         return model
 
+    @fit_signals
     def fit(self, v, x) -> Preisach:
         """Identify the model from a record (Section III-A); see
         :func:`~hystcomp.identify.preisach.identify_preisach`.

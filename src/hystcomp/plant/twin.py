@@ -158,19 +158,22 @@ class TwinStepper(Stepper):
     def _bind(self) -> None:
         super()._bind()
         self._kernel = step_function(self.kernels.step)
-        del self.step  # the base class binds a step without the sensor; use the method below
+        # the base class binds a step and a step_block without the sensor; use the methods below
+        del self.step
+        self.__dict__.pop("step_block", None)
 
     def step(self, v: float) -> float:
         """Apply one command sample (V) and return the measured displacement (µm)."""
         v = check_real(v, "v", "TwinStepper.step")
         return self._kernel(self._p, v) + self._offset + self._sigma * self._rng.normal()
 
-    def step_block(self, v) -> np.ndarray:
-        """Apply a block of command samples and return the measured displacements."""
+    def step_block(self, v, out=None) -> np.ndarray:
+        """Apply a block of command samples and return the measured displacements (into
+        ``out`` if given, as :meth:`Stepper.step_block <hystcomp.models.system.Stepper.step_block>`)."""
         u = as_signal(v, "v")
-        return (
-            super().step_block(u) + self._offset + self._sigma * self._rng.standard_normal(u.size)
-        )
+        x = super().step_block(u, out)
+        x += self._offset + self._sigma * self._rng.standard_normal(u.size)
+        return x
 
     def copy(self) -> TwinStepper:
         """An independent stepper in the same state, with a noise generator spawned from this
