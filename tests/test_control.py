@@ -206,7 +206,7 @@ def test_systems_and_states_are_named_after_what_they_are():
     dyn = hystcomp.to_control(_dynamics(), DT)
     assert dyn.name == "dynamics"
     assert dyn.state_labels[:2] == ["creep[0]", "creep[1]"]
-    dcomp = hystcomp.to_control(model.inverse(dynamics=_dynamics()), DT)
+    dcomp = hystcomp.to_control(HammersteinModel(model, _dynamics()).inverse(), DT)
     assert dcomp.name == "inverse_dynamics_mpi"
     # a compensator and its model interconnect without a renaming (and so without a warning)
     series = control.interconnect([csys, sys], inplist=["x_ref"], outlist=["x"])

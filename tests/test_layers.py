@@ -29,7 +29,6 @@ LAYERS = {
     "hystcomp.identify": 2,  # the array-level fits the models delegate to
     "hystcomp.models": 3,
     "hystcomp.identify.workflow": 4,  # builds models from a record
-    "hystcomp.workflows": 4,  # the application layer: what a command runs
     "hystcomp.io": 4,  # model files name every model class
     "hystcomp.plant": 4,
     "hystcomp.presets": 4,
