@@ -164,6 +164,47 @@ def run() -> list[dict]:
     return pair_rows(panel_table())
 
 
+def estimate_table(stages=DYNAMICS_STAGES, *, seed: int = 0) -> list[dict]:
+    """What ``hystcomp identify --dynamics-record`` estimates against what it measures:
+    ``[{stage, model, frequency, which ("alone" or "pair"), estimate, measured}]`` (µm rms)
+    for the triangles of the panel's references (:func:`hystcomp.workflows.pair.
+    tracking_estimates` on the dynamics record's held-out triangles)."""
+    import numpy as np
+
+    from hystcomp.io.records import Record
+    from hystcomp.workflows.pair import identify_pair_record
+
+    rows = []
+    for name in stages:
+        st = stage(name, seed=seed)
+        refs = references(st)
+        recs = records(st)
+        fs = st.sample_rate
+        as_record = {
+            k: Record(np.arange(v.size) / fs, v, x, source=k) for k, (v, x) in recs.items()
+        }
+        for label, cls in ESTIMATORS.items():
+            found = identify_pair_record(as_record["pi"], as_record["dynamics"], cls())
+            alone = found.hysteresis.model.inverse(sample_rate=fs)
+            measured = {
+                "alone": tracking(st, alone, refs),
+                "pair": tracking(st, found.model.inverse(), refs),
+            }
+            for f, est in found.estimates.items():
+                for which in ("alone", "pair"):
+                    rows.append(
+                        {
+                            "stage": name,
+                            "model": label,
+                            "frequency": f,
+                            "which": which,
+                            "estimate": est[f"{which}_um"],
+                            "measured": measured[which][f"{f:g} Hz"],
+                        }
+                    )
+    return rows
+
+
 def format_bound(table, bound) -> str:
     """The pair's errors beside those of the bound (the true linear part), µm."""
     head = f"{'stage':<12} {'model':<9}" + "".join(f"{r:>16}" for r in REFERENCES)
@@ -187,5 +228,27 @@ if __name__ == "__main__":
     for row in pair_rows(table):
         flag = "" if row["ok"] else "   MISSED"
         print(f"{row['name']}: {row['value']:.3f} (target {row['target']}){flag}")
+    if "--estimates" in sys.argv:
+        import numpy as np
+
+        found = estimate_table(chosen)
+        for r in found:
+            print(
+                f"{r['stage']:<12} {r['model']:<9} {r['frequency']:>5g} Hz {r['which']:<6}"
+                f" estimate {r['estimate']:.3f} measured {r['measured']:.3f}"
+            )
+        ratio = np.array([r["estimate"] / r["measured"] for r in found])
+        print(
+            f"estimate / measured: median {np.median(ratio):.2f}, {ratio.min():.2f} .. "
+            f"{ratio.max():.2f}, within 1.5x in {np.mean((ratio <= 1.5) & (ratio >= 1 / 1.5)):.0%}"
+            f" of {ratio.size}; the better of alone and pair picked right in "
+            + str(
+                sum(
+                    (a["estimate"] < b["estimate"]) == (a["measured"] < b["measured"])
+                    for a, b in zip(found[::2], found[1::2], strict=True)
+                )
+            )
+            + f" of {len(found) // 2}"
+        )
     if "--bound" in sys.argv:
         print(format_bound(table, panel_table(chosen, identify_true)))
