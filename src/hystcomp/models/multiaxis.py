@@ -31,7 +31,7 @@ from hystcomp.errors import (
     InvalidTypeError,
 )
 from hystcomp.identify.compensation import tracking_estimate
-from hystcomp.identify.coupling import fit_coupling
+from hystcomp.identify.coupling import fit_coupling, refine_coupling
 from hystcomp.identify.scoring import transient_end
 from hystcomp.models.base import HysteresisModel
 from hystcomp.models.estimator import Estimator
@@ -265,7 +265,9 @@ class MultiAxisModel(Estimator):
 
         ``M`` first (:func:`~hystcomp.identify.coupling.fit_coupling`: each sensor's reading
         on its own input's plays and the other axes' readings), then each ``H_i`` on the
-        decoupled displacements ``M^-1 x`` (:func:`fit_axis`), in parallel with ``n_jobs``.
+        decoupled displacements ``M^-1 x`` (:func:`fit_axis`), in parallel with ``n_jobs``,
+        then ``M`` again with the axes' models among the regressors
+        (:func:`~hystcomp.identify.coupling.refine_coupling`).
 
         Parameters
         ----------
@@ -314,6 +316,9 @@ class MultiAxisModel(Estimator):
         else:
             matrix, shared, H = np.eye(n_axes), np.zeros((n_axes, n_axes)), X
         axes = fit_axes(self.family, V, H, ranges, n_jobs=self.n_jobs)
+        if self.coupling:  # M again, with each axis's model among its regressors
+            own = np.column_stack([axis.simulate(V[:, i]) for i, axis in enumerate(axes)])
+            matrix = refine_coupling(V, X, own, matrix, start=start)
         fitted = type(self).from_parameters(axes=axes, coupling=matrix)
         off = np.abs(matrix - np.eye(n_axes))
         predicted = fitted.simulate(V)
