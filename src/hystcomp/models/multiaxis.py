@@ -63,13 +63,16 @@ AUTO_FAMILIES = ("preisach", "mpi", "pi")
 MAX_AXES = 64
 
 
-def as_axes(value, name: str, owner: str, *, n_axes: int | None = None, finite=True):
+def as_axes(
+    value, name: str, owner: str, *, n_axes: int | None = None, finite=True, max_columns=MAX_AXES
+):
     """``value`` as a C-contiguous float64 array of shape (n, N), or raise.
 
-    A 1-D array is one sample of N axes when ``n_axes`` is given and equals its length.
+    A 1-D array is one sample of N axes when ``n_axes`` is given and equals its length. A
+    float64 C-contiguous array is returned as it is (a view): callers do not write into it.
     """
     try:
-        arr = np.array(value, dtype=np.float64)
+        arr = np.ascontiguousarray(value, dtype=np.float64)  # no copy of a float64 array
     except (TypeError, ValueError, OverflowError):
         raise InvalidTypeError(
             f"{name!r} of {owner} must be an array of real numbers of shape (samples, axes). "
@@ -77,10 +80,10 @@ def as_axes(value, name: str, owner: str, *, n_axes: int | None = None, finite=T
         ) from None
     if arr.ndim == 1 and n_axes is not None and arr.size == n_axes:
         arr = arr.reshape(1, -1)
-    if arr.ndim != 2 or arr.shape[0] < 1 or not 1 <= arr.shape[1] <= MAX_AXES:
+    if arr.ndim != 2 or arr.shape[0] < 1 or not 1 <= arr.shape[1] <= max_columns:
         raise InvalidSignalError(
             f"{name!r} of {owner} must have shape (samples, axes), one column per axis "
-            f"(1 to {MAX_AXES}). Got shape {arr.shape}; stack the axes as columns, "
+            f"(1 to {max_columns}). Got shape {arr.shape}; stack the axes as columns, "
             "np.column_stack([x1, x2])."
         )
     if n_axes is not None and arr.shape[1] != n_axes:
@@ -88,15 +91,15 @@ def as_axes(value, name: str, owner: str, *, n_axes: int | None = None, finite=T
             f"{name!r} of {owner} has {arr.shape[1]} columns, but the model has {n_axes} axes: "
             "give one column per axis, in the model's order."
         )
-    if finite:
+    # two reductions, no temporary array: NaN propagates through min and max
+    if finite and not (-MAX_MAGNITUDE <= arr.min() and arr.max() <= MAX_MAGNITUDE):
         bad = np.argwhere(~(np.abs(arr) <= MAX_MAGNITUDE))
-        if bad.size:
-            k, i = (int(b) for b in bad[0])
-            raise InvalidSignalError(
-                f"{name!r} of {owner} has the value {arr[k, i]!r} at sample {k}, axis {i + 1}: "
-                f"samples must be finite and at most {MAX_MAGNITUDE:g} in size. Remove or "
-                "interpolate it."
-            )
+        k, i = (int(b) for b in bad[0])
+        raise InvalidSignalError(
+            f"{name!r} of {owner} has the value {arr[k, i]!r} at sample {k}, axis {i + 1}: "
+            f"samples must be finite and at most {MAX_MAGNITUDE:g} in size. Remove or "
+            "interpolate it."
+        )
     return np.ascontiguousarray(arr)
 
 

@@ -159,7 +159,7 @@ class Scanner:
     def __post_init__(self):
         axes = tuple(self.axes)
         object.__setattr__(self, "axes", axes)
-        m = as_axes(self.coupling, "coupling", "Scanner")
+        m = as_axes(self.coupling, "coupling", "Scanner").copy()
         if m.shape != (len(axes), len(axes)) or not np.allclose(np.diag(m), 1.0):
             raise InvalidParameterError(
                 f"The 'coupling' parameter of Scanner must be a {len(axes)} x {len(axes)} "
