@@ -30,6 +30,7 @@ from hystcomp.io.models import load_model
 from hystcomp.io.records import read_table, write_table
 from hystcomp.models.dynamics import APART
 from hystcomp.models.hammerstein import HammersteinModel
+from hystcomp.models.multiaxis import MultiAxisModel
 from hystcomp.workflows.pair import predicted_worse
 
 
@@ -127,6 +128,25 @@ def compensate(
     inputs = (model_file, reference_file) + ((dynamics_file,) if dynamics_file else ())
     check_data_output(output, inputs=inputs, what="voltage file")
     model = load_model(model_file)
+    if isinstance(model, MultiAxisModel):  # N coupled axes: t, x1..xN -> t, v1..vN, x1_ref..
+        from hystcomp.cli._multiaxis import compensate_multiaxis, refuse
+
+        refuse("--dynamics", dynamics_file, "a multi-axis model")
+        compensate_multiaxis(
+            model,
+            model_file,
+            reference_file,
+            output,
+            columns=columns,
+            sample_rate=sample_rate,
+            x_unit=x_unit,
+            quiet=quiet,
+            slew_rate=slew_rate,
+            narrow_range=narrow_range,
+            method=method,
+            strict=strict,
+        )
+        return
     refuse_dynamics_as_model(model, model_file)
     pair = isinstance(model, HammersteinModel)
     if pair and dynamics_file is not None:

@@ -41,6 +41,20 @@ def simulate(model_file, input_file, output, columns, sample_rate, x_unit, quiet
     """
     check_data_output(output, inputs=(model_file, input_file), what="result file")
     model = load_model(model_file)
+    if getattr(model, "kind", None) == "multiaxis":  # N coupled axes: t, v1..vN -> x1..xN
+        from hystcomp.cli._multiaxis import simulate_multiaxis
+
+        simulate_multiaxis(
+            model,
+            model_file,
+            input_file,
+            output,
+            columns=columns,
+            sample_rate=sample_rate,
+            x_unit=x_unit,
+            quiet=quiet,
+        )
+        return
     if getattr(model, "kind", None) == "dynamics":
         raise ModelFileError(
             f"{str(model_file)!r} holds linear dynamics, not a hysteresis model; simulate "
