@@ -89,6 +89,10 @@ COMMANDS = {
         "hystcomp.cli.identify",
         "Identify a hysteresis model from DATA (columns t, v, x) and write it as JSON.",
     ),
+    "raster": (
+        "hystcomp.cli.raster",
+        "An AFM raster on the simulated scanner: uncompensated, per-axis, coupled.",
+    ),
     "simulate": (
         "hystcomp.cli.simulate",
         "Run the model in MODEL.json on the voltage in INPUT (columns t, v).",
