@@ -61,7 +61,7 @@ def _stage(rng, n_axes):
 def _build(compensator, folder, prefix="stage"):
     export_multiaxis_c(compensator, folder, prefix=prefix)
     (folder / "driver.c").write_text(DRIVER.replace("{p}", prefix))
-    sources = sorted(p.name for p in folder.glob(f"{prefix}*.c")) + ["driver.c"]
+    sources = [*sorted(p.name for p in folder.glob(f"{prefix}*.c")), "driver.c"]
     lib = folder / "libstage.so"
     cmd = [CC, *STRICT, "-shared", "-fPIC", "-o", str(lib), *sources]
     build = subprocess.run(cmd, cwd=folder, capture_output=True, text=True, check=False)
@@ -104,7 +104,8 @@ def test_one_state_struct_and_the_step_signature():
     files = generate_multiaxis_c(_stage(rng, 3).inverse(), prefix="xyz")
     header = files["xyz.h"]
     assert "void xyz_step(xyz_state *s, const double *x_ref, double *v);" in header
-    assert "xyz_axis1_state axis1;" in header and "xyz_axis3_state axis3;" in header
+    assert "xyz_axis1_state axis1;" in header
+    assert "xyz_axis3_state axis3;" in header
     assert header.count("} xyz_state;") == 1
     assert set(files) == {"xyz.h", "xyz.c"} | {f"xyz_axis{i}.{e}" for i in (1, 2, 3) for e in "hc"}
 

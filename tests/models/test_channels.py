@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-
 import joblib
 import numpy as np
 import pytest
@@ -61,7 +60,8 @@ def test_compensators_agree_with_each_channels_own_chain(slew_rate, rng):
     assert np.array_equal(stepper.clamped_count, [s.clamped_count for s in own])
     assert np.array_equal(stepper.nonfinite_count, [s.nonfinite_count for s in own])
     assert stepper.clamped_count.sum() > 0
-    assert out.min() >= 0.0 and out.max() <= 120.0
+    assert out.min() >= 0.0
+    assert out.max() <= 120.0
 
 
 def test_models_agree_with_each_channels_own_run(rng):

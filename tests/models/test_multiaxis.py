@@ -54,7 +54,7 @@ def record():
 
 
 def test_the_coupling_of_a_known_stage_is_recovered(record):
-    stage, V, X = record
+    _stage, V, X = record
     found = fit_coupling(V, X)
     assert np.allclose(found.matrix, M_TRUE, atol=2e-3)
     assert np.allclose(found.decoupling @ found.matrix, np.eye(3), atol=1e-12)
@@ -120,9 +120,11 @@ def test_each_axis_is_clamped_to_its_own_range_and_counted():
     x_hi = stage.simulate([[120.0, 0.0]])[0, 0]
     X = np.column_stack([np.linspace(0, 1.5 * x_hi, 500), np.linspace(1.0, 2.0, 500)])
     run = comp.run(X)
-    assert run.v[:, 0].max() == 120.0 and run.v[:, 1].min() >= 10.0
+    assert run.v[:, 0].max() == 120.0
+    assert run.v[:, 1].min() >= 10.0
     assert run.v[:, 1].max() <= 90.0
-    assert run.clamped[0] > 100 and run.clamped[1] > 0  # axis 2 asks below 10 V
+    assert run.clamped[0] > 100
+    assert run.clamped[1] > 0
 
 
 def test_a_non_finite_reference_holds_the_axes_it_reaches():
@@ -154,7 +156,8 @@ def test_the_model_file_holds_the_axes_and_m():
         coupling=M_TRUE,
     )
     doc = json.loads(model_text(stage))
-    assert doc["kind"] == "multiaxis" and len(doc["axes"]) == 3
+    assert doc["kind"] == "multiaxis"
+    assert len(doc["axes"]) == 3
     assert [a["kind"] for a in doc["axes"]] == ["pi", "mpi", "preisach"]
     again = model_from_dict(doc)
     V = np.column_stack([np.linspace(0, 100, 50)] * 3)
@@ -177,7 +180,8 @@ def test_to_control_has_n_inputs_and_outputs():
     stage = _known_stage(rng, 2)
     V = np.column_stack([random_walk(rng, 60, 0.0, 120.0, 5.0) for _ in range(2)])
     sys = hystcomp.to_control(stage.inverse(), 5e-5)
-    assert sys.ninputs == 2 and sys.noutputs == 2
+    assert sys.ninputs == 2
+    assert sys.noutputs == 2
     X = stage.simulate(V)
     res = control.input_output_response(sys, 5e-5 * np.arange(60), X.T, X0=sys.x0)
     assert np.allclose(res.outputs.T, stage.inverse().simulate(X), rtol=0, atol=1e-12)

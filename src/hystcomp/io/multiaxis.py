@@ -147,12 +147,12 @@ def read_axes(
     where = f"Data file {str(path)!r}"
     found: dict[str, dict[int, int]] = {key: {} for key in keys}
     for index, name in enumerate(names or []):
-        key = axis_key(name)
-        if key is not None and key[0] in found:
-            found[key[0]][key[1]] = index
+        named = axis_key(name)
+        if named is not None and named[0] in found:
+            found[named[0]][named[1]] = index
     for spec_key, spec in columns.items():
-        key = axis_key(spec_key)
-        if key is None or key[0] not in found:
+        axis = axis_key(spec_key)
+        if axis is None or axis[0] not in found:
             continue
         if isinstance(spec, int):
             if not positional or spec > len(arrays):
@@ -160,15 +160,15 @@ def read_axes(
                     f"{where} has no column {spec} for {spec_key!r}: it has {len(arrays)} "
                     "numbered columns."
                 )
-            found[key[0]][key[1]] = spec - 1
+            found[axis[0]][axis[1]] = spec - 1
         else:
-            index = _find(path, names or [], spec)
-            if index is None:
+            picked = _find(path, names or [], spec)
+            if picked is None:
                 raise DataFileError(
                     f"{where} has no column {spec!r} for {spec_key!r}; its columns are "
                     f"{', '.join(map(str, names or []))}."
                 )
-            found[key[0]][key[1]] = index
+            found[axis[0]][axis[1]] = picked
     counts = {key: len(idx) for key, idx in found.items()}
     n_axes = max(counts.values(), default=0)
     if n_axes == 0:
@@ -192,8 +192,8 @@ def read_axes(
     raw_units = _Raw(names, [], positional, units)
     for key, idx in found.items():
         cols = []
-        for axis in range(1, n_axes + 1):
-            index = idx[axis]
+        for number in range(1, n_axes + 1):
+            index = idx[number]
             label = f"column {names[index]!r}" if names else f"column {index + 1}"
             arr = _as_column(arrays[index], path, key, label)
             factor = _units(path, raw_units, key, index, x_unit)
@@ -211,10 +211,10 @@ def read_axes(
     t = None
     if isinstance(t_index, int):
         t = _as_column(arrays[t_index - 1], path, "t", f"column {t_index}")
-    else:
-        index = _find(path, names or [], t_index or "t") if names else None
-        if index is not None:
-            t = _as_column(arrays[index], path, "t", f"column {names[index]!r}")
+    elif names:
+        t_at = _find(path, names, t_index or "t")
+        if t_at is not None:
+            t = _as_column(arrays[t_at], path, "t", f"column {names[t_at]!r}")
     out["t"] = _time(path, t, n, sample_rate)
     for arr in out.values():
         arr.setflags(write=False)

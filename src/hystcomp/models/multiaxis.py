@@ -146,8 +146,9 @@ def fit_axis(family, v: np.ndarray, h: np.ndarray, voltage_range=None) -> Hyster
         if best is None:
             raise IdentificationError("No model family fits this axis: " + "; ".join(reasons))
         return best
+    estimator: Any
     if isinstance(family, str):
-        estimator = AXIS_KINDS[family](voltage_range=voltage_range)
+        estimator = AXIS_KINDS[family](voltage_range=voltage_range)  # type: ignore[call-arg]
     else:
         params = family.get_params()
         if voltage_range is not None and params.get("voltage_range") is None:

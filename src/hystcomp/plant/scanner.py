@@ -34,6 +34,7 @@ scanner's cross-talk does), and white sensor noise. The scanner starts at rest a
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -51,7 +52,7 @@ __all__ = ["KINDS", "Scanner", "ScannerAxis", "raster_scanner"]
 #: The hysteresis kinds of an axis.
 KINDS = ("bouc-wen", "preisach", "kp")
 #: Bouc-Wen shape of the scanner's ``bouc-wen`` axes (the twin's model, other parameters).
-_BOUC_WEN = {
+_BOUC_WEN: dict[str, Any] = {
     "anhysteretic": (20.0, 28.0, -16.0),
     "hysteresis_amplitude": 2.6,
     "hysteresis_onset": 0.15,
