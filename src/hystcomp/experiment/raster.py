@@ -28,6 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
+from hystcomp import paper
 from hystcomp.experiment.baseline import linear_gain
 from hystcomp.identify.multiaxis_excitation import multiaxis_sequence
 from hystcomp.models.multiaxis import MultiAxisModel
@@ -44,7 +45,7 @@ PITCH_UM = 4.0
 
 
 def raster_reference(
-    strokes, *, lines: int = 64, line_rate: float = 10.0, sample_rate: float = 20_000.0
+    strokes, *, lines: int = 64, line_rate: float = 10.0, sample_rate: float = paper.SAMPLE_RATE
 ):
     """The raster reference: two frames with the slow axis's retrace between them.
 

@@ -196,7 +196,7 @@ class MultiAxisModel(Estimator):
     >>> model = MultiAxisModel.from_parameters(axes=[axis, axis], coupling=[[1, 0.05], [0, 1]])
     >>> V = np.array([[0.0, 0.0], [20.0, 0.0], [20.0, 20.0]])
     >>> model.simulate(V).round(6).tolist()
-    [[0.0, 0.0], [5.25, 0.0], [5.25, 5.0]]
+    [[0.0, 0.0], [5.0, 0.0], [5.25, 5.0]]
     >>> comp = model.inverse()
     >>> comp.simulate(model.simulate(V)).round(9).tolist()
     [[0.0, 0.0], [20.0, 0.0], [20.0, 20.0]]

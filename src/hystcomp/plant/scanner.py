@@ -108,7 +108,7 @@ def _raw_hysteresis(kind: str, u: np.ndarray) -> np.ndarray:
     out = np.empty_like(u)
     if kind == "bouc-wen":
         twin = Twin(TwinParameters(sensor_noise=0.0, **_BOUC_WEN))
-        return twin.hysteresis(u * 120.0)
+        return twin.hysteresis(u * paper.VOLTAGE_RANGE[1])
     relays = kind == "preisach"
     edges = np.linspace(0.0, 1.0, (_RELAY_GRID if relays else _KP_GRID) + 1)
     mid = 0.5 * (edges[:-1] + edges[1:])
