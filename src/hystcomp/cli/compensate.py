@@ -119,6 +119,9 @@ def compensate(
 ):
     """Voltage that makes the actuator of MODEL.json follow REFERENCE (columns t, x).
 
+    With an N-axis model: REFERENCE has t, x1..xN and the output t, v1..vN, x1_ref..xN_ref,
+    each axis clamped to its own range and warned about on its own.
+
     Uses the model's inverse (eqs. 23-26 for PI/MPI; for Preisach eq. 10 or, with
     --method exact, the exact inverse), clamped to the model's voltage range (or a narrower
     --voltage-range). Writes t (s), v (V) and x_ref (µm). Samples whose reference lies out

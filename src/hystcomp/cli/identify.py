@@ -247,6 +247,9 @@ def identify(
 ):
     """Identify a hysteresis model from DATA (columns t, v, x) and write it as JSON.
 
+    A DATA with columns v1..vN, x1..xN (N coupled axes) gives an N-axis model: each axis's
+    model (--model and its options apply to every axis) and the coupling between them.
+
     PI and MPI: constrained least squares (eqs. 16-19) with invertible weights; the
     start-up transient, the input range (bipolar too) and a displacement offset are handled.
     Preisach: least squares over any record with a tabulated Everett function by default;

@@ -67,14 +67,17 @@ def parse_axis_columns(text: str) -> dict[str, int | str]:
 
 def _header_names(path: Path) -> list[str]:
     """The names a file's columns may have, read cheaply: a text file's first lines, an
-    NPZ file's keys (a MAT file is not peeked at: give --columns)."""
+    NPZ file's keys, a MAT file's variables (parsed as for reading it)."""
     suffix = path.suffix.lower()
     try:
         if suffix == ".npz":
             with zipfile.ZipFile(path) as archive:
                 return [Path(n).stem for n in archive.namelist()]
         if suffix == ".mat":
-            return []
+            try:
+                return [str(name) for name in read_raw(path, None)[0] or []]
+            except DataFileError:
+                return []  # the reader says what is wrong with it
         with path.open("rb") as f:
             head = f.read(PEEK_BYTES).decode("utf-8", errors="replace")
     except (OSError, zipfile.BadZipFile):
