@@ -167,3 +167,21 @@ def test_axes_driven_together_are_refused_with_what_to_record(tmp_path):
     assert "move together" in err
     assert "hystcomp excite multiaxis" in err
     assert not (tmp_path / "m.json").exists()
+
+
+def test_voltage_range_may_only_narrow_every_axis(stage, tmp_path):
+    folder, _, _ = stage
+    n = 200
+    ref = {"t": np.arange(n) / FS, "x1": np.linspace(2, 28, n), "x2": np.full(n, 8.0)}
+    write_table(tmp_path / "ref.csv", ref)
+    args = ["compensate", folder / "m.json", tmp_path / "ref.csv", "-o", tmp_path / "v.csv"]
+    code, _, err = _run(*args, "--voltage-range", 10, 100, "--slew-rate", 2e4)
+    assert code == 0, err
+    v = read_axes(tmp_path / "v.csv", ("v",))["v"]
+    assert v.min() >= 10.0
+    assert v.max() <= 100.0
+    assert np.abs(np.diff(v, axis=0)).max() <= 2e4 / FS + 1e-9  # the slew limit, per axis
+    assert "axis 1" in err  # 28 µm needs more than 100 V: told
+    code, _, err = _run(*args, "--voltage-range", -10, 100)
+    assert code == 2
+    assert "may only narrow" in err

@@ -7,6 +7,8 @@ import json
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import hystcomp
 from hystcomp.errors import IdentificationError, InvalidParameterError, InvalidSignalError
@@ -15,7 +17,7 @@ from hystcomp.identify.multiaxis_excitation import multiaxis_sequence
 from hystcomp.io.models import model_from_dict, model_text
 from hystcomp.models.multiaxis import MultiAxisModel
 from hystcomp.plant import Twin
-from tests.conftest import random_walk
+from tests.conftest import examples, mpi_models, pi_models, random_walk
 
 M_TRUE = np.array([[1.0, 0.05, -0.02], [-0.03, 1.0, 0.04], [0.06, 0.02, 1.0]])
 
@@ -185,3 +187,25 @@ def test_to_control_has_n_inputs_and_outputs():
     X = stage.simulate(V)
     res = control.input_output_response(sys, 5e-5 * np.arange(60), X.T, X0=sys.x0)
     assert np.allclose(res.outputs.T, stage.inverse().simulate(X), rtol=0, atol=1e-12)
+
+
+@settings(max_examples=examples(0.5))
+@given(
+    first=mpi_models(),
+    second=pi_models(),
+    coupling=st.lists(st.floats(-0.08, 0.08), min_size=2, max_size=2),
+)
+def test_property_inverse_after_forward_is_the_identity(first, second, coupling):
+    """Random MPI and PI axes, random couplings up to 8 %: the compensator recovers any
+    voltage inside the ranges from the displacements it produced."""
+    (a, rng), (b, _) = first, second
+    stage = MultiAxisModel.from_parameters(
+        axes=[a, b], coupling=[[1.0, coupling[0]], [coupling[1], 1.0]]
+    )
+    V = np.column_stack(
+        [random_walk(rng, 300, *m.voltage_range_, 0.05 * np.ptp(m.voltage_range_)) for m in (a, b)]
+    )
+    X = stage.simulate(V)
+    back = stage.inverse().simulate(X)
+    span = np.array([np.ptp(m.voltage_range_) for m in (a, b)])
+    assert np.all(np.abs(back - V) <= 1e-6 * span)
