@@ -595,16 +595,14 @@ class MultiAxisStepper:
             mix_rows(self._pre, row, mid)
         else:
             mid[:] = row
-        steps = self._steps
-        out = self._out if self._post is not None else mid
-        h = mid[0]
-        if self._post is not None:
-            for i in range(self._n):
-                out[0, i] = steps[i](float(h[i]))
-            res = np.empty_like(out)
-            mix_rows(self._post, out, res)
-            return res[0]
-        return np.array([steps[i](float(h[i])) for i in range(self._n)])
+        h, own = mid[0], self._out
+        for i, step in enumerate(self._steps):
+            own[0, i] = step(float(h[i]))
+        if self._post is None:
+            return own[0].copy()
+        out = np.empty_like(own)
+        mix_rows(self._post, own, out)
+        return out[0]
 
     def step_block(self, U) -> np.ndarray:
         """Advance over a block of rows (n, N); returns the outputs (n, N)."""
