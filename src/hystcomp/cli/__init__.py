@@ -79,7 +79,7 @@ COMMANDS = {
     ),
     "excite": (
         "hystcomp.cli.excite",
-        "Write the identification input for MODEL: pi, mpi, preisach, rich or dynamics.",
+        "Write the identification input for MODEL: pi, mpi, preisach, rich, dynamics, multiaxis.",
     ),
     "export-c": (
         "hystcomp.cli.export_c",

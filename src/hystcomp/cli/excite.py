@@ -61,7 +61,7 @@ from hystcomp.io.records import format_csv, write_table
 )
 @quiet_option
 def excite(model, output, sample_rate, voltage_range, frequency, axes, quiet):
-    """Write the identification input for MODEL: pi, mpi, preisach, rich or dynamics.
+    """Write the identification input for MODEL: pi, mpi, preisach, rich, dynamics, multiaxis.
 
     pi, mpi: triangles of 30, 60, 90, 120 V at 1 Hz (Section IV-A); preisach: sinusoids of
     5, 10, ..., 120 V at 1 Hz (Section III-A); rich (not in the paper, one record for all
