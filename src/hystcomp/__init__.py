@@ -23,15 +23,18 @@ __version__ = "0.1.0"
 
 #: Public name -> (module, attribute in it; None for the module itself).
 _LAZY = {
+    "ChannelBank": ("hystcomp.models.channels", "ChannelBank"),
     "Compensator": ("hystcomp.models.compensator", "Compensator"),
     "LinearDynamics": ("hystcomp.models.dynamics", "LinearDynamics"),
     "ModifiedPrandtlIshlinskii": ("hystcomp.models.mpi", "ModifiedPrandtlIshlinskii"),
+    "MultiAxisModel": ("hystcomp.models.multiaxis", "MultiAxisModel"),
     "PrandtlIshlinskii": ("hystcomp.models.pi", "PrandtlIshlinskii"),
     "Preisach": ("hystcomp.models.preisach", "Preisach"),
     "Record": ("hystcomp.io.records", "Record"),
     "Stepper": ("hystcomp.models.system", "Stepper"),
     "errors": ("hystcomp.errors", None),
     "evaluate": ("hystcomp.workflows.evaluate", "evaluate"),
+    "fit_channels": ("hystcomp.models.channels", "fit_channels"),
     "load_model": ("hystcomp.io.models", "load_model"),
     "presets": ("hystcomp.presets", None),
     "read_record": ("hystcomp.io.records", "read_record"),
@@ -41,9 +44,11 @@ _LAZY = {
 }
 
 __all__ = [  # written out for static tools; tests/cli/test_cli_lazy.py checks it against _LAZY
+    "ChannelBank",
     "Compensator",
     "LinearDynamics",
     "ModifiedPrandtlIshlinskii",
+    "MultiAxisModel",
     "PrandtlIshlinskii",
     "Preisach",
     "Record",
@@ -51,6 +56,7 @@ __all__ = [  # written out for static tools; tests/cli/test_cli_lazy.py checks i
     "__version__",
     "errors",
     "evaluate",
+    "fit_channels",
     "load_model",
     "presets",
     "read_record",
@@ -64,9 +70,11 @@ if TYPE_CHECKING:  # what static tools see; at run time __getattr__ imports on f
     from hystcomp.control import to_control
     from hystcomp.io.models import load_model, save_model
     from hystcomp.io.records import Record, read_record
+    from hystcomp.models.channels import ChannelBank, fit_channels
     from hystcomp.models.compensator import Compensator
     from hystcomp.models.dynamics import LinearDynamics
     from hystcomp.models.mpi import ModifiedPrandtlIshlinskii
+    from hystcomp.models.multiaxis import MultiAxisModel
     from hystcomp.models.pi import PrandtlIshlinskii
     from hystcomp.models.preisach import Preisach
     from hystcomp.models.scorers import tracking_score

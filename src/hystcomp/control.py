@@ -44,7 +44,8 @@ __all__ = ["DiscreteSystem", "register", "to_control"]
 
 @dataclass(frozen=True)
 class DiscreteSystem:
-    """A single-input, single-output discrete-time system as :func:`to_control` needs it.
+    """A discrete-time system as :func:`to_control` needs it (one input and output, or one
+    per axis).
 
     Attributes
     ----------
@@ -55,7 +56,7 @@ class DiscreteSystem:
         (``u`` is the input vector, of one element, as python-control passes it).
     output : callable
         ``output(s, u) -> y``: the output for input ``u`` in state ``s`` (direct feedthrough
-        allowed).
+        allowed), a float, or an array of one value per output.
     inputs, outputs : tuple of str
         Signal names.
     name : str
@@ -66,7 +67,7 @@ class DiscreteSystem:
 
     state: np.ndarray
     update: Callable[[np.ndarray, np.ndarray], np.ndarray]
-    output: Callable[[np.ndarray, np.ndarray], float]
+    output: Callable[[np.ndarray, np.ndarray], float | np.ndarray]
     inputs: tuple[str, ...]
     outputs: tuple[str, ...]
     name: str = "system"
@@ -163,6 +164,26 @@ def _stepped(
         name=name,
         states=packed_state_names(stepper),
     )
+
+
+def _stepped_axes(stepper, model: bool) -> DiscreteSystem:
+    """A multi-axis model (inputs ``v1..vN``, outputs ``x1..xN``) or compensator (inputs
+    ``x1_ref..xN_ref``, outputs ``v1..vN``): its stepper's state, stepped by the stepper."""
+    n = stepper.n_axes
+    initial = stepper.state
+
+    def update(s, u):
+        stepper.state = s
+        stepper.step(np.ravel(u))
+        return stepper.state
+
+    def output(s, u):
+        stepper.state = s
+        return stepper.step(np.ravel(u))
+
+    names_in = [f"v{i + 1}" for i in range(n)] if model else [f"x{i + 1}_ref" for i in range(n)]
+    names_out = [f"x{i + 1}" for i in range(n)] if model else [f"v{i + 1}" for i in range(n)]
+    return DiscreteSystem(initial, update, output, tuple(names_in), tuple(names_out))
 
 
 def _twin(twin, dt: float) -> DiscreteSystem:
@@ -323,7 +344,14 @@ def _builtin_adapters() -> list[tuple[type, Adapter]]:
     def _compensator(obj, dt) -> DiscreteSystem:
         return _stepped(obj.stepper(), ("x_ref",), ("v",), f"inverse_{obj.kind}")
 
+    def _multiaxis(obj, dt) -> DiscreteSystem:
+        return _stepped_axes(obj.stepper(), obj.kind == "multiaxis" and hasattr(obj, "axes_"))
+
+    from hystcomp.models.multiaxis import MultiAxisCompensator, MultiAxisModel
+
     return [
+        (MultiAxisModel, _multiaxis),
+        (MultiAxisCompensator, _multiaxis),
         (HysteresisModel, _model),
         (Compensator, _compensator),
         (Twin, _twin),
@@ -357,32 +385,40 @@ def describe(obj, dt: float) -> DiscreteSystem:
     )
 
 
+def _names(given, default) -> list[str]:
+    """Signal names: one given as a str, several as a sequence, else the defaults."""
+    if not given:
+        return list(default)
+    return [given] if isinstance(given, str) else list(given)
+
+
 def to_control(obj, dt, *, name=None, inputs=None, outputs=None):
     """A discrete-time ``control.NonlinearIOSystem`` that runs a model or a compensator.
 
     Parameters
     ----------
-    obj : HysteresisModel, Compensator or Twin
+    obj : HysteresisModel, Compensator, MultiAxisModel, MultiAxisCompensator or Twin
         A fitted model (input ``v`` in V, output ``x`` in µm), a compensator (input
-        ``x_ref`` in µm, output ``v`` in V, clamped to its voltage range as always), or the
-        simulated axis (input ``v``, output the sensor's reading ``x``), or an object of a
-        kind added with :func:`register`.
+        ``x_ref`` in µm, output ``v`` in V, clamped to its voltage range as always), a
+        multi-axis model (inputs ``v1..vN``, outputs ``x1..xN``) or its compensator (inputs
+        ``x1_ref..xN_ref``, outputs ``v1..vN``), or the simulated axis (input ``v``, output
+        the sensor's reading ``x``), or an object of a kind added with :func:`register`.
     dt : float
         Sample time in s (``1 / sample_rate``; the twin's is 5e-5). A compensator built with
         a slew-rate limit should be given the ``sample_rate`` it was built for.
     name : str, optional
         System name for ``control.interconnect``; by default what the system is: the
-        model's kind (``"pi"``, ``"mpi"``, ``"preisach"``), ``"inverse_"`` and the kind
-        for a compensator (``"inverse_dynamics_mpi"`` with the inverse of the dynamics),
-        ``"twin"`` or ``"dynamics"``. Two systems of one kind in one interconnection need
-        names of their own (python-control renames and warns).
-    inputs, outputs : str, optional
-        Other signal names than the defaults above.
+        model's kind (``"pi"``, ``"mpi"``, ``"preisach"``, ``"multiaxis"``), ``"inverse_"``
+        and the kind for a compensator (``"inverse_dynamics_mpi"`` with the inverse of the
+        dynamics), ``"twin"`` or ``"dynamics"``. Two systems of one kind in one
+        interconnection need names of their own (python-control renames and warns).
+    inputs, outputs : str or sequence of str, optional
+        Other signal names than the defaults above (one per axis for a multi-axis object).
 
     Returns
     -------
     control.NonlinearIOSystem
-        One input, one output; its state is the object's packed state, starting at the
+        One input and one output per axis; its state is the object's packed state, starting at the
         initial state (``sys.x0``), so ``control.input_output_response(sys, T, U, X0=sys.x0)``
         equals ``obj.simulate(U)``. The states are named after their slots (``play[0]``,
         ``last_output``, ``extremum[2]``, ``creep[0]``, ...).
@@ -416,9 +452,9 @@ def to_control(obj, dt, *, name=None, inputs=None, outputs=None):
     control = _import_control()
     sys = control.NonlinearIOSystem(
         lambda t, s, u, params: system.update(s, u),
-        lambda t, s, u, params: np.array([system.output(s, u)]),
-        inputs=[inputs] if inputs else list(system.inputs),
-        outputs=[outputs] if outputs else list(system.outputs),
+        lambda t, s, u, params: np.atleast_1d(system.output(s, u)),
+        inputs=_names(inputs, system.inputs),
+        outputs=_names(outputs, system.outputs),
         states=system.state_names(),
         dt=dt,
         name=name if name is not None else system.name,

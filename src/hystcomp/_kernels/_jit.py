@@ -96,6 +96,18 @@ def inner_kernel(func):
     )(func)
 
 
+def flat_kernel(func):
+    """Compile ``func`` as a batch kernel without reference counting: cached, :data:`FASTMATH`,
+    the GIL released.
+
+    A slice of an array inside its loops is then a plain view, not an object whose count is
+    changed atomically (two atomic operations per slice: in a loop over operators they
+    cost more than the arithmetic), so a kernel can hand 1-D rows of its 2-D arrays to an
+    inlined helper whose loop vectorises. It must not allocate: work buffers are passed in.
+    """
+    return numba.njit(cache=True, fastmath=FASTMATH, nogil=True, _nrt=False)(func)
+
+
 def step_kernel(func):
     """Compile ``func(p, u) -> float``, one sample through packed system ``p``, as a step kernel.
 

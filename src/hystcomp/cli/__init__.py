@@ -64,7 +64,7 @@ COMMANDS = {
     ),
     "excite": (
         "hystcomp.cli.excite",
-        "Write the identification input for MODEL: pi, mpi, preisach, rich or dynamics.",
+        "Write the identification input for MODEL: pi, mpi, preisach, rich, dynamics, multiaxis.",
     ),
     "export-c": (
         "hystcomp.cli.export_c",
@@ -73,6 +73,10 @@ COMMANDS = {
     "identify": (
         "hystcomp.cli.identify",
         "Identify a hysteresis model from DATA (columns t, v, x) and write it as JSON.",
+    ),
+    "raster": (
+        "hystcomp.cli.raster",
+        "An AFM raster on the simulated scanner: uncompensated, per-axis, coupled.",
     ),
     "simulate": (
         "hystcomp.cli.simulate",

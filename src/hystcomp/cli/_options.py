@@ -123,6 +123,13 @@ def columns(ctx, param, value):
     try:
         return parse_columns(value)
     except InvalidParameterError as exc:
+        if value is not None and any(c.isdigit() for c in value.split("=")[0]):
+            from hystcomp.io.multiaxis import parse_axis_columns  # an N-axis file: v1=2,...
+
+            try:
+                return parse_axis_columns(value)
+            except InvalidParameterError as axis_exc:
+                raise click.BadParameter(str(axis_exc), param=param) from None
         raise click.BadParameter(str(exc), param=param) from None
 
 
@@ -134,7 +141,8 @@ columns_option = click.option(
     help=(
         "Which file columns hold t, v, x: 1-based numbers for text tables or the one matrix "
         "of a MAT/NPZ file (v=1,x=5), or names in any case (v=volts,x=disp). Default: "
-        "columns named t, v, x."
+        "columns named t, v, x. N-axis files: v1=2,v2=3,x1=4,x2=5 (default: columns named "
+        "v1..vN, x1..xN)."
     ),
 )
 fs_option = click.option(

@@ -32,6 +32,7 @@ from hystcomp.io.models import load_model
 from hystcomp.io.records import read_table, write_table
 from hystcomp.models.dynamics import APART
 from hystcomp.models.hammerstein import HammersteinModel
+from hystcomp.models.multiaxis import MultiAxisModel
 from hystcomp.workflows.pair import predicted_worse
 
 
@@ -100,6 +101,9 @@ def compensate(
 ):
     """Voltage that makes the actuator of MODEL.json follow REFERENCE (columns t, x).
 
+    With an N-axis model: REFERENCE has t, x1..xN and the output t, v1..vN, x1_ref..xN_ref,
+    each axis clamped to its own range and warned about on its own.
+
     Uses the model's inverse (eqs. 23-26 for PI/MPI; for Preisach eq. 10 or, with
     --method exact, the exact inverse), clamped to the model's voltage range (or a narrower
     --voltage-range). Writes t (s), v (V) and x_ref (µm). Samples whose reference lies out
@@ -109,6 +113,25 @@ def compensate(
     inputs = (model_file, reference_file) + ((dynamics_file,) if dynamics_file else ())
     check_data_output(output, inputs=inputs, what="voltage file")
     model = load_model(model_file)
+    if isinstance(model, MultiAxisModel):  # N coupled axes: t, x1..xN -> t, v1..vN, x1_ref..
+        from hystcomp.cli._multiaxis import compensate_multiaxis, refuse
+
+        refuse("--dynamics", dynamics_file, "a multi-axis model")
+        compensate_multiaxis(
+            model,
+            model_file,
+            reference_file,
+            output,
+            columns=columns,
+            sample_rate=sample_rate,
+            x_unit=x_unit,
+            quiet=quiet,
+            slew_rate=slew_rate,
+            narrow_range=narrow_range,
+            method=method,
+            strict=strict,
+        )
+        return
     refuse_dynamics_as_model(model, model_file)
     pair = isinstance(model, HammersteinModel)
     if pair and dynamics_file is not None:

@@ -22,7 +22,7 @@ from hystcomp.io.records import format_csv, write_table
 
 
 @main.command("excite")
-@click.argument("model", type=click.Choice(SIGNAL_KINDS))
+@click.argument("model", type=click.Choice((*SIGNAL_KINDS, "multiaxis")))
 @output_option(required=False, what="signal; CSV on standard output if omitted")
 @click.option(
     "--fs",
@@ -53,9 +53,15 @@ from hystcomp.io.records import format_csv, write_table
     callback=positive("Hz"),
     help="Period rate.",
 )
+@click.option(
+    "--axes",
+    type=click.IntRange(1, 16),
+    default=None,
+    help="multiaxis: the number of axes N (columns t, v1..vN).",
+)
 @quiet_option
-def excite(model, output, sample_rate, voltage_range, frequency, quiet):
-    """Write the identification input for MODEL: pi, mpi, preisach, rich or dynamics.
+def excite(model, output, sample_rate, voltage_range, frequency, axes, quiet):
+    """Write the identification input for MODEL: pi, mpi, preisach, rich, dynamics, multiaxis.
 
     pi, mpi: triangles of 30, 60, 90, 120 V at 1 Hz (Section IV-A); preisach: sinusoids of
     5, 10, ..., 120 V at 1 Hz (Section III-A); rich (not in the paper, one record for all
@@ -64,8 +70,19 @@ def excite(model, output, sample_rate, voltage_range, frequency, quiet):
     ones (about 14 s). Each starts and ends at the lower end of the range. dynamics (beyond
     the paper): a step to mid-range held 3 s (creep), then three 1 s periods of a
     multisine of 1 Hz .. 5 kHz around it, of 1/30 of the range peak (+-4 V on 0..120 V;
-    --frequency unused). Columns: t (s), v (V).
+    --frequency unused). Columns: t (s), v (V). multiaxis --axes N (beyond the paper): every
+    axis sweeps its range with turning points of its own while the others move
+    independently, which identifies the coupling between them; columns t, v1..vN.
     """
+    if (model == "multiaxis") != (axes is not None):
+        raise click.UsageError(
+            "--axes N goes with 'excite multiaxis' (and only with it): give both or neither."
+        )
+    if model == "multiaxis":
+        from hystcomp.cli._multiaxis import excite_multiaxis
+
+        excite_multiaxis(axes, output, sample_rate, voltage_range, frequency, quiet)
+        return
     if output is not None:
         check_data_output(output, what="signal file")
     t, v = excitation_signal(

@@ -87,6 +87,12 @@ def export_c_command(
     for suffix in (".h", ".c") if directory.is_dir() else ():  # never overwrite the model
         check_output_path(directory / f"{prefix}{suffix}", inputs=(model_file,))
     model = load_model(model_file)
+    if getattr(model, "kind", None) == "multiaxis":  # one state struct for all axes
+        from hystcomp.cli._multiaxis import export_multiaxis, refuse
+
+        refuse("--dynamics", dynamics_file, "a multi-axis model")
+        export_multiaxis(model, model_file, directory, prefix, slew_rate, sample_rate, method)
+        return
     refuse_dynamics_as_model(model, model_file)
     options = {"slew_rate": slew_rate, "sample_rate": sample_rate, **narrowed(model, narrow_range)}
     pair = isinstance(model, HammersteinModel)

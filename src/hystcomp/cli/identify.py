@@ -210,6 +210,13 @@ def _regularization(ctx, param, value):
     "model: D behind H, H in front of D, alternated. Writes the pair; compensate and "
     "export-c then invert both (beyond the paper).",
 )
+@click.option(
+    "--jobs",
+    "n_jobs",
+    type=int,
+    default=None,
+    help="N-axis records: axes identified in parallel by joblib (-1: every core) [1].",
+)
 @click.option("--plot", default=None, metavar="FILE", help="Fig. 8-style figure (.png/.pdf/.svg).")
 @click.option("-o", "--output", required=True, metavar="MODEL.json", help="Model file to write.")
 def identify(
@@ -233,10 +240,14 @@ def identify(
     allow_extrapolation,
     holdout,
     dynamics_record,
+    n_jobs,
     plot,
     output,
 ):
     """Identify a hysteresis model from DATA (columns t, v, x) and write it as JSON.
+
+    A DATA with columns v1..vN, x1..xN (N coupled axes) gives an N-axis model: each axis's
+    model (--model and its options apply to every axis) and the coupling between them.
 
     PI and MPI: constrained least squares (eqs. 16-19) with invertible weights; the
     start-up transient, the input range (bipolar too) and a displacement offset are handled.
@@ -255,6 +266,37 @@ def identify(
     """
     inputs = (data,) if dynamics_record is None else (data, dynamics_record)
     check_output_path(output, inputs=inputs, what="model file")
+    from hystcomp.io.multiaxis import is_multiaxis
+
+    if is_multiaxis(data, columns):  # t, v1..vN, x1..xN: N coupled axes
+        from hystcomp.cli._multiaxis import identify_multiaxis, refuse
+
+        why = "an N-axis record"
+        refuse("--model dynamics", kind == "dynamics" or None, why)
+        for name, value in (("--holdout", holdout), ("--dynamics-record", dynamics_record)):
+            refuse(name, value, why)
+        refuse("--plot", plot, why)
+        options = {"operators": operators, "deadzones": deadzones, "degree": degree}
+        options.update(fit=fit, everett=everett, grid=grid, regularization=regularization)
+        options.update(constraints=constraints, initial_memory=initial_memory)
+        _check_options(kind, options)
+        identify_multiaxis(
+            data,
+            output,
+            kind=kind,
+            options=options,
+            columns=columns,
+            sample_rate=sample_rate,
+            x_unit=x_unit,
+            quiet=quiet,
+            transient=transient,
+            voltage_range=voltage_range,
+            allow_extrapolation=allow_extrapolation,
+            n_jobs=n_jobs,
+        )
+        return
+    if n_jobs is not None:
+        raise click.UsageError("--jobs applies to N-axis records (columns v1..vN, x1..xN).")
     if plot is not None:  # matplotlib is imported only when a figure is asked for
         from hystcomp.experiment.fig_identification import FORMATS, plot_identification_result
 

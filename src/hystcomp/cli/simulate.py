@@ -35,12 +35,28 @@ from hystcomp.models.hammerstein import HammersteinModel
 def simulate(model_file, input_file, output, columns, sample_rate, x_unit, quiet):
     """Run the model in MODEL.json on the voltage in INPUT (columns t, v).
 
+    With an N-axis model: INPUT has t, v1..vN and the output t, v1..vN, x1..xN.
+
     Writes t (s), v (V) and the modelled displacement x (µm). If INPUT also holds a
     measured displacement x (a record the model was not fitted on, say), prints how far the
     model is from it, beside a straight line fitted to that record: a validation.
     """
     check_data_output(output, inputs=(model_file, input_file), what="result file")
     model = load_model(model_file)
+    if getattr(model, "kind", None) == "multiaxis":  # N coupled axes: t, v1..vN -> x1..xN
+        from hystcomp.cli._multiaxis import simulate_multiaxis
+
+        simulate_multiaxis(
+            model,
+            model_file,
+            input_file,
+            output,
+            columns=columns,
+            sample_rate=sample_rate,
+            x_unit=x_unit,
+            quiet=quiet,
+        )
+        return
     if getattr(model, "kind", None) == "dynamics":
         raise ModelFileError(
             f"{str(model_file)!r} holds linear dynamics, not a hysteresis model; simulate "

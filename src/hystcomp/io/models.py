@@ -27,6 +27,7 @@ from hystcomp.models.base import HysteresisModel
 from hystcomp.models.dynamics import LinearDynamics
 from hystcomp.models.hammerstein import HammersteinModel
 from hystcomp.models.mpi import ModifiedPrandtlIshlinskii
+from hystcomp.models.multiaxis import AXIS_KINDS, MAX_AXES, MultiAxisModel
 from hystcomp.models.pi import PrandtlIshlinskii
 from hystcomp.models.preisach import Preisach
 
@@ -37,7 +38,7 @@ MAX_MODEL_FILE_BYTES = 64 * 2**20
 
 #: What a model file holds: a hysteresis model, the linear dynamics (not a hysteresis
 #: model), or both identified as one pair.
-Model: TypeAlias = HysteresisModel | LinearDynamics | HammersteinModel
+Model: TypeAlias = HysteresisModel | LinearDynamics | HammersteinModel | MultiAxisModel
 
 #: Model classes by the ``kind`` written in model files.
 MODEL_KINDS: dict[str, type[Model]] = {
@@ -46,6 +47,7 @@ MODEL_KINDS: dict[str, type[Model]] = {
     Preisach.kind: Preisach,
     LinearDynamics.kind: LinearDynamics,  # the linear dynamics (creep, resonance)
     HammersteinModel.kind: HammersteinModel,  # a hysteresis model and dynamics, one pair
+    MultiAxisModel.kind: MultiAxisModel,  # N coupled axes: a model per axis and the coupling
 }
 #: The kinds a pair's parts may have.
 PAIR_PARTS = {"hysteresis": ("pi", "mpi", "preisach"), "dynamics": ("dynamics",)}
@@ -149,6 +151,9 @@ def _check_document(doc: Any, source: str) -> type[Model]:
         if "fit_report" in doc and not isinstance(doc["fit_report"], dict):
             raise ModelFileError(f'{source} has a "fit_report" that is not an object.')
         return cls
+    if issubclass(cls, MultiAxisModel):
+        _check_multiaxis(doc, version, source)
+        return cls
     params = doc.get("parameters")
     if not isinstance(params, dict):
         raise ModelFileError(f'{source} has no "parameters" object; the file is corrupt.')
@@ -181,6 +186,40 @@ def _check_document(doc: Any, source: str) -> type[Model]:
                 "the file is corrupt or was edited by hand."
             )
     return cls
+
+
+def _check_multiaxis(doc: dict, version: int, source: str) -> None:
+    """The shape of a multi-axis document: an "axes" list of axis models and a square
+    "coupling" matrix of as many rows."""
+    axes = doc.get("axes")
+    if not isinstance(axes, list) or not 1 <= len(axes) <= MAX_AXES:
+        raise ModelFileError(
+            f'{source} has no "axes" list of 1 to {MAX_AXES} axis models, which a '
+            "'multiaxis' model holds; the file is corrupt or was edited by hand."
+        )
+    for i, inner in enumerate(axes):
+        if not isinstance(inner, dict) or inner.get("kind") not in AXIS_KINDS:
+            raise ModelFileError(
+                f"{source} has an axis {i + 1} that is not a model of kind "
+                f"{' or '.join(AXIS_KINDS)}; the file is corrupt or was edited by hand."
+            )
+        _check_document(
+            {"format": MODEL_FORMAT, "version": version, **inner}, f"{source} (axis {i + 1})"
+        )
+    coupling = doc.get("coupling")
+    _check_value(coupling, '"coupling"', source)
+    if not (
+        isinstance(coupling, list)
+        and len(coupling) == len(axes)
+        and all(isinstance(row, list) and len(row) == len(axes) for row in coupling)
+    ):
+        raise ModelFileError(
+            f'{source} has a "coupling" that is not a {len(axes)} x {len(axes)} matrix (one '
+            "row and column per axis); the file is corrupt or was edited by hand."
+        )
+    for key in ("hyperparameters", "fit_report"):
+        if key in doc and not isinstance(doc[key], dict):
+            raise ModelFileError(f'{source} has a "{key}" that is not an object.')
 
 
 def model_from_dict(doc: Any, source: str = "the model document") -> Model:

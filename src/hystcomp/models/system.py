@@ -346,6 +346,21 @@ class Stepper(Rebound):
         return twin
 
     @property
+    def state(self) -> np.ndarray:
+        """The state part of the packed system (a copy): get it, and set it back later."""
+        return self._p[self._start :].copy()
+
+    @state.setter
+    def state(self, value) -> None:
+        value = np.asarray(value, dtype=np.float64)
+        if value.shape != (self._p.size - self._start,):
+            raise InvalidParameterError(
+                f"The state of this {type(self).__name__} has {self._p.size - self._start} "
+                f"values. Got shape {value.shape}; take it from .state."
+            )
+        self._p[self._start :] = value
+
+    @property
     def nonfinite_count(self) -> int:
         """How many non-finite input samples were held since the last reset."""
         return int(self._p[self._start + self.kernels.nonfinite])

@@ -1,0 +1,224 @@
+"""N-axis data files: records ``t, v1..vN, x1..xN``, inputs ``t, v1..vN``, references
+``t, x1..xN``.
+
+The columns are found by their names, in any case (``V1``, ``x2``), numbered from 1 without
+gaps; ``--columns v1=2,x1=5,v2=3,x2=6`` (1-based numbers or names) maps others. Everything
+else is as for one axis (:mod:`hystcomp.io.records`): the same formats, the same checks of
+every column (finite, bounded, a time column that increases or a sample rate), units rows
+and ``x_unit`` for the displacements. A file is an N-axis file when a column is named
+``v1`` or ``x1`` (or ``--columns`` names one).
+"""
+
+from __future__ import annotations
+
+import re
+import zipfile
+from pathlib import Path
+
+import numpy as np
+
+from hystcomp._validation import as_path, check_real
+from hystcomp.errors import DataFileError, InvalidParameterError
+from hystcomp.io._formats import read_raw
+from hystcomp.io.records import MEANINGS, X_UNITS, _as_column, _find, _Raw, _time, _units
+
+__all__ = ["axis_key", "is_multiaxis", "parse_axis_columns", "read_axes"]
+
+_KEY = re.compile(r"^([vx])([1-9][0-9]*)$", re.IGNORECASE)
+#: Most axes of a file.
+MAX_AXES = 64
+#: Bytes of a text file's start read to find its header.
+PEEK_BYTES = 65_536
+
+
+def axis_key(name) -> tuple[str, int] | None:
+    """``("v", 2)`` for a column named ``v2`` (any case), else None.
+
+    >>> axis_key("X12"), axis_key("x"), axis_key("v0")
+    (('x', 12), None, None)
+    """
+    match = _KEY.match(str(name).strip())
+    if match is None:
+        return None
+    return match.group(1).lower(), int(match.group(2))
+
+
+def parse_axis_columns(text: str) -> dict[str, int | str]:
+    """Parse ``--columns`` of an N-axis file, such as ``t=1,v1=2,v2=3,x1=4,x2=5``.
+
+    Examples
+    --------
+    >>> parse_axis_columns("v1=2, x1=volts")
+    {'v1': 2, 'x1': 'volts'}
+    """
+    mapping: dict[str, int | str] = {}
+    for item in str(text).split(","):
+        key, sep, value = (part.strip() for part in item.partition("="))
+        key = key.lower()
+        if not sep or not value or key in mapping or not (key == "t" or axis_key(key)):
+            raise InvalidParameterError(
+                "The 'columns' option of an N-axis file must look like t=1,v1=2,v2=3,x1=4,x2=5 "
+                "(1-based column numbers or header names), each key once. Got "
+                f"{text!r} instead."
+            )
+        mapping[key] = int(value) if value.isascii() and value.isdigit() else value
+    return mapping
+
+
+def _header_names(path: Path) -> list[str]:
+    """The names a file's columns may have, read cheaply: a text file's first lines, an
+    NPZ file's keys, a MAT file's variables (parsed as for reading it)."""
+    suffix = path.suffix.lower()
+    try:
+        if suffix == ".npz":
+            with zipfile.ZipFile(path) as archive:
+                return [Path(n).stem for n in archive.namelist()]
+        if suffix == ".mat":
+            try:
+                return [str(name) for name in read_raw(path, None)[0] or []]
+            except DataFileError:
+                return []  # the reader says what is wrong with it
+        with path.open("rb") as f:
+            head = f.read(PEEK_BYTES).decode("utf-8", errors="replace")
+    except (OSError, zipfile.BadZipFile):
+        return []
+    names: list[str] = []
+    for line in head.splitlines()[:50]:
+        names += re.split(r"[,;\t ]+", line.strip().lstrip("#%").strip())
+    return names
+
+
+def is_multiaxis(path, columns: dict | None = None) -> bool:
+    """Whether ``path`` is an N-axis file: a column named ``v1`` or ``x1`` (any case), or
+    ``columns`` naming one."""
+    if columns and any(axis_key(key) for key in columns):
+        return True
+    try:
+        path = Path(path)
+    except TypeError:
+        return False
+    if not path.is_file():
+        return False
+    return any((key := axis_key(name)) is not None and key[1] == 1 for name in _header_names(path))
+
+
+def read_axes(
+    path, keys=("v", "x"), *, columns=None, sample_rate=None, x_unit=None, progress=None
+) -> dict[str, np.ndarray]:
+    """Read an N-axis file: time and the columns ``keys`` of every axis.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The file (CSV, NPZ, MAT or a text table, as :func:`hystcomp.io.records.read_table`).
+    keys : sequence of {'v', 'x'}
+        What each axis needs: ``("v", "x")`` for a record, ``("v",)`` for an input,
+        ``("x",)`` for a reference.
+    columns : dict, optional
+        ``{"v1": 2, "x1": "disp_x", ...}``: 1-based numbers or names; the rest by name.
+    sample_rate : float, optional
+        Hz, for a file without a time column.
+    x_unit : {'m', 'mm', 'um', 'nm'}, optional
+        The displacements' unit, converted to µm.
+    progress : callable, optional
+        Called with the fraction read.
+
+    Returns
+    -------
+    dict
+        ``"t"`` (n,), and each key's (n, N) array, axis ``i`` in column ``i - 1``.
+
+    Raises
+    ------
+    DataFileError
+        Naming the file, the column, the problem and the fix.
+    """
+    path = as_path(path, "path", "read_axes")
+    columns = {str(k).lower(): v for k, v in (columns or {}).items()}
+    if sample_rate is not None:
+        sample_rate = check_real(sample_rate, "sample_rate", "read_axes", positive=True)
+    if x_unit is not None and x_unit not in X_UNITS:
+        raise InvalidParameterError(
+            f"The 'x_unit' parameter of read_axes must be one of {', '.join(X_UNITS)}. Got "
+            f"{x_unit!r} instead."
+        )
+    try:
+        names, arrays, positional, units = read_raw(path, progress)
+    finally:
+        if progress is not None:
+            progress(1.0)
+    where = f"Data file {str(path)!r}"
+    found: dict[str, dict[int, int]] = {key: {} for key in keys}
+    for index, name in enumerate(names or []):
+        named = axis_key(name)
+        if named is not None and named[0] in found:
+            found[named[0]][named[1]] = index
+    for spec_key, spec in columns.items():
+        axis = axis_key(spec_key)
+        if axis is None or axis[0] not in found:
+            continue
+        if isinstance(spec, int):
+            if not positional or spec > len(arrays):
+                raise DataFileError(
+                    f"{where} has no column {spec} for {spec_key!r}: it has {len(arrays)} "
+                    "numbered columns."
+                )
+            found[axis[0]][axis[1]] = spec - 1
+        else:
+            picked = _find(path, names or [], spec)
+            if picked is None:
+                raise DataFileError(
+                    f"{where} has no column {spec!r} for {spec_key!r}; its columns are "
+                    f"{', '.join(map(str, names or []))}."
+                )
+            found[axis[0]][axis[1]] = picked
+    counts = {key: len(idx) for key, idx in found.items()}
+    n_axes = max(counts.values(), default=0)
+    if n_axes == 0:
+        raise DataFileError(
+            f"{where} has no N-axis columns ({', '.join(k + '1' for k in keys)}, ...); its "
+            f"columns are {', '.join(map(str, names or [])) or 'unnamed'}. Name them, or map "
+            "them with --columns v1=2,x1=3,..."
+        )
+    if n_axes > MAX_AXES:
+        raise DataFileError(f"{where} has {n_axes} axes, more than {MAX_AXES}.")
+    for key, idx in found.items():
+        missing = [i for i in range(1, n_axes + 1) if i not in idx]
+        if missing or len(idx) != n_axes:
+            label = f"{key}{missing[0]}" if missing else f"{key}{max(idx)}"
+            raise DataFileError(
+                f"{where} has no column {label!r} ({MEANINGS[key]} of axis "
+                f"{label[1:]}), but {n_axes} axes elsewhere: every axis needs its "
+                f"{' and '.join(keys)}, numbered 1..{n_axes} without gaps."
+            )
+    out: dict[str, np.ndarray] = {}
+    raw_units = _Raw(names, [], positional, units)
+    for key, idx in found.items():
+        cols = []
+        for number in range(1, n_axes + 1):
+            index = idx[number]
+            label = f"column {names[index]!r}" if names else f"column {index + 1}"
+            arr = _as_column(arrays[index], path, key, label)
+            factor = _units(path, raw_units, key, index, x_unit)
+            if factor != 1.0:
+                arr = _as_column(arr * factor, path, key, label)
+            cols.append(arr)
+        lengths = {a.size for a in cols}
+        if len(lengths) > 1:
+            raise DataFileError(f"{where} has columns of different lengths ({sorted(lengths)}).")
+        out[key] = np.column_stack(cols)
+    n = next(iter(out.values())).shape[0]
+    if n < 2:
+        raise DataFileError(f"{where} has {n} sample; at least 2 are needed.")
+    t_index = columns.get("t")
+    t = None
+    if isinstance(t_index, int):
+        t = _as_column(arrays[t_index - 1], path, "t", f"column {t_index}")
+    elif names:
+        t_at = _find(path, names, t_index or "t")
+        if t_at is not None:
+            t = _as_column(arrays[t_at], path, "t", f"column {names[t_at]!r}")
+    out["t"] = _time(path, t, n, sample_rate)
+    for arr in out.values():
+        arr.setflags(write=False)
+    return out
