@@ -54,7 +54,7 @@ def evaluate(reference, measured, as_json, plot, skip, columns, sample_rate, x_u
     from hystcomp.workflows.evaluate import evaluate as run_evaluation
 
     if plot is not None:
-        from hystcomp.experiment.fig_evaluate import FORMATS
+        from hystcomp.experiment.fig_identification import FORMATS
 
         if Path(plot).suffix.lower() not in FORMATS:
             raise click.BadParameter(f"must end in {', '.join(FORMATS)}.", param_hint="--plot")

@@ -3,10 +3,6 @@ measured displacement against the reference."""
 
 from __future__ import annotations
 
-import os
-from pathlib import Path
-
-from hystcomp.errors import InvalidParameterError
 from hystcomp.experiment._layout import (
     TITLE_Y,
     _thin,
@@ -16,19 +12,7 @@ from hystcomp.experiment._layout import (
     pixel_columns,
     save_figure,
 )
-
-FORMATS = (".png", ".pdf", ".svg")
-DPI = 150
-
-
-def check_figure_path(path) -> Path:
-    """``path`` as a Path if a figure can be saved there (by its suffix), else raise."""
-    path = Path(os.fspath(path))
-    if path.suffix.lower() not in FORMATS:
-        raise InvalidParameterError(
-            f"Cannot save a figure as {str(path)!r}: use a name ending in {', '.join(FORMATS)}."
-        )
-    return path
+from hystcomp.experiment.fig_identification import DPI, check_figure_path
 
 
 def plot_evaluation(result, path) -> None:

@@ -28,6 +28,18 @@ from hystcomp.experiment._layout import (
 
 FORMATS = (".png", ".pdf", ".svg")
 DPI = 150
+
+
+def check_figure_path(path) -> Path:
+    """``path`` as a Path if a figure can be saved there (by its suffix), else raise."""
+    path = Path(os.fspath(path))
+    if path.suffix.lower() not in FORMATS:
+        raise InvalidParameterError(
+            f"Cannot save a figure as {str(path)!r}: use a name ending in {', '.join(FORMATS)}."
+        )
+    return path
+
+
 #: Turning points of the input above which a record is drawn as excerpts (about 6 loops).
 LONG_TURNS = 12
 #: Turning points (half-cycles) in an excerpt: two whole loops.
@@ -103,11 +115,7 @@ def plot_identification(
         The first sample of the hold-out (the samples before it were fitted); None: no
         hold-out.
     """
-    path = Path(os.fspath(path))
-    if path.suffix.lower() not in FORMATS:
-        raise InvalidParameterError(
-            f"Cannot save a figure as {str(path)!r}: use a name ending in {', '.join(FORMATS)}."
-        )
+    path = check_figure_path(path)
     v, x = np.asarray(v, dtype=np.float64), np.asarray(x, dtype=np.float64)
     before = np.asarray(before, dtype=np.float64)
     after = np.asarray(after, dtype=np.float64)
