@@ -68,9 +68,11 @@ def excite(model, output, sample_rate, voltage_range, frequency, axes, quiet):
     three models): ramps at the slope of the 1 Hz major triangle (times --frequency) between
     turning points at many levels, decaying loops from each end of the range then random
     ones (about 14 s). Each starts and ends at the lower end of the range. dynamics (beyond
-    the paper): a step to mid-range held 3 s (creep), then three 1 s periods of a
-    multisine of 1 Hz .. 5 kHz around it, of 1/30 of the range peak (+-4 V on 0..120 V;
-    --frequency unused). Columns: t (s), v (V). multiaxis --axes N (beyond the paper): every
+    the paper; with a hysteresis record, identify --dynamics-record fits both as a pair): a
+    step to mid-range held 3 s (creep), three 1 s periods of a multisine of 1 Hz .. 5 kHz
+    around it of a quarter of the range peak (+-30 V on 0..120 V), then triangles over 5-90
+    % of the range at 1, 10, 100 and 200 Hz, which the fits leave out and the tracking
+    estimates use (9.2 s; --frequency unused). Columns: t (s), v (V). multiaxis --axes N (beyond the paper): every
     axis sweeps its range with turning points of its own while the others move
     independently, which identifies the coupling between them; columns t, v1..vN.
     """
