@@ -13,7 +13,7 @@ import warnings
 import click
 import numpy as np
 
-from hystcomp.cli._options import check_data_output, progress
+from hystcomp.cli._options import check_data_output, progress, slew_sample_rate
 from hystcomp.errors import HystcompWarning, InvalidSignalError, OutputPathError
 
 
@@ -77,22 +77,20 @@ def identify_multiaxis(
     n_jobs=None,
 ) -> None:
     """``hystcomp identify`` on an N-axis record."""
+    from hystcomp.identify.workflow import extrapolation_error
     from hystcomp.io.atomic import atomic_paths
     from hystcomp.io.models import model_text
     from hystcomp.io.multiaxis import read_axes
     from hystcomp.workflows.multiaxis import identify_axes
 
     table = read_axes(data, ("v", "x"), **_read_options(columns, sample_rate, x_unit, quiet, data))
-    if voltage_range is not None and not allow_extrapolation:
-        lo, hi = voltage_range
-        v = table["v"]
-        if lo < v.min() - 1e-9 * (hi - lo) or hi > v.max() + 1e-9 * (hi - lo):
-            raise click.BadParameter(
-                f"reaches beyond the record's input ({v.min():.4g} .. {v.max():.4g} V over the "
-                "axes): the compensators would command voltages the models never saw. Give a "
-                "range within the record, or pass --allow-extrapolation.",
-                param_hint="'--voltage-range'",
-            )
+    why = None if voltage_range is None else extrapolation_error(voltage_range, table["v"])
+    if why is not None and not allow_extrapolation:
+        raise click.BadParameter(
+            f"{why} (over the axes): the compensators would command voltages the models never "
+            "saw. Give a range within the record, or pass --allow-extrapolation.",
+            param_hint="'--voltage-range'",
+        )
     given = {k: v for k, v in options.items() if v is not None}
     with progress(f"identifying {table['v'].shape[1]} axes", quiet).ticking():
         result = identify_axes(
@@ -164,7 +162,9 @@ def compensate_multiaxis(
         )
     options: dict = {"voltage_range": _narrow(model, narrow_range)}
     if slew_rate is not None:
-        options.update(slew_rate=slew_rate, sample_rate=1.0 / float(np.min(np.diff(table["t"]))))
+        options.update(
+            slew_rate=slew_rate, sample_rate=slew_sample_rate(table["t"], reference_file)
+        )
     if method is not None:
         if not any(a.kind == "preisach" for a in model.axes_):
             raise click.BadParameter(

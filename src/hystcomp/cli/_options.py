@@ -265,3 +265,30 @@ def method_options(model, model_file, method) -> dict:
             param_hint="'--method'",
         )
     return {"method": method}
+
+
+#: A step of the reference's time column shorter than this share of its median step is a
+#: fault of the column, not jitter: at its rate the slew-rate limit would all but hold the
+#: voltage still on every sample.
+SHORTEST_STEP = 1e-3
+
+
+def slew_sample_rate(t, path) -> float:
+    """The rate (Hz) of the shortest step of ``t``, at which the slew-rate limit holds on
+    every step; refused, naming the row, if that step is a fault of the time column."""
+    import numpy as np
+
+    from hystcomp.errors import InvalidSignalError
+
+    steps = np.diff(t)
+    k = int(np.argmin(steps))
+    shortest, median = float(steps[k]), float(np.median(steps))
+    if not shortest >= SHORTEST_STEP * median or not 1.0 / shortest <= MAX_MAGNITUDE:
+        raise InvalidSignalError(
+            f"--slew-rate limits the voltage's change per sample at the reference's shortest "
+            f"time step, but the time column 't' of {str(path)!r} steps by only "
+            f"{shortest:.3g} s from t = {float(t[k])!r} to {float(t[k + 1])!r} s (data row "
+            f"{k + 2}), against a median step of {median:.3g} s: the limit would hold the "
+            "voltage nearly still. Correct the time column there, or drop it and give --fs."
+        )
+    return 1.0 / shortest

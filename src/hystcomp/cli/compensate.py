@@ -8,7 +8,6 @@ from typing import Any
 import click
 import numpy as np
 
-from hystcomp._validation import MAX_MAGNITUDE
 from hystcomp.cli import main
 from hystcomp.cli._dynamics import dynamics_for, load_dynamics, refuse_dynamics_as_model
 from hystcomp.cli._options import (
@@ -24,6 +23,7 @@ from hystcomp.cli._options import (
     progress,
     quiet_option,
     read_options,
+    slew_sample_rate,
     warn_x_unit,
     x_unit_option,
 )
@@ -44,7 +44,7 @@ def inverse_options(model, table, *, slew_rate, narrow_range, path="the referenc
     """
     options: dict[str, Any] = {}
     if slew_rate is not None:
-        options.update(slew_rate=slew_rate, sample_rate=_slew_sample_rate(table["t"], path))
+        options.update(slew_rate=slew_rate, sample_rate=slew_sample_rate(table["t"], path))
     options.update(narrowed(model, narrow_range))
     return options
 
@@ -224,29 +224,6 @@ def compensate(
             f"  with the inverse of the dynamics of {dynamics_file or model_file}: "
             f"{compensator.preview} samples of look-ahead in the reference"
         )
-
-
-#: A step of the reference's time column shorter than this share of its median step is a
-#: fault of the column, not jitter: at its rate the slew-rate limit would all but hold the
-#: voltage still on every sample.
-SHORTEST_STEP = 1e-3
-
-
-def _slew_sample_rate(t, path) -> float:
-    """The rate (Hz) of the shortest step of ``t``, at which the slew-rate limit holds on
-    every step; refused, naming the row, if that step is a fault of the time column."""
-    steps = np.diff(t)
-    k = int(np.argmin(steps))
-    shortest, median = float(steps[k]), float(np.median(steps))
-    if not shortest >= SHORTEST_STEP * median or not 1.0 / shortest <= MAX_MAGNITUDE:
-        raise InvalidSignalError(
-            f"--slew-rate limits the voltage's change per sample at the reference's shortest "
-            f"time step, but the time column 't' of {str(path)!r} steps by only "
-            f"{shortest:.3g} s from t = {float(t[k])!r} to {float(t[k + 1])!r} s (data row "
-            f"{k + 2}), against a median step of {median:.3g} s: the limit would hold the "
-            "voltage nearly still. Correct the time column there, or drop it and give --fs."
-        )
-    return 1.0 / shortest
 
 
 #: A turn of the voltage larger than this fraction of the range, where the reference does

@@ -260,9 +260,10 @@ def identify(
     --constraints paper --regularization 0 is eq. 19 as printed.
 
     Besides the fit error, prints an estimate of the compensator's tracking error in µm
-    rms (the inverse run on the measured displacement, its voltage error times the record's
-    gain) beside the same estimate for a straight line, and warns when the compensator is
-    predicted to do no better than the line, or when a hold-out leaves the fitted range.
+    rms (the model's error on the record's swings and its inverse's on its own model) beside
+    a straight line's, and the error on reversal branches a cross-validation left out; warns
+    when the compensator is predicted to do no better than the line, when the latter is
+    more than twice the former, or when a hold-out leaves the fitted range.
     """
     inputs = (data,) if dynamics_record is None else (data, dynamics_record)
     check_output_path(output, inputs=inputs, what="model file")
@@ -346,37 +347,39 @@ def identify(
         "transient": transient,
         "unit_check": False,  # checked above, before the fit, and silenced by --quiet
     }
+    if dynamics_record is not None and holdout is not None:
+        raise click.UsageError(
+            "--holdout does not apply with --dynamics-record: the pair's tracking is "
+            "estimated on the dynamics record's triangles. Hold out without it."
+        )
     lines: list[str] = []
+    fitted = None  # the hysteresis model's identification, where auto made it
     if kind == "auto":
         from hystcomp.workflows.auto import identify_best
 
-        given = {k: v for k, v in options.items() if v is not None}
         chosen = identify_best(
             rec,
             voltage_range=voltage_range,
-            holdout=None if dynamics_record is not None else holdout,
+            holdout=holdout,
             progress=lambda k: progress(f"identifying the {LABELS[k]} model", quiet).ticking(),
-            **given,
+            **{k: v for k, v in options.items() if v is not None},
             **fitting,
         )
         lines += chosen.lines
-        kind = chosen.best.kind
-        options = {k: v for k, v in given.items() if k in SIZE_OPTIONS[kind]}
-        model = build_estimator(kind, voltage_range=voltage_range, **options)
-    fitting["progress"] = progress(f"identifying the {LABELS[kind]} model", quiet).ticking()
+        fitted = chosen.best
+    else:
+        fitting["progress"] = progress(f"identifying the {LABELS[kind]} model", quiet).ticking()
     if dynamics_record is None:
-        result = chosen.best if lines else identify_record(rec, model, holdout=holdout, **fitting)
+        result = fitted or identify_record(rec, model, holdout=holdout, **fitting)
         lines, warnings, written = lines + result.lines, result.warnings, result.model
     else:
         from hystcomp.workflows.pair import identify_pair_record
 
-        if holdout is not None:
-            raise click.UsageError(
-                "--holdout does not apply with --dynamics-record: the pair's tracking is "
-                "estimated on the dynamics record's triangles. Hold out without it."
-            )
         dyn = read_record(dynamics_record, **read_options(columns, sample_rate))
-        paired = identify_pair_record(rec, dyn, model, **fitting)
+        if fitted is not None:
+            paired = identify_pair_record(rec, dyn, fitted.model, hysteresis=fitted)
+        else:
+            paired = identify_pair_record(rec, dyn, model, **fitting)
         result = paired.hysteresis
         lines = lines + result.lines + paired.lines
         warnings = result.warnings + paired.warnings

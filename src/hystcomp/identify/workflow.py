@@ -262,8 +262,8 @@ class IdentificationResult:
     fit : dict
         The fit errors over ``start .. n_fit`` (:func:`~hystcomp.identify.scoring.error_report`).
     tracking : dict
-        The compensator's estimated tracking error beside a straight line's
-        (:func:`~hystcomp.identify.compensation.compensation_error`).
+        The compensator's estimated tracking error beside a straight line's, and the
+        cross-validated error (:func:`~hystcomp.identify.compensation.tracking_estimate`).
     holdout : dict or None
         The hold-out figures (:func:`~hystcomp.identify.scoring.holdout_report`), or None
         without a hold-out.
@@ -311,8 +311,9 @@ def identify_record(
     input reaches an end of its range (:func:`~hystcomp.identify.scoring.transient_end`),
     else ``transient`` seconds into the record. With ``holdout`` the last fraction of the
     record is left out of the fit and the model's prediction of it is scored against a
-    straight line. The compensator's tracking error is estimated by running its inverse on
-    the measured displacement (:func:`~hystcomp.identify.compensation.compensation_error`).
+    straight line. The compensator's tracking error is estimated from the model's error on
+    the record's swings and its inverse's on its own model
+    (:func:`~hystcomp.identify.compensation.tracking_estimate`).
 
     Parameters
     ----------

@@ -139,7 +139,9 @@ def _rms(e) -> float:
     return float(np.sqrt(np.mean(np.square(e))))
 
 
-def identify_pair_record(record, dynamics_record, model, **options) -> PairResult:
+def identify_pair_record(
+    record, dynamics_record, model, *, hysteresis=None, **options
+) -> PairResult:
     """Identify a hysteresis model and the linear dynamics as one pair, and report.
 
     Parameters
@@ -150,8 +152,13 @@ def identify_pair_record(record, dynamics_record, model, **options) -> PairResul
         The answer to ``hystcomp excite dynamics``, at the rate the compensator will run.
     model : {'pi', 'mpi', 'preisach'} or estimator
         As in :func:`~hystcomp.identify.workflow.identify_record`.
+    hysteresis : IdentificationResult, optional
+        ``model`` already identified from ``record`` (by
+        :func:`~hystcomp.identify.workflow.identify_record`, as ``--model auto`` does): it
+        is the pair's first round, not fitted again.
     **options
-        Those of :func:`~hystcomp.identify.workflow.identify_record` (no ``holdout``).
+        Those of :func:`~hystcomp.identify.workflow.identify_record` (no ``holdout``), for
+        the hysteresis model's identification when it is not given.
 
     Returns
     -------
@@ -160,7 +167,8 @@ def identify_pair_record(record, dynamics_record, model, **options) -> PairResul
     uneven = uneven_sampling(dynamics_record.t, f"the dynamics record {dynamics_record.source}")
     if uneven:
         raise InvalidParameterError(uneven)
-    hysteresis = identify_record(record, model, **options)
+    if hysteresis is None:
+        hysteresis = identify_record(record, model, **options)
     estimator = hysteresis.model
     fs = dynamics_record.sample_rate
     pair = fit_pair(
