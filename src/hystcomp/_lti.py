@@ -16,7 +16,9 @@ import numpy as np
 from hystcomp._kernels import dynamics as dk
 
 
-def resonance_zoh(resonance_hz: float, damping_ratio: float, sample_rate: float):
+def resonance_zoh(
+    resonance_hz: float, damping_ratio: float, sample_rate: float
+) -> tuple[np.ndarray, np.ndarray]:
     """``(b, a)`` of the zero-order-hold discretisation of ``wn^2 / (s^2 + 2 zeta wn s + wn^2)``.
 
     ``R(z) = (b[0] z + b[1]) / (z^2 + a[1] z + a[2])``, ``a[0] = 1``, with unit gain at

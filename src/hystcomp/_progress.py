@@ -58,7 +58,7 @@ class Progress:
         self.width = 0
         self._lock = threading.Lock()
         self._stop = threading.Event()
-        self._thread = None
+        self._thread: threading.Thread | None = None
 
     def __call__(self, fraction: float) -> None:
         if fraction >= 1.0:

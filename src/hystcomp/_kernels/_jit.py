@@ -16,6 +16,7 @@ from __future__ import annotations
 import functools
 import sys
 from collections import namedtuple
+from typing import Any
 
 import numba
 
@@ -58,6 +59,12 @@ def caching() -> bool:
 #: finiteness tests on the input must survive compilation.
 FASTMATH = {"reassoc", "contract", "nsz", "arcp"}
 
+#: numba's options for a kernel compiled without reference counting (``_nrt``) and, for an
+#: inner kernel, without the wrappers for Python and C. numba takes them, but its type hints
+#: leave them out, so they are passed as a dictionary.
+NO_NRT: dict[str, Any] = {"_nrt": False}
+NO_WRAPPERS: dict[str, Any] = {**NO_NRT, "no_cpython_wrapper": True, "no_cfunc_wrapper": True}
+
 
 def kernel(func):
     """Compile ``func`` as a batch kernel: cached, :data:`FASTMATH`, the GIL released."""
@@ -90,9 +97,7 @@ def inner_kernel(func):
     return numba.njit(
         cache=caching(),
         fastmath=FASTMATH,
-        _nrt=False,
-        no_cpython_wrapper=True,
-        no_cfunc_wrapper=True,
+        **NO_WRAPPERS,
     )(func)
 
 
@@ -105,7 +110,7 @@ def flat_kernel(func):
     cost more than the arithmetic), so a kernel can hand 1-D rows of its 2-D arrays to an
     inlined helper whose loop vectorises. It must not allocate: work buffers are passed in.
     """
-    return numba.njit(cache=True, fastmath=FASTMATH, nogil=True, _nrt=False)(func)
+    return numba.njit(cache=True, fastmath=FASTMATH, nogil=True, **NO_NRT)(func)
 
 
 def step_kernel(func):
@@ -119,7 +124,7 @@ def step_kernel(func):
     that a step and the batch run it mirrors agree bit for bit. :func:`step_function` gives
     its fast entry point.
     """
-    return numba.njit(cache=caching(), fastmath=FASTMATH, _nrt=False)(func)
+    return numba.njit(cache=caching(), fastmath=FASTMATH, **NO_NRT)(func)
 
 
 @functools.cache

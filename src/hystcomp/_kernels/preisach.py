@@ -36,6 +36,9 @@ The same :func:`preisach_step` serves the forward model, the inverse multiplicat
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from typing import cast
+
 import numba
 import numpy as np
 from llvmlite import ir  # type: ignore[import-untyped]
@@ -68,8 +71,7 @@ DEFAULT_DEPTH = 1024
 MAX_DEPTH = 1_000_000
 
 
-@intrinsic
-def _fma(typingctx, x, y, z):
+def _fma_intrinsic(typingctx, x, y, z):
     """``x * y + z`` rounded once (LLVM's ``llvm.fma``), as C99's ``fma()``.
 
     Written out rather than left to the compiler's contraction, so that the order and the
@@ -85,6 +87,10 @@ def _fma(typingctx, x, y, z):
         return builder.call(fma, args)
 
     return sig, codegen
+
+
+# as the kernels call it: three floats, the typing context is numba's (its type hints name it)
+_fma = cast("Callable[[float, float, float], float]", intrinsic(_fma_intrinsic))
 
 
 def monomial_exponents(degree: int) -> list[tuple[int, int]]:

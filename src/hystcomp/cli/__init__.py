@@ -37,7 +37,7 @@ def remove_pending() -> None:
         atomic.remove_pending()
 
 
-def _one_line(text: str) -> str:
+def _one_line(text: object) -> str:
     return " ".join(str(text).split())
 
 

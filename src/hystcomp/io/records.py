@@ -465,7 +465,7 @@ def _read_table(path, keys, columns, sample_rate, min_samples, x_unit, progress,
             out[key] = arr
     if len(raw.arrays) > len(out):  # keep the columns read only, not the whole table
         out = {key: np.array(arr) for key, arr in out.items()}
-    raw = None  # the other columns are no longer needed
+    del raw  # the other columns are no longer needed
     lengths = {key: arr.size for key, arr in out.items()}
     if len(set(lengths.values())) > 1:
         raise DataFileError(

@@ -8,7 +8,8 @@ reachable displacements.
 
 from __future__ import annotations
 
-from typing import Any
+from abc import abstractmethod
+from typing import TYPE_CHECKING, Any, Self
 
 import numpy as np
 
@@ -17,6 +18,10 @@ from hystcomp._validation import check_range, check_real
 from hystcomp.errors import InvalidParameterError
 from hystcomp.models.estimator import Estimator
 from hystcomp.models.system import PackedSystem
+
+if TYPE_CHECKING:  # the compensators import this module
+    from hystcomp.models.compensator import Compensator
+    from hystcomp.models.dynamic_compensator import DynamicCompensator
 
 DEFAULT_VOLTAGE_RANGE = paper.VOLTAGE_RANGE  # V, the paper's piezo voltage v_px
 #: The fit report's entry for the input range (V) that the fitted record covered.
@@ -30,10 +35,59 @@ class HysteresisModel(PackedSystem, Estimator):
     model files) run as a :class:`~hystcomp.models.system.PackedSystem` (``simulate``,
     ``stepper``). Every forward model has a ``voltage_range`` hyperparameter and learns
     ``voltage_range_``, the range its compensators clamp to.
+
+    What every forward model gives:
+
+    - :meth:`fit` ``(v, x)``: identify the model from a record, return ``self``;
+    - :meth:`simulate` ``(v)``: the displacement for a voltage, from the initial state,
+      without changing the model (:meth:`PackedSystem.simulate
+      <hystcomp.models.system.PackedSystem.simulate>`);
+    - :meth:`stepper`: the same, one sample at a time, with a state of its own;
+    - :meth:`inverse`: its compensator, clamped to ``voltage_range_``;
+    - :meth:`reachable_range`: the displacements the compensator can ask for.
     """
 
     voltage_range: Any  # the hyperparameter, stored as given
     voltage_range_: tuple[float, float]
+
+    @abstractmethod
+    def fit(self, v, x) -> Self:
+        """Identify the model from a record: voltage ``v`` (V) and displacement ``x`` (µm).
+
+        Parameters
+        ----------
+        v, x : array_like
+            Input voltage (V) and measured displacement (µm), one sample each per instant.
+
+        Returns
+        -------
+        HysteresisModel
+            ``self``, fitted.
+        """
+
+    @abstractmethod
+    def inverse(
+        self, *, slew_rate=None, sample_rate=None, voltage_range=None, dynamics=None
+    ) -> Compensator | DynamicCompensator:
+        """The model's compensator: reference (µm) in, voltage (V) out.
+
+        Parameters
+        ----------
+        slew_rate : float, optional
+            Largest output slew rate in V/s (none by default).
+        sample_rate : float, optional
+            Sample rate in Hz at which the compensator runs; sets the per-sample slew step.
+        voltage_range : (float, float), optional
+            A narrower output clamp in V, inside ``voltage_range_`` (never wider).
+        dynamics : LinearDynamics, optional
+            An inverse of the actuator's linear dynamics in series (then a
+            :class:`~hystcomp.models.dynamic_compensator.DynamicCompensator`).
+
+        Returns
+        -------
+        Compensator or DynamicCompensator
+            The compensator, clamped to the voltage range.
+        """
 
     def _check_hyperparameters(self) -> None:
         """Validate every hyperparameter's type and value, as ``fit`` does (and raise)."""

@@ -184,9 +184,10 @@ class DynamicsInverseStepper(Rebound):
         # bound fast path, with the stepper's check of the sample's type
         self.step = checked_step(step_function(dk.inverse_step), self._p)  # type: ignore[method-assign]
 
-    def step(self, x_ref: float) -> float:
-        """One reference sample (µm, ``preview`` samples ahead) -> filter output; NaN held out."""
-        return dk.inverse_step(self._p, x_ref)
+    def step(self, u: float) -> float:
+        """One reference sample ``u`` (µm, ``preview`` samples ahead) -> filter output; NaN
+        held out."""
+        return dk.inverse_step(self._p, u)
 
     def step_block(self, x_ref) -> np.ndarray:
         """A block of reference samples."""

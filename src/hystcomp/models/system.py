@@ -13,7 +13,8 @@ from __future__ import annotations
 import math
 import numbers
 from abc import ABC, abstractmethod
-from typing import ClassVar
+from collections.abc import Callable
+from typing import Any, ClassVar, Protocol, cast
 
 import numpy as np
 
@@ -142,7 +143,25 @@ def output_block(out, u: np.ndarray, owner: str) -> np.ndarray:
     return out
 
 
-def checked_step(kernel, p):
+class BoundStep(Protocol):
+    """A stepper's fast ``step(u)``: a plain function that also names, as
+    :func:`functools.partial` does, what it calls (``func``) and on what (``state``)."""
+
+    func: Callable[..., float]
+    state: Any
+
+    def __call__(self, u: float) -> float: ...
+
+
+def _named(step: Callable[[float], float], kernel, state) -> BoundStep:
+    """``step`` with the attributes of :class:`BoundStep`."""
+    bound = cast(BoundStep, step)
+    bound.func = kernel
+    bound.state = state
+    return bound
+
+
+def checked_step(kernel, p) -> BoundStep:
     """``step(u) = kernel(p, u)`` for a float ``u`` (the fast path: one type test), and
     for any other real number after conversion; text, bools and arrays are refused (the
     compiled kernel alone would parse a string)."""
@@ -152,12 +171,10 @@ def checked_step(kernel, p):
             return kernel(p, u)
         return kernel(p, _sample(u))
 
-    step.func = kernel  # as functools.partial names them: what it calls, and on what
-    step.state = p
-    return step
+    return _named(step, kernel, p)
 
 
-def checked_pair_step(kernel, p, q):
+def checked_pair_step(kernel, p, q) -> BoundStep:
     """:func:`checked_step` for a kernel over two packed systems: ``step(u) = kernel(p, q, u)``."""
 
     def step(u):
@@ -165,9 +182,7 @@ def checked_pair_step(kernel, p, q):
             return kernel(p, q, u)
         return kernel(p, q, _sample(u))
 
-    step.func = kernel
-    step.state = (p, q)
-    return step
+    return _named(step, kernel, (p, q))
 
 
 def fast_block(kernel, p, work, checked):
