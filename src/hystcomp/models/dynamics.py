@@ -69,6 +69,7 @@ from hystcomp.models.dynamic_compensator import (
     DynamicStepper,
     inverse_fir,
 )
+from hystcomp.models.estimator import learned_values, set_learned
 
 __all__ = [
     "MATCH_HZ",
@@ -168,18 +169,14 @@ class LinearDynamics:
         existed hold: one mode)."""
         owner = cls.__name__
         model = cls()
-        model.sample_rate_ = check_real(sample_rate, "sample_rate", owner, positive=True)
-        model.resonance_hz_, model.damping_ratio_ = _check_mode(
-            resonance_hz, damping_ratio, model.sample_rate_, "", owner
-        )
+        rate = check_real(sample_rate, "sample_rate", owner, positive=True)
+        first = _check_mode(resonance_hz, damping_ratio, rate, "", owner)
         second = {
             "second_resonance_hz": second_resonance_hz,
             "second_damping_ratio": second_damping_ratio,
             "second_mode_gain": second_mode_gain,
         }
         given = [name for name, value in second.items() if value is not None]
-        model.second_resonance_hz_ = model.second_damping_ratio_ = None
-        model.second_mode_gain_ = None
         if given and len(given) < len(second):
             missing = ", ".join(repr(name) for name in second if name not in given)
             raise InvalidParameterError(
@@ -190,12 +187,12 @@ class LinearDynamics:
             )
         if given:
             hz, zeta = _check_mode(
-                second_resonance_hz, second_damping_ratio, model.sample_rate_, "second_", owner
+                second_resonance_hz, second_damping_ratio, rate, "second_", owner
             )
-            if not hz > model.resonance_hz_:
+            if not hz > first[0]:
                 raise InvalidParameterError(
                     f"The 'second_resonance_hz' parameter of {owner} must be above "
-                    f"'resonance_hz' ({model.resonance_hz_:g} Hz): the first mode is the "
+                    f"'resonance_hz' ({first[0]:g} Hz): the first mode is the "
                     f"lowest. Got {hz:g}; swap the two modes."
                 )
             gain = check_real(second_mode_gain, "second_mode_gain", owner)
@@ -205,8 +202,11 @@ class LinearDynamics:
                     f"of the static gain, in (0, 1) (the first mode has the rest). Got "
                     f"{gain:g}; leave the second mode out (None) for a model of one mode."
                 )
-            model.second_resonance_hz_, model.second_damping_ratio_ = hz, zeta
-            model.second_mode_gain_ = gain
+            second = {
+                "second_resonance_hz": hz,
+                "second_damping_ratio": zeta,
+                "second_mode_gain": gain,
+            }
         if np.size(creep_time_constants) == 0 and np.size(creep_weights) == 0:  # no creep
             taus = weights = np.zeros(0)
         else:
@@ -219,12 +219,21 @@ class LinearDynamics:
                 f"The creep of {owner} needs time constants > 0 s and weights >= 0. Got "
                 f"time constants {taus.tolist()} and weights {weights.tolist()}."
             )
-        model.creep_time_constants_ = taus
-        model.creep_weights_ = weights
         if isinstance(delay_samples, float) and delay_samples.is_integer():
             delay_samples = int(delay_samples)  # 3.0, as some JSON writers put 3
-        model.delay_samples_ = check_int(
+        delay = check_int(
             delay_samples, "delay_samples", owner, minimum=DELAY_RANGE[0], maximum=DELAY_RANGE[1]
+        )
+        set_learned(
+            model,
+            cls._learned,
+            sample_rate=rate,
+            resonance_hz=first[0],
+            damping_ratio=first[1],
+            creep_time_constants=taus,
+            creep_weights=weights,
+            delay_samples=delay,
+            **second,
         )
         return model
 
@@ -239,7 +248,7 @@ class LinearDynamics:
         """
         result = fit_dynamics(v, x, sample_rate, u=u)
         fitted = type(self).from_parameters(**result.parameters)
-        self.__dict__.update(fitted.__dict__)
+        set_learned(self, self._learned, **learned_values(fitted, self._learned))
         self.fit_report_ = dict(result.report)
         return self
 

@@ -104,6 +104,34 @@ def fit_signals(fit: Fit) -> Fit:
     return wrapper  # type: ignore[return-value]
 
 
+def set_learned(model: object, names: tuple[str, ...], **learned: Any) -> None:
+    """Set a model's learned attributes, ``name_`` for each of ``names``: the one path by
+    which ``fit``, ``from_parameters`` and the model files write them.
+
+    ``learned`` names each of ``names`` (without the trailing underscore), and nothing else.
+    An array that the caller may still change is copied first, so that every array of the
+    model is its own and read-only. The values are taken as they are: ``from_parameters``
+    validates them before, and a fit computed them under its constraints.
+    """
+    if set(learned) != set(names):  # a programming error in a model class, not a user's
+        raise TypeError(
+            f"The learned attributes of {type(model).__name__} are {', '.join(names)}; got "
+            f"{', '.join(learned)}."
+        )
+    for name in names:
+        value = learned[name]
+        if isinstance(value, np.ndarray) and value.flags.writeable:
+            value = value.copy()
+            value.setflags(write=False)
+        setattr(model, name + "_", value)
+
+
+def learned_values(model: object, names: tuple[str, ...]) -> dict[str, Any]:
+    """A model's learned attributes by name (without the underscore), as
+    :func:`set_learned` takes them."""
+    return {name: getattr(model, name + "_") for name in names}
+
+
 class Estimator:
     """Base of the fitted models: voltage (V) in, displacement (µm) out, learned from data.
 
@@ -124,6 +152,8 @@ class Estimator:
 
     kind: ClassVar[str]
     _learned: ClassVar[tuple[str, ...]]
+    #: Learned attributes computed from those of ``_learned`` (not in the model file).
+    _learned_derived: ClassVar[tuple[str, ...]] = ()
     fit_report_: dict[str, Any]
 
     if TYPE_CHECKING:  # what every subclass gives (declared for the type checker only)
@@ -336,10 +366,20 @@ class Estimator:
             regressor_tags=RegressorTags(),
         )
 
+    def _set_learned(self, **learned: Any) -> None:
+        """Set the learned attributes: the one place where ``fit``, ``from_parameters`` and
+        the model files write them (:func:`set_learned`, with ``_learned`` and
+        ``_learned_derived``)."""
+        set_learned(self, (*self._learned, *self._learned_derived), **learned)
+
+    def _learned_values(self) -> dict[str, Any]:
+        """The learned attributes by name (without the underscore), as :meth:`_set_learned`
+        takes them."""
+        return learned_values(self, (*self._learned, *self._learned_derived))
+
     def _adopt(self, fitted: Self, fit_report: dict[str, Any]) -> None:
         """Take the learned parameters of ``fitted`` (built by ``from_parameters``, so validated)."""
-        for name in self._learned:
-            setattr(self, name + "_", getattr(fitted, name + "_"))
+        self._set_learned(**fitted._learned_values())
         self.fit_report_ = fit_report
 
     def __repr__(self) -> str:

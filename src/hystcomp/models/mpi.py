@@ -22,7 +22,12 @@ from hystcomp.models.compensator import Compensator
 from hystcomp.models.dynamic_compensator import DynamicCompensator
 from hystcomp.models.estimator import fit_signals
 from hystcomp.models.inversion import check_invertible, invert_superposition
-from hystcomp.models.pi import PrandtlIshlinskii, thinned_record
+from hystcomp.models.pi import (
+    PrandtlIshlinskii,
+    _checked_offsets,
+    _checked_plays,
+    thinned_record,
+)
 
 
 class ModifiedPrandtlIshlinskii(PrandtlIshlinskii):
@@ -208,7 +213,7 @@ class ModifiedPrandtlIshlinskii(PrandtlIshlinskii):
         from the identified inverse ones (eqs. 24-25; see :meth:`_set_fitted`)."""
         rs, ws = invert_superposition(fit.inverse_deadzone_thresholds, fit.inverse_deadzone_weights)
         model = type(self)(n_operators=fit.thresholds.size, n_deadzones=rs.size, voltage_range=None)
-        model._set_fitted(fit, voltage_range, deadzone_thresholds_=rs, deadzone_weights_=ws)
+        model._set_fitted(fit, voltage_range, deadzone_thresholds=rs, deadzone_weights=ws)
         return model
 
     def _penalties(self, owner: str) -> tuple[float, ...]:
@@ -233,12 +238,12 @@ class ModifiedPrandtlIshlinskii(PrandtlIshlinskii):
         owner = cls.__name__
         rs = check_thresholds(deadzone_thresholds, "deadzone_thresholds", owner)
         model = cls(n_operators=np.size(thresholds), n_deadzones=rs.size, voltage_range=None)
-        model._set_plays(owner, thresholds, weights, initial_state)
-        model.deadzone_thresholds_ = rs
-        model.deadzone_weights_ = as_vector(
-            deadzone_weights, "deadzone_weights", owner, length=rs.size
+        model._set_learned(
+            **_checked_plays(owner, thresholds, weights, initial_state),
+            deadzone_thresholds=rs,
+            deadzone_weights=as_vector(deadzone_weights, "deadzone_weights", owner, length=rs.size),
+            **_checked_offsets(owner, voltage_range, input_offset, output_offset),
         )
-        model._set_offsets(owner, voltage_range, input_offset, output_offset)
         return model
 
     def _derived_hyperparameters(self) -> dict[str, Any]:

@@ -204,6 +204,7 @@ class MultiAxisModel(Estimator):
 
     kind: ClassVar[str] = "multiaxis"
     _learned: ClassVar[tuple[str, ...]] = ("axes", "coupling")
+    _learned_derived: ClassVar[tuple[str, ...]] = ("decoupling",)
     axes_: tuple[HysteresisModel, ...]
     coupling_: np.ndarray
     decoupling_: np.ndarray
@@ -337,7 +338,6 @@ class MultiAxisModel(Estimator):
             ],
         }
         self._adopt(fitted, report)
-        self.decoupling_ = fitted.decoupling_
         return self
 
     @classmethod
@@ -377,14 +377,9 @@ class MultiAxisModel(Estimator):
                 "from a record in which the axes move independently."
             )
         model = cls(family=axes[0].kind if len({a.kind for a in axes}) == 1 else "auto")
-        model.axes_ = axes
         m = m.copy()
         np.fill_diagonal(m, 1.0)
-        m.setflags(write=False)
-        model.coupling_ = m
-        inv = np.linalg.inv(m)
-        inv.setflags(write=False)
-        model.decoupling_ = inv
+        model._set_learned(axes=axes, coupling=m, decoupling=np.linalg.inv(m))
         return model
 
     # -- the model's run ---------------------------------------------------------------------

@@ -187,19 +187,15 @@ class PrandtlIshlinskii(HysteresisModel):
         under its constraints (finite, every partial sum above the margin) and
         ``voltage_range`` was checked, while a fit builds dozens of candidate models.
         """
-        fields = {
-            "thresholds_": fit.thresholds,
-            "weights_": fit.weights,
-            "initial_state_": fit.initial_state,
-            **arrays,
-        }
-        for name, value in fields.items():
-            value = np.array(value, dtype=np.float64)  # the model's own, read-only
-            value.setflags(write=False)
-            setattr(self, name, value)
-        self.voltage_range_ = voltage_range
-        self.input_offset_ = float(fit.input_offset)
-        self.output_offset_ = float(fit.output_offset)
+        self._set_learned(
+            thresholds=np.array(fit.thresholds, dtype=np.float64),
+            weights=np.array(fit.weights, dtype=np.float64),
+            initial_state=np.array(fit.initial_state, dtype=np.float64),
+            **{name: np.array(value, dtype=np.float64) for name, value in arrays.items()},
+            voltage_range=voltage_range,
+            input_offset=float(fit.input_offset),
+            output_offset=float(fit.output_offset),
+        )
 
     def _adopt_fit(self, fitted: Self, v_k, x_k, first: int, est: dict, **extra) -> None:
         """Take ``fitted``'s parameters, with its fit report on the thinned record: the
@@ -230,30 +226,11 @@ class PrandtlIshlinskii(HysteresisModel):
         """A model with the given parameters (V, µm/V, µm); every value is validated."""
         owner = cls.__name__
         model = cls(n_operators=np.size(thresholds), voltage_range=None)
-        model._set_plays(owner, thresholds, weights, initial_state)
-        model._set_offsets(owner, voltage_range, input_offset, output_offset)
+        model._set_learned(
+            **_checked_plays(owner, thresholds, weights, initial_state),
+            **_checked_offsets(owner, voltage_range, input_offset, output_offset),
+        )
         return model
-
-    def _set_plays(self, owner: str, thresholds, weights, initial_state) -> None:
-        """Validate and set ``thresholds_``, ``weights_`` and ``initial_state_`` (eq. 18:
-        zero unless given)."""
-        r = check_thresholds(thresholds, "thresholds", owner)
-        self.thresholds_ = r
-        self.weights_ = as_vector(weights, "weights", owner, length=r.size)
-        if initial_state is None:
-            zeros = np.zeros(r.size)
-            zeros.setflags(write=False)
-            self.initial_state_ = zeros
-        else:
-            y = as_vector(initial_state, "initial_state", owner, length=r.size)
-            check_reachable_state(y, r, owner)
-            self.initial_state_ = y
-
-    def _set_offsets(self, owner: str, voltage_range, input_offset, output_offset) -> None:
-        """Validate and set ``voltage_range_``, ``input_offset_`` and ``output_offset_``."""
-        self.voltage_range_ = check_range(voltage_range, "voltage_range", owner)
-        self.input_offset_ = check_real(input_offset, "input_offset", owner)
-        self.output_offset_ = check_real(output_offset, "output_offset", owner)
 
     def _derived_hyperparameters(self) -> dict[str, Any]:
         return {"n_operators": int(self.thresholds_.size)}
@@ -335,6 +312,28 @@ class PrandtlIshlinskii(HysteresisModel):
         )
         compensator = Compensator(packed, kind=self.kind, voltage_range=(lo, hi))
         return compensator if dynamics is None else with_dynamics(self, compensator, dynamics)
+
+
+def _checked_plays(owner: str, thresholds, weights, initial_state) -> dict[str, np.ndarray]:
+    """The validated ``thresholds``, ``weights`` and ``initial_state`` of a chain's plays
+    (eq. 18: a zero state unless given)."""
+    r = check_thresholds(thresholds, "thresholds", owner)
+    w = as_vector(weights, "weights", owner, length=r.size)
+    if initial_state is None:
+        y = np.zeros(r.size)
+    else:
+        y = as_vector(initial_state, "initial_state", owner, length=r.size)
+        check_reachable_state(y, r, owner)
+    return {"thresholds": r, "weights": w, "initial_state": y}
+
+
+def _checked_offsets(owner: str, voltage_range, input_offset, output_offset) -> dict[str, Any]:
+    """The validated ``voltage_range``, ``input_offset`` and ``output_offset``."""
+    return {
+        "voltage_range": check_range(voltage_range, "voltage_range", owner),
+        "input_offset": check_real(input_offset, "input_offset", owner),
+        "output_offset": check_real(output_offset, "output_offset", owner),
+    }
 
 
 def thinned_record(v, x, fit) -> tuple[np.ndarray, np.ndarray, int]:

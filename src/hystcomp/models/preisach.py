@@ -228,8 +228,8 @@ class Preisach(HysteresisModel):
             )
         check_int(max_extrema, "max_extrema", owner, minimum=3, maximum=pk.MAX_DEPTH)
         model = cls(max_extrema=max_extrema)
-        model.voltage_range_ = check_range(voltage_range, "voltage_range", owner)
-        model.output_offset_ = check_real(output_offset, "output_offset", owner)
+        plane = check_range(voltage_range, "voltage_range", owner)
+        offset = check_real(output_offset, "output_offset", owner)
         if theta is not None:
             theta = as_vector(theta, "theta", owner)
             sizes = {pk.n_monomials(d): d for d in range(1, MAX_DEGREE + 1)}
@@ -241,11 +241,11 @@ class Preisach(HysteresisModel):
                 )
             model.degree = sizes[theta.size]
             model.everett = "polynomial"
-            model.theta_, model.table_ = theta, None
         else:
+            table = _check_table(table, owner)
             model.everett = "table"
-            model.theta_, model.table_ = None, _check_table(table, owner)
-            model.grid_size = model.table_.shape[0]
+            model.grid_size = table.shape[0]
+        model._set_learned(voltage_range=plane, output_offset=offset, theta=theta, table=table)
         model.voltage_range = None
         return model
 
@@ -303,10 +303,12 @@ class Preisach(HysteresisModel):
             zero_diagonal=self.zero_diagonal,
             fit_method=self.fit_method,
         )
-        self.theta_ = None if result.theta is None else _frozen(result.theta)
-        self.table_ = None if result.table is None else _frozen(result.table)
-        self.voltage_range_ = result.voltage_range
-        self.output_offset_ = result.output_offset
+        self._set_learned(
+            voltage_range=result.voltage_range,
+            output_offset=result.output_offset,
+            theta=None if result.theta is None else _frozen(result.theta),
+            table=None if result.table is None else _frozen(result.table),
+        )
         start = transient_end(v)
         # the same error figures as the PI and MPI reports, beside the fit's own
         report = {
