@@ -123,7 +123,7 @@ def packed_state_names(stepper) -> tuple[str, ...]:
     :mod:`~hystcomp._kernels.twin`)."""
     from hystcomp._kernels import chain, preisach
 
-    size = stepper._p.size - stepper._start
+    size = stepper.state.size
     if stepper.kernels is chain.CHAIN_KERNELS:
         fixed = [*_CHAIN_SLOTS, "step_work"]
         return tuple(fixed + _indexed("play", size - len(fixed)))
@@ -138,25 +138,26 @@ def _stepped(
 ) -> DiscreteSystem:
     """A packed system (any :class:`~hystcomp.models.system.Stepper`) as a DiscreteSystem.
 
-    The state is the packed array's state part, from ``kernels.state_start`` to its end; one
-    step of the stepper's own kernel gives both the output and the next state.
+    The state is the stepper's :attr:`~hystcomp.models.system.Stepper.state`, the packed
+    array's state part; one step of the stepper's own kernel gives both the output and the
+    next state. ``stepper`` is this system's own (made for it, at its initial state): the
+    two functions set its state, step it and read it.
     """
-    start = stepper._start
-    work = stepper._p  # this private stepper is the scratch space of the two functions
+    initial = stepper.state
 
     def step(s: np.ndarray, u: np.ndarray) -> float:
-        work[start:] = s
+        stepper.state = s
         return stepper.step(float(np.ravel(u)[0]))
 
     def update(s, u):
         step(s, u)
-        return work[start:].copy()
+        return stepper.state
 
     def output(s, u):
         return step(s, u)
 
     return DiscreteSystem(
-        state=np.array(stepper._initial[start:]),
+        state=initial,
         update=update,
         output=output,
         inputs=inputs,
@@ -189,16 +190,19 @@ def _stepped_axes(stepper, model: bool) -> DiscreteSystem:
 def _twin(twin, dt: float) -> DiscreteSystem:
     """The simulated axis: the kernel of ``Twin.run``, the sensor noise drawn per sample.
 
-    The state is the axis's state, then a sample counter; the noise of sample ``k`` comes from
-    a generator seeded with the twin's seed, so a response is reproducible whatever python-
-    control evaluates. The sensor reads the axis before the sample's voltage acts, so the
-    output does not depend on the input (no algebraic loop in feedback).
+    The state is the axis's state (that of its noiseless stepper), then a sample counter; the
+    noise of sample ``k`` comes from a generator seeded with the twin's seed, so a response
+    is reproducible whatever python-control evaluates. The sensor reads the axis before the
+    sample's voltage acts, so the output does not depend on the input (no algebraic loop in
+    feedback).
     """
     from hystcomp._kernels import twin as kernels
 
     _check_rate(dt, twin.sample_rate, "the twin's", "build a Twin with another sample_rate instead")
     params = twin.params
     sigma = params.sensor_noise / params.sensor_gain
+    stepper = twin.stepper(noise=False)  # the displacement and the offset: noise added below
+    rest = stepper.state
     rng = np.random.default_rng(twin.seed)
     noise = np.empty(0)
 
@@ -209,19 +213,19 @@ def _twin(twin, dt: float) -> DiscreteSystem:
         return float(noise[k])
 
     def update(s, u):
-        nxt = s.copy()
-        kernels.axis_step(twin._p, nxt[:-1], float(np.ravel(u)[0]))
-        nxt[-1] += 1.0
-        return nxt
+        stepper.state = s[:-1]
+        stepper.step(float(np.ravel(u)[0]))
+        return np.append(stepper.state, s[-1] + 1.0)
 
     def output(s, u):
         # the reading before u acts: the input does not matter
-        x = kernels.axis_step(twin._p, s[:-1].copy(), float(np.ravel(u)[0]))
-        return x + params.sensor_offset + sigma * noise_at(int(s[-1]))
+        stepper.state = s[:-1]
+        x = stepper.step(float(np.ravel(u)[0]))
+        return x + sigma * noise_at(int(s[-1]))
 
-    n_creep = twin._rest.size - kernels.S_CREEP
+    n_creep = rest.size - kernels.S_CREEP
     return DiscreteSystem(
-        state=np.append(twin._rest, 0.0),
+        state=np.append(rest, 0.0),
         update=update,
         output=output,
         inputs=("v",),
@@ -299,26 +303,25 @@ def _dynamic_compensator(obj, dt: float) -> DiscreteSystem:
     if obj.sample_rate is not None:
         _check_rate(dt, obj.sample_rate, "the dynamics'", "identify them at the loop's rate")
     stepper = obj.stepper()
-    dyn, hyst = stepper._dyn, stepper._hyst
-    n_dyn, start = dyn._p.size, hyst._start
+    initial = stepper.state
+    n_dyn = stepper.dynamics_inverse.state.size
 
     def step(s: np.ndarray, u: np.ndarray) -> float:
-        dyn._p[:] = s[:n_dyn]
-        hyst._p[start:] = s[n_dyn:]
+        stepper.state = s
         return stepper.step(float(np.ravel(u)[0]))
 
     def update(s, u):
         step(s, u)
-        return np.concatenate([dyn._p, hyst._p[start:]])
+        return stepper.state
 
     return DiscreteSystem(
-        state=np.concatenate([dyn._initial, hyst._initial[start:]]),
+        state=initial,
         update=update,
         output=step,
         inputs=("x_ref",),
         outputs=("v",),
         name=f"inverse_dynamics_{obj.kind}",
-        states=(*_indexed("inverse_dynamics", n_dyn), *packed_state_names(hyst)),
+        states=(*_indexed("inverse_dynamics", n_dyn), *packed_state_names(stepper.hysteresis)),
     )
 
 

@@ -34,6 +34,7 @@ from hystcomp.errors import InvalidParameterError, InvalidSignalError, InvalidTy
 from hystcomp.models.base import HysteresisModel
 from hystcomp.models.compensator import Compensator
 from hystcomp.models.multiaxis import as_axes, fit_axis
+from hystcomp.models.system import checked_state
 
 __all__ = ["BankStepper", "ChannelBank", "fit_channels"]
 
@@ -242,20 +243,22 @@ class BankStepper:
 
     @property
     def state(self) -> np.ndarray:
-        """Every group's play states and counters, concatenated (a copy)."""
+        """Every group's play states and counters, concatenated (a copy); set it to go back
+        to a saved state (see :attr:`Stepper.state <hystcomp.models.system.Stepper.state>`).
+
+        Returns
+        -------
+        ndarray
+            1-D float64.
+        """
         return np.concatenate(
             [a.ravel() for pair in zip(self._plays, self._counters, strict=True) for a in pair]
         )
 
     @state.setter
     def state(self, value) -> None:
-        value = np.asarray(value, dtype=np.float64).ravel()
         arrays = [a for pair in zip(self._plays, self._counters, strict=True) for a in pair]
-        if value.size != sum(a.size for a in arrays):
-            raise InvalidParameterError(
-                f"The state of this BankStepper has {sum(a.size for a in arrays)} values. Got "
-                f"{value.size}; take it from .state."
-            )
+        value = checked_state(np.ravel(value), sum(a.size for a in arrays), self)
         at = 0
         for a in arrays:
             a.ravel()[:] = value[at : at + a.size]

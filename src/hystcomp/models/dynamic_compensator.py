@@ -19,7 +19,14 @@ from hystcomp._kernels._jit import step_function
 from hystcomp._validation import as_signal, as_vector, check_int
 from hystcomp.errors import InvalidSignalError
 from hystcomp.models.compensator import CompensatorRun
-from hystcomp.models.system import Rebound, block, checked_pair_step, checked_step
+from hystcomp.models.system import (
+    Rebound,
+    Stepper,
+    block,
+    checked_pair_step,
+    checked_state,
+    checked_step,
+)
 
 #: Frequency (Hz) at which a hysteresis compensator and the inverse of the dynamics are
 #: matched in :func:`with_dynamics`: that of the paper's identification signals.
@@ -177,6 +184,7 @@ class DynamicsInverseStepper(Rebound):
     def __init__(self, packed: np.ndarray, preview: int):
         self._initial = packed
         self._p = packed.copy()
+        self._start = int(dk.state_start.py_func(packed))
         self.preview = preview
         self._bind()
 
@@ -228,10 +236,33 @@ class DynamicsInverseStepper(Rebound):
         return int(self._p[dk.clamped_slot.py_func(self._p)])
 
     def copy(self) -> DynamicsInverseStepper:
-        """An independent stepper in the same state."""
+        """An independent stepper in the same state.
+
+        Returns
+        -------
+        DynamicsInverseStepper
+            A copy whose state is its own: stepping one leaves the other as it is.
+        """
         other = type(self)(self._initial, self.preview)
         other._p[:] = self._p
         return other
+
+    @property
+    def state(self) -> np.ndarray:
+        """The filter's state: its delay line, its creep lags and its count (a copy); set it
+        to go back to a saved state (see :attr:`Stepper.state
+        <hystcomp.models.system.Stepper.state>`).
+
+        Returns
+        -------
+        ndarray
+            1-D float64, a copy.
+        """
+        return self._p[self._start :].copy()
+
+    @state.setter
+    def state(self, value) -> None:
+        self._p[self._start :] = checked_state(value, self._p.size - self._start, self)
 
 
 class DynamicCompensator:
@@ -351,8 +382,44 @@ class DynamicStepper(Rebound):
         self._hyst.reset()
 
     def copy(self) -> DynamicStepper:
-        """An independent stepper in the same state."""
+        """An independent stepper in the same state.
+
+        Returns
+        -------
+        DynamicStepper
+            A copy of both stages: stepping one stepper leaves the other as it is.
+        """
         return type(self)(self._dyn.copy(), self._hyst.copy())
+
+    @property
+    def dynamics_inverse(self) -> DynamicsInverseStepper:
+        """The first stage, the inverse filter of the dynamics (it steps with this stepper)."""
+        return self._dyn
+
+    @property
+    def hysteresis(self) -> Stepper:
+        """The second stage, the hysteresis compensator's stepper (it steps with this one)."""
+        return self._hyst
+
+    @property
+    def state(self) -> np.ndarray:
+        """Both stages' states: the filter's (:attr:`dynamics_inverse`), then the hysteresis
+        compensator's (:attr:`hysteresis`), as a copy; set it to go back to a saved state
+        (see :attr:`Stepper.state <hystcomp.models.system.Stepper.state>`).
+
+        Returns
+        -------
+        ndarray
+            1-D float64, a copy.
+        """
+        return np.concatenate([self._dyn.state, self._hyst.state])
+
+    @state.setter
+    def state(self, value) -> None:
+        n_dyn = self._dyn.state.size
+        value = checked_state(value, n_dyn + self._hyst.state.size, self)
+        self._dyn.state = value[:n_dyn]
+        self._hyst.state = value[n_dyn:]
 
     @property
     def nonfinite_count(self) -> int:

@@ -38,6 +38,7 @@ from hystcomp.models.estimator import Estimator
 from hystcomp.models.mpi import ModifiedPrandtlIshlinskii
 from hystcomp.models.pi import PrandtlIshlinskii
 from hystcomp.models.preisach import Preisach
+from hystcomp.models.system import checked_state
 
 __all__ = [
     "AXIS_KINDS",
@@ -617,18 +618,20 @@ class MultiAxisStepper:
 
     @property
     def state(self) -> np.ndarray:
-        """The axes' states, concatenated (a copy)."""
+        """The axes' states, concatenated (a copy); set it to go back to a saved state (see
+        :attr:`Stepper.state <hystcomp.models.system.Stepper.state>`).
+
+        Returns
+        -------
+        ndarray
+            1-D float64: axis 1's state, then axis 2's, ...
+        """
         return np.concatenate([s.state for s in self._steppers])
 
     @state.setter
     def state(self, value) -> None:
-        value = np.asarray(value, dtype=np.float64)
         sizes = [s.state.size for s in self._steppers]
-        if value.shape != (sum(sizes),):
-            raise InvalidParameterError(
-                f"The state of this MultiAxisStepper has {sum(sizes)} values. Got shape "
-                f"{value.shape}; take it from .state."
-            )
+        value = checked_state(value, sum(sizes), self)
         for s, part in zip(self._steppers, np.split(value, np.cumsum(sizes)[:-1]), strict=True):
             s.state = part
 

@@ -219,6 +219,18 @@ def fast_block(kernel, p, work, checked):
     return step_block
 
 
+def checked_state(value, size: int, stepper: object) -> np.ndarray:
+    """``value`` as the state of ``stepper``, a 1-D array of ``size`` floats, or raise (for
+    the ``state`` setters of the steppers)."""
+    value = np.asarray(value, dtype=np.float64)
+    if value.shape != (size,):
+        raise InvalidParameterError(
+            f"The state of this {type(stepper).__name__} has {size} values. Got shape "
+            f"{value.shape}; take it from .state."
+        )
+    return value
+
+
 class Rebound(ABC):
     """Steppers whose fast ``step`` is a closure over their state, bound by ``_bind``.
 
@@ -355,25 +367,42 @@ class Stepper(Rebound):
         self._p[:] = self._initial
 
     def copy(self) -> Stepper:
-        """An independent stepper in the same state."""
+        """An independent stepper in the same state.
+
+        Returns
+        -------
+        Stepper
+            A stepper of the same class and system, whose state is a copy of this one's:
+            stepping one leaves the other as it is.
+        """
         twin = type(self)(self._initial)
         twin._p[:] = self._p
         return twin
 
     @property
     def state(self) -> np.ndarray:
-        """The state part of the packed system (a copy): get it, and set it back later."""
+        """The stepper's state: the state part of its packed system, as a copy.
+
+        Get it to save where the stepper is, and set it (an array of the same size, from
+        ``.state`` of this stepper or of another of the same system) to go back there: the
+        next steps then give the outputs they gave after the state was taken, bit for bit.
+        The counters (:attr:`nonfinite_count`, :attr:`clamped_count`) are part of it.
+
+        Returns
+        -------
+        ndarray
+            1-D float64, a copy (changing it changes nothing in the stepper).
+
+        Raises
+        ------
+        InvalidParameterError
+            On setting, if the array does not have the state's size.
+        """
         return self._p[self._start :].copy()
 
     @state.setter
     def state(self, value) -> None:
-        value = np.asarray(value, dtype=np.float64)
-        if value.shape != (self._p.size - self._start,):
-            raise InvalidParameterError(
-                f"The state of this {type(self).__name__} has {self._p.size - self._start} "
-                f"values. Got shape {value.shape}; take it from .state."
-            )
-        self._p[self._start :] = value
+        self._p[self._start :] = checked_state(value, self._p.size - self._start, self)
 
     @property
     def nonfinite_count(self) -> int:

@@ -119,9 +119,21 @@ class Twin:
         k.hysteresis_run(self._packed.copy(), u, out)
         return out
 
-    def stepper(self) -> TwinStepper:
-        """A streaming twin, one sample per call, with its own noise generator."""
-        return TwinStepper(self._packed, self.params, self._rng.spawn(1)[0])
+    def stepper(self, *, noise: bool = True) -> TwinStepper:
+        """A streaming twin, one sample per call, at rest.
+
+        Parameters
+        ----------
+        noise : bool, default True
+            Add the sensor's noise, from a generator of its own (spawned from the twin's);
+            False reads the displacement without noise (the offset is still added), and
+            leaves the twin's generator as it was.
+
+        Returns
+        -------
+        TwinStepper
+        """
+        return TwinStepper(self._packed, self.params, self._rng.spawn(1)[0] if noise else None)
 
     def _noise(self, n: int) -> np.ndarray:
         sigma = self.params.sensor_noise / self.params.sensor_gain
@@ -144,7 +156,7 @@ class TwinStepper(Stepper):
 
     kernels = k.TWIN_KERNELS
 
-    def __init__(self, packed, params: TwinParameters, rng: np.random.Generator):
+    def __init__(self, packed, params: TwinParameters, rng: np.random.Generator | None):
         super().__init__(packed)
         self._params = params
         self._offset = params.sensor_offset
@@ -165,20 +177,25 @@ class TwinStepper(Stepper):
     def step(self, v: float) -> float:
         """Apply one command sample (V) and return the measured displacement (µm)."""
         v = check_real(v, "v", "TwinStepper.step")
-        return self._kernel(self._p, v) + self._offset + self._sigma * self._rng.normal()
+        x = self._kernel(self._p, v) + self._offset
+        return x if self._rng is None else x + self._sigma * self._rng.normal()
 
     def step_block(self, v, out=None) -> np.ndarray:
         """Apply a block of command samples and return the measured displacements (into
         ``out`` if given, as :meth:`Stepper.step_block <hystcomp.models.system.Stepper.step_block>`)."""
         u = as_signal(v, "v")
         x = super().step_block(u, out)
-        x += self._offset + self._sigma * self._rng.standard_normal(u.size)
+        if self._rng is None:
+            x += self._offset
+        else:
+            x += self._offset + self._sigma * self._rng.standard_normal(u.size)
         return x
 
     def copy(self) -> TwinStepper:
         """An independent stepper in the same state, with a noise generator spawned from this
         one's."""
-        twin = type(self)(self._initial, self._params, self._rng.spawn(1)[0])
+        rng = None if self._rng is None else self._rng.spawn(1)[0]
+        twin = type(self)(self._initial, self._params, rng)
         twin._p[:] = self._p
         return twin
 
