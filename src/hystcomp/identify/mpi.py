@@ -103,12 +103,16 @@ import numpy as np
 from hystcomp import paper
 from hystcomp._hyperparameters import (
     DEFAULT_MARGIN,
-    check_constraints,
-    check_margin,
-    check_operator_count,
-    check_regularization,
+    FIT_CONSTRAINTS,
+    MARGIN,
+    OPERATOR_COUNT,
+    REGULARIZATION,
+    Constraint,
+    Each,
+    Integer,
+    validate_parameters,
 )
-from hystcomp._validation import as_vector, check_int, check_real
+from hystcomp._validation import as_vector, check_real
 from hystcomp.errors import InvalidParameterError
 from hystcomp.identify.lsq import RIDGE, constrained_lsq_path, held_out_fits, normal_equations
 from hystcomp.identify.pi import (
@@ -265,6 +269,17 @@ def fit_mpi(
     return fit
 
 
+#: The options of :func:`fit_mpi_path` checked at its boundary.
+FIT_MPI_OPTIONS: dict[str, Constraint] = {
+    "n_operators": OPERATOR_COUNT,
+    "n_deadzones": OPERATOR_COUNT,
+    "margin": MARGIN,
+    "constraints": FIT_CONSTRAINTS,
+    "regularizations": Each(REGULARIZATION, "regularization", "value >= 0"),
+    "n_folds": Integer(0),
+}
+
+
 def fit_mpi_path(
     v,
     x,
@@ -308,17 +323,10 @@ def fit_mpi_path(
         One fit per initial memory and value of ``regularizations``, memory by memory.
     """
     owner = "fit_mpi"
-    n = check_operator_count(n_operators, "n_operators", owner)
-    m = check_operator_count(n_deadzones, "n_deadzones", owner)
-    margin = check_margin(margin, owner)
-    constraints = check_constraints(constraints, owner)
-    penalties = [check_regularization(value, owner) for value in regularizations]
-    if not penalties:
-        raise InvalidParameterError(
-            f"The 'regularizations' parameter of {owner} must hold at least one value >= 0. "
-            "Got an empty sequence instead."
-        )
-    n_folds = check_int(n_folds, "n_folds", owner, minimum=0)
+    options = validate_parameters(FIT_MPI_OPTIONS, locals(), owner, fitting=True)
+    n, m, margin = options["n_operators"], options["n_deadzones"], options["margin"]
+    constraints, penalties = options["constraints"], options["regularizations"]
+    n_folds = options["n_folds"]
     memories = [check_initial_memory(memory) for memory in initial_memories]
     rec = prepare_record(v, x, n_weights=n + m, transient=transient, owner=owner)
     r = play_thresholds(n, rec.input_span, constraints)

@@ -55,9 +55,12 @@ import numpy as np
 from hystcomp import paper
 from hystcomp._hyperparameters import (
     DEFAULT_MARGIN,
-    check_constraints,
-    check_margin,
-    check_operator_count,
+    FIT_CONSTRAINTS,
+    MARGIN,
+    OPERATOR_COUNT,
+    Constraint,
+    Integer,
+    validate_parameters,
 )
 from hystcomp._validation import as_signal, check_int, check_real
 from hystcomp.errors import IdentificationError, InvalidParameterError, InvalidSignalError
@@ -254,6 +257,15 @@ class PIFit:
     held_out: tuple = ()
 
 
+#: The options of :func:`fit_pi` checked at its boundary (the record's, by prepare_record).
+FIT_PI_OPTIONS: dict[str, Constraint] = {
+    "n_operators": OPERATOR_COUNT,
+    "margin": MARGIN,
+    "constraints": FIT_CONSTRAINTS,
+    "n_folds": Integer(0),
+}
+
+
 def fit_pi(
     v,
     x,
@@ -309,10 +321,9 @@ def fit_pi(
     ([0.5, 0.0], 2.0)
     """
     owner = "fit_pi"
-    n = check_operator_count(n_operators, "n_operators", owner)
-    margin = check_margin(margin, owner)
-    constraints = check_constraints(constraints, owner)
-    n_folds = check_int(n_folds, "n_folds", owner, minimum=0)
+    options = validate_parameters(FIT_PI_OPTIONS, locals(), owner, fitting=True)
+    n, margin = options["n_operators"], options["margin"]
+    constraints, n_folds = options["constraints"], options["n_folds"]
     rec = prepare_record(
         v, x, n_weights=n + 1, transient=transient, owner=owner, weighted=constraints == "physical"
     )

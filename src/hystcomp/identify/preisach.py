@@ -22,7 +22,15 @@ from typing import NamedTuple
 
 import numpy as np
 
-from hystcomp._hyperparameters import check_options
+from hystcomp._hyperparameters import (
+    DEGREE,
+    EVERETT,
+    GRID_SIZE,
+    ZERO_DIAGONAL,
+    Constraint,
+    Options,
+    validate_parameters,
+)
 from hystcomp._kernels import preisach as pk
 from hystcomp._validation import as_signal, check_range, check_real
 from hystcomp.errors import (
@@ -305,6 +313,16 @@ def fit_everett_table(alpha, beta, value, *, grid_size: int, voltage_range) -> n
     return pk.antisymmetric_table(lower)
 
 
+#: The options of :func:`identify_preisach` checked at its boundary.
+IDENTIFY_PREISACH_OPTIONS: dict[str, Constraint] = {
+    "degree": DEGREE,
+    "everett": EVERETT,
+    "grid_size": GRID_SIZE,
+    "zero_diagonal": ZERO_DIAGONAL,
+    "fit_method": Options(FIT_METHODS),
+}
+
+
 def identify_preisach(
     v,
     x,
@@ -362,12 +380,8 @@ def identify_preisach(
         curve or too few; for least squares, an input that does not move.
     """
     owner = "identify_preisach"
-    degree, grid_size = check_options(degree, everett, grid_size, zero_diagonal, owner)
-    if fit_method not in FIT_METHODS:
-        raise InvalidParameterError(
-            f"The 'fit_method' parameter of {owner} must be one of "
-            f"{', '.join(map(repr, FIT_METHODS))}. Got {fit_method!r} instead."
-        )
+    options = validate_parameters(IDENTIFY_PREISACH_OPTIONS, locals(), owner, fitting=True)
+    degree, grid_size = options["degree"], options["grid_size"]
     v = as_signal(v, "v", min_samples=3)  # writable: the kernels compile for one array type
     x = as_signal(x, "x", min_samples=3)
     check_isolated(v, owner)  # one glitch would set the Preisach plane

@@ -9,11 +9,12 @@ reachable displacements.
 from __future__ import annotations
 
 from abc import abstractmethod
-from typing import TYPE_CHECKING, Any, Self
+from typing import TYPE_CHECKING, Any, ClassVar, Self
 
 import numpy as np
 
 from hystcomp import paper
+from hystcomp._hyperparameters import VOLTAGE_RANGE, Constraint
 from hystcomp._validation import check_range, check_real
 from hystcomp.errors import InvalidParameterError
 from hystcomp.models.estimator import Estimator
@@ -49,6 +50,7 @@ class HysteresisModel(PackedSystem, Estimator):
 
     voltage_range: Any  # the hyperparameter, stored as given
     voltage_range_: tuple[float, float]
+    _parameter_constraints: ClassVar[dict[str, Constraint]] = {"voltage_range": VOLTAGE_RANGE}
 
     @abstractmethod
     def fit(self, v, x) -> Self:
@@ -88,12 +90,6 @@ class HysteresisModel(PackedSystem, Estimator):
         Compensator or DynamicCompensator
             The compensator, clamped to the voltage range.
         """
-
-    def _check_hyperparameters(self) -> None:
-        """Validate every hyperparameter's type and value, as ``fit`` does (and raise)."""
-        super()._check_hyperparameters()
-        if self.voltage_range is not None:
-            check_range(self.voltage_range, "voltage_range", type(self).__name__)
 
     def _clamp_range(self, voltage_range, owner: str) -> tuple[float, float]:
         """The compensator's clamp: ``voltage_range_``, or a ``voltage_range`` inside it.
@@ -188,9 +184,10 @@ def input_range_report(v) -> dict[str, list[float]]:
     return {INPUT_RANGE_KEY: [float(v.min()), float(v.max())]}
 
 
-def fit_voltage_range(voltage_range, v, owner) -> tuple[float, float]:
-    """The ``voltage_range`` hyperparameter, or the data's ``(min v, max v)`` if it is None."""
+def fit_voltage_range(voltage_range, v) -> tuple[float, float]:
+    """The checked ``voltage_range`` hyperparameter, or the data's ``(min v, max v)`` if it
+    is None."""
     if voltage_range is None:
         v = np.asarray(v, dtype=np.float64)
         return float(v.min()), float(v.max())
-    return check_range(voltage_range, "voltage_range", owner)
+    return voltage_range

@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING, Any, ClassVar, Self, TypeVar
 import numpy as np
 
 from hystcomp._blas import one_blas_thread
+from hystcomp._hyperparameters import Constraint, validate_parameters
 from hystcomp._validation import as_signal_pair
 from hystcomp.errors import (
     InvalidParameterError,
@@ -152,6 +153,10 @@ class Estimator:
 
     kind: ClassVar[str]
     _learned: ClassVar[tuple[str, ...]]
+    #: Each hyperparameter's constraint (:mod:`hystcomp._hyperparameters`), declared once
+    #: per class and checked by :meth:`_check_hyperparameters`; every hyperparameter of
+    #: ``__init__`` has one (checked when the class is made).
+    _parameter_constraints: ClassVar[dict[str, Constraint]] = {}
     #: Learned attributes computed from those of ``_learned`` (not in the model file).
     _learned_derived: ClassVar[tuple[str, ...]] = ()
     fit_report_: dict[str, Any]
@@ -200,12 +205,43 @@ class Estimator:
         from the thresholds), with their values; a model file must agree with them."""
         return {}
 
-    def _check_hyperparameters(self) -> None:
-        """Validate every hyperparameter's type and value, as ``fit`` does (and raise).
+    def __init_subclass__(cls, **kwargs: Any) -> None:
+        super().__init_subclass__(**kwargs)
+        if "__init__" in cls.__dict__:  # a concrete estimator: a constraint per hyperparameter
+            names, declared = set(cls._get_param_names()), set(cls._parameter_constraints)
+            if names != declared:  # a programming error in the class, found at import
+                raise TypeError(
+                    f"{cls.__name__}._parameter_constraints must declare exactly the "
+                    f"hyperparameters of __init__; missing {sorted(names - declared)}, "
+                    f"unknown {sorted(declared - names)}."
+                )
 
-        Subclasses extend it for their own; ``fit`` and ``from_dict`` both call it, so a
-        new hyperparameter is checked on both paths once it is checked here.
+    def _check_hyperparameters(self, *, fitting: bool = False) -> dict[str, Any]:
+        """Validate every hyperparameter against ``_parameter_constraints`` (and raise).
+
+        ``fit`` and ``from_dict`` both call it, so a hyperparameter is checked on both
+        paths once its constraint is declared.
+
+        Parameters
+        ----------
+        fitting : bool, default False
+            The values are about to be used by a fit, which may bound them more tightly.
+
+        Returns
+        -------
+        dict
+            The checked hyperparameters by name (ints of NumPy integers, ranges as pairs
+            of floats); the attributes themselves stay as given, as in scikit-learn.
         """
+        return validate_parameters(
+            self._parameter_constraints, self.get_params(), type(self).__name__, fitting=fitting
+        )
+
+    def _checked(self, name: str) -> Any:
+        """One hyperparameter, checked against its declared constraint."""
+        return self._parameter_constraints[name].check(
+            getattr(self, name), name, type(self).__name__, False
+        )
 
     def get_params(self, deep: bool = True) -> dict[str, Any]:
         """The hyperparameters, as given to ``__init__`` (scikit-learn's contract).

@@ -6,14 +6,18 @@ after the plays; only that stage and the fit of eq. (19) are written here.
 
 from __future__ import annotations
 
-from typing import Any, Self
+from typing import Any, ClassVar, Self
 
 import numpy as np
 
 from hystcomp import paper
-from hystcomp._hyperparameters import check_operator_count, check_regularization_option
-from hystcomp._validation import as_vector, check_int, check_thresholds
-from hystcomp.errors import InvalidParameterError
+from hystcomp._hyperparameters import (
+    OPERATOR_COUNT,
+    REGULARIZATION_OPTION,
+    Constraint,
+    Options,
+)
+from hystcomp._validation import as_vector, check_thresholds
 from hystcomp.identify.compensation import CV_FOLDS, tracking_scorer
 from hystcomp.identify.mpi import REGULARIZATION_GRID, fit_mpi_path
 from hystcomp.identify.pi import INITIAL_MEMORIES
@@ -120,6 +124,14 @@ class ModifiedPrandtlIshlinskii(PrandtlIshlinskii):
         "input_offset",
         "output_offset",
     )
+    _parameter_constraints: ClassVar[dict[str, Constraint]] = {
+        **PrandtlIshlinskii._parameter_constraints,
+        "n_deadzones": OPERATOR_COUNT,
+        "regularization": REGULARIZATION_OPTION,
+        "initial_memory": Options(
+            ("auto", *INITIAL_MEMORIES), wording=f"'auto' or one of {INITIAL_MEMORIES}"
+        ),
+    }
     deadzone_thresholds_: np.ndarray
     deadzone_weights_: np.ndarray
 
@@ -162,32 +174,30 @@ class ModifiedPrandtlIshlinskii(PrandtlIshlinskii):
         ModifiedPrandtlIshlinskii
             ``self``, fitted.
         """
-        owner = type(self).__name__
-        self._check_hyperparameters()
-        n = check_operator_count(self.n_operators, "n_operators", owner)
-        m = check_operator_count(self.n_deadzones, "n_deadzones", owner)
-        penalties = self._penalties(owner)
+        params = self._check_hyperparameters(fitting=True)
+        regularization = params["regularization"]
+        penalties = REGULARIZATION_GRID if regularization == "auto" else (regularization,)
         # eq. 18's virgin plays, and with the physical constraints the descended ones too
-        if self.initial_memory != "auto":
-            memories: tuple[str, ...] = (self.initial_memory,)
+        if params["initial_memory"] != "auto":
+            memories: tuple[str, ...] = (params["initial_memory"],)
         else:
-            memories = INITIAL_MEMORIES if self.constraints == "physical" else ("virgin",)
+            memories = INITIAL_MEMORIES if params["constraints"] == "physical" else ("virgin",)
         fits = fit_mpi_path(
             v,
             x,
-            n_operators=n,
-            n_deadzones=m,
-            transient=self.transient,
-            margin=self.margin,
+            n_operators=params["n_operators"],
+            n_deadzones=params["n_deadzones"],
+            transient=params["transient"],
+            margin=params["margin"],
             regularizations=penalties,
-            constraints=self.constraints,
+            constraints=params["constraints"],
             n_folds=CV_FOLDS,
             initial_memories=memories,
         )
         # scored on the samples the fit used (a long record is thinned, see fit_mpi_path);
         # they hold the extremes of the input
         v_k, x_k, first = thinned_record(v, x, fits[0])
-        voltage_range = fit_voltage_range(self.voltage_range, v_k, owner)
+        voltage_range = fit_voltage_range(params["voltage_range"], v_k)
         score = tracking_scorer(v_k, x_k, start=first, folds=fits[0].folds)
         candidates = []
         for fit in fits:
@@ -215,11 +225,6 @@ class ModifiedPrandtlIshlinskii(PrandtlIshlinskii):
         model = type(self)(n_operators=fit.thresholds.size, n_deadzones=rs.size, voltage_range=None)
         model._set_fitted(fit, voltage_range, deadzone_thresholds=rs, deadzone_weights=ws)
         return model
-
-    def _penalties(self, owner: str) -> tuple[float, ...]:
-        """The regularisation values to fit: the grid for ``"auto"``, else the one given."""
-        value = check_regularization_option(self.regularization, owner)
-        return REGULARIZATION_GRID if isinstance(value, str) else (value,)
 
     @classmethod
     def from_parameters(  # type: ignore[override]  # S's dead-zones are required
@@ -251,17 +256,6 @@ class ModifiedPrandtlIshlinskii(PrandtlIshlinskii):
             **super()._derived_hyperparameters(),
             "n_deadzones": int(self.deadzone_thresholds_.size),
         }
-
-    def _check_hyperparameters(self) -> None:
-        super()._check_hyperparameters()
-        owner = type(self).__name__
-        check_int(self.n_deadzones, "n_deadzones", owner)
-        check_regularization_option(self.regularization, owner)
-        if self.initial_memory not in ("auto", *INITIAL_MEMORIES):
-            raise InvalidParameterError(
-                f"The 'initial_memory' parameter of {owner} must be 'auto' or one of "
-                f"{INITIAL_MEMORIES}. Got {self.initial_memory!r} instead."
-            )
 
     def _saturation(self) -> tuple[np.ndarray, np.ndarray]:
         return self.deadzone_thresholds_, self.deadzone_weights_

@@ -22,6 +22,16 @@ from typing import Any, ClassVar, NamedTuple, Self
 
 import numpy as np
 
+from hystcomp._hyperparameters import (
+    Boolean,
+    Constraint,
+    InstanceOf,
+    Integer,
+    Nullable,
+    Options,
+    TextOr,
+    Unchecked,
+)
 from hystcomp._kernels.multiaxis import mix_rows
 from hystcomp._validation import MAX_MAGNITUDE, check_range
 from hystcomp.errors import (
@@ -206,6 +216,22 @@ class MultiAxisModel(Estimator):
     kind: ClassVar[str] = "multiaxis"
     _learned: ClassVar[tuple[str, ...]] = ("axes", "coupling")
     _learned_derived: ClassVar[tuple[str, ...]] = ("decoupling",)
+    _parameter_constraints: ClassVar[dict[str, Constraint]] = {
+        "family": TextOr(
+            Options(
+                ("auto", *AXIS_KINDS),
+                wording="'auto', 'pi', 'mpi', 'preisach' or an unfitted estimator",
+            ),
+            InstanceOf(
+                HysteresisModel,
+                "'auto', 'pi', 'mpi', 'preisach' or an unfitted estimator such as "
+                "PrandtlIshlinskii(n_operators=8)",
+            ),
+        ),
+        "coupling": Boolean(),
+        "voltage_range": Unchecked(),  # one pair or one per axis: fit knows the axes
+        "n_jobs": Nullable(Integer(None, nonzero=True, wording="None, -1 or an int >= 1")),
+    }
     axes_: tuple[HysteresisModel, ...]
     coupling_: np.ndarray
     decoupling_: np.ndarray
@@ -217,36 +243,6 @@ class MultiAxisModel(Estimator):
         self.n_jobs = n_jobs
 
     # -- hyperparameters -------------------------------------------------------------------
-
-    def _check_hyperparameters(self) -> None:
-        owner = type(self).__name__
-        family = self.family
-        if isinstance(family, str):
-            if family != "auto" and family not in AXIS_KINDS:
-                raise InvalidParameterError(
-                    f"The 'family' parameter of {owner} must be 'auto', 'pi', 'mpi', 'preisach' "
-                    f"or an unfitted estimator. Got {family!r} instead."
-                )
-        elif not isinstance(family, HysteresisModel):
-            raise InvalidParameterError(
-                f"The 'family' parameter of {owner} must be 'auto', 'pi', 'mpi', 'preisach' or "
-                f"an unfitted estimator such as PrandtlIshlinskii(n_operators=8). Got "
-                f"{type(family).__name__}."
-            )
-        if not isinstance(self.coupling, bool | np.bool_):
-            raise InvalidParameterError(
-                f"The 'coupling' parameter of {owner} must be True or False. Got "
-                f"{self.coupling!r} instead."
-            )
-        if self.n_jobs is not None and (
-            not isinstance(self.n_jobs, int | np.integer)
-            or isinstance(self.n_jobs, bool)
-            or self.n_jobs == 0
-        ):
-            raise InvalidParameterError(
-                f"The 'n_jobs' parameter of {owner} must be None, -1 or an int >= 1. Got "
-                f"{self.n_jobs!r} instead."
-            )
 
     def _axis_ranges(self, n_axes: int) -> list[tuple[float, float] | None]:
         """The ``voltage_range`` hyperparameter as one pair (or None) per axis."""

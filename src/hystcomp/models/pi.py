@@ -13,11 +13,16 @@ from typing import Any, ClassVar, Self
 import numpy as np
 
 from hystcomp import paper
-from hystcomp._hyperparameters import check_constraints, check_margin, check_operator_count
+from hystcomp._hyperparameters import (
+    FIT_CONSTRAINTS,
+    MARGIN,
+    OPERATOR_COUNT,
+    TRANSIENT,
+    Constraint,
+)
 from hystcomp._kernels import chain
 from hystcomp._validation import (
     as_vector,
-    check_int,
     check_range,
     check_reachable_state,
     check_real,
@@ -114,6 +119,13 @@ class PrandtlIshlinskii(HysteresisModel):
         "input_offset",
         "output_offset",
     )
+    _parameter_constraints: ClassVar[dict[str, Constraint]] = {
+        **HysteresisModel._parameter_constraints,
+        "n_operators": OPERATOR_COUNT,
+        "transient": TRANSIENT,
+        "margin": MARGIN,
+        "constraints": FIT_CONSTRAINTS,
+    }
     thresholds_: np.ndarray
     weights_: np.ndarray
     initial_state_: np.ndarray
@@ -153,21 +165,19 @@ class PrandtlIshlinskii(HysteresisModel):
         PrandtlIshlinskii
             ``self``, fitted.
         """
-        owner = type(self).__name__
-        self._check_hyperparameters()
-        n = check_operator_count(self.n_operators, "n_operators", owner)
+        params = self._check_hyperparameters(fitting=True)
         fit = fit_pi(
             v,
             x,
-            n_operators=n,
-            transient=self.transient,
-            margin=self.margin,
-            constraints=self.constraints,
+            n_operators=params["n_operators"],
+            transient=params["transient"],
+            margin=params["margin"],
+            constraints=params["constraints"],
             n_folds=CV_FOLDS,
         )
         # the samples the fit ran over: they hold the extremes of the input (thin)
         v_k, x_k, first = thinned_record(v, x, fit)
-        voltage_range = fit_voltage_range(self.voltage_range, v_k, owner)
+        voltage_range = fit_voltage_range(params["voltage_range"], v_k)
         fitted = self._from_fit(fit, voltage_range)
         score = tracking_scorer(v_k, x_k, start=first, folds=fit.folds)
         held_out = tuple(self._from_fit(part, voltage_range) for part in fit.held_out)
@@ -234,17 +244,6 @@ class PrandtlIshlinskii(HysteresisModel):
 
     def _derived_hyperparameters(self) -> dict[str, Any]:
         return {"n_operators": int(self.thresholds_.size)}
-
-    def _check_hyperparameters(self) -> None:
-        """The range, then the play hyperparameters: operator count, transient, margin,
-        constraints."""
-        super()._check_hyperparameters()
-        owner = type(self).__name__
-        check_int(self.n_operators, "n_operators", owner)
-        if self.transient is not None:
-            check_int(self.transient, "transient", owner, minimum=0)
-        check_margin(self.margin, owner)
-        check_constraints(self.constraints, owner)
 
     def _saturation(self) -> tuple[np.ndarray, np.ndarray] | None:
         """The dead-zones ``(thresholds, weights)`` of the saturation stage ``S`` after the

@@ -7,16 +7,26 @@ does not grow with the depth of the memory.
 
 from __future__ import annotations
 
+from typing import ClassVar
+
 import numpy as np
 
-from hystcomp._hyperparameters import MAX_DEGREE, check_options
+from hystcomp._hyperparameters import (
+    DEGREE,
+    EVERETT,
+    GRID_SIZE,
+    MAX_DEGREE,
+    ZERO_DIAGONAL,
+    Constraint,
+    Integer,
+    Options,
+)
 from hystcomp._kernels import preisach as pk
 from hystcomp._validation import (
     MAX_MAGNITUDE,
     _first_out_of_bounds,
     _real_array,
     as_vector,
-    check_int,
     check_range,
     check_real,
 )
@@ -45,6 +55,8 @@ CHECK_NODES = 129
 #: The default ``rho`` is at least the major loop's steepest slope over this, so that eq. (10)
 #: never amplifies an error on any branch: see :meth:`Preisach.default_rho`.
 RHO_STEEPEST = 2.0
+#: The memory bound's constraint: 3 extrema at least, and a stepper's memory allocated whole.
+MAX_EXTREMA = Integer(3, pk.MAX_DEPTH)
 
 
 class PreisachStepper(Stepper):
@@ -180,6 +192,15 @@ class Preisach(HysteresisModel):
     kind = "preisach"
     _learned = ("voltage_range", "output_offset", "theta", "table")
     stepper_class = PreisachStepper
+    _parameter_constraints: ClassVar[dict[str, Constraint]] = {
+        **HysteresisModel._parameter_constraints,
+        "degree": DEGREE,
+        "everett": EVERETT,
+        "grid_size": GRID_SIZE,
+        "zero_diagonal": ZERO_DIAGONAL,
+        "max_extrema": MAX_EXTREMA,
+        "fit_method": Options(FIT_METHODS),
+    }
     theta_: np.ndarray | None
     table_: np.ndarray | None
     output_offset_: float
@@ -226,7 +247,7 @@ class Preisach(HysteresisModel):
                 "eq. 5) and 'table' (X on a grid). Got "
                 f"{'both' if theta is not None else 'neither'}."
             )
-        check_int(max_extrema, "max_extrema", owner, minimum=3, maximum=pk.MAX_DEPTH)
+        MAX_EXTREMA.check(max_extrema, "max_extrema", owner, False)
         model = cls(max_extrema=max_extrema)
         plane = check_range(voltage_range, "voltage_range", owner)
         offset = check_real(output_offset, "output_offset", owner)
@@ -257,8 +278,7 @@ class Preisach(HysteresisModel):
         a document whose ``theta`` has the size of another degree, or whose ``max_extrema``
         is not an int >= 3, is refused here rather than failing later.
         """
-        model = super().from_dict(data)
-        check_int(model.max_extrema, "max_extrema", cls.__name__, minimum=3, maximum=pk.MAX_DEPTH)
+        model = super().from_dict(data)  # every hyperparameter checked, max_extrema too
         if model.theta_ is not None:
             sizes = {pk.n_monomials(d): d for d in range(1, MAX_DEGREE + 1)}
             degree = sizes[model.theta_.size]
@@ -292,16 +312,16 @@ class Preisach(HysteresisModel):
             at an end of the range on) and ``baseline_tracking_rms_um`` (the same for a
             straight line ``v = x / k_lin``), as for PI and MPI.
         """
-        self._check_hyperparameters()
+        params = self._check_hyperparameters(fitting=True)
         result = identify_preisach(
             v,
             x,
-            degree=self.degree,
-            everett=self.everett,
-            grid_size=self.grid_size,
-            voltage_range=self.voltage_range,
-            zero_diagonal=self.zero_diagonal,
-            fit_method=self.fit_method,
+            degree=params["degree"],
+            everett=params["everett"],
+            grid_size=params["grid_size"],
+            voltage_range=params["voltage_range"],
+            zero_diagonal=params["zero_diagonal"],
+            fit_method=params["fit_method"],
         )
         self._set_learned(
             voltage_range=result.voltage_range,
@@ -327,17 +347,6 @@ class Preisach(HysteresisModel):
             return {"everett": "polynomial", "degree": self.degree}
         return {"everett": "table", "grid_size": int(self.table_.shape[0])}
 
-    def _check_hyperparameters(self) -> None:
-        super()._check_hyperparameters()
-        owner = type(self).__name__
-        check_options(self.degree, self.everett, self.grid_size, self.zero_diagonal, owner)
-        check_int(self.max_extrema, "max_extrema", owner, minimum=3, maximum=pk.MAX_DEPTH)
-        if not isinstance(self.fit_method, str) or self.fit_method not in FIT_METHODS:
-            raise InvalidParameterError(
-                f"The 'fit_method' parameter of {owner} must be one of "
-                f"{', '.join(map(repr, FIT_METHODS))}. Got {self.fit_method!r} instead."
-            )
-
     def parameters(self) -> dict:
         """The learned parameters as plain Python values (``theta`` or ``table``)."""
         out = super().parameters()
@@ -346,9 +355,7 @@ class Preisach(HysteresisModel):
     def _packed(self, mode=pk.FORWARD, rho=1.0, max_step=np.inf, clamp=None) -> np.ndarray:
         """The packed Preisach system of :mod:`hystcomp._kernels.preisach` (not a play chain)."""
         self._check_fitted()
-        depth = check_int(
-            self.max_extrema, "max_extrema", type(self).__name__, minimum=3, maximum=pk.MAX_DEPTH
-        )
+        depth = self._checked("max_extrema")  # set_params may have changed it since
         lo, hi = self.voltage_range_
         if self.theta_ is not None:
             kind, coef = pk.POLYNOMIAL, pk.coefficient_matrix(self.theta_, self.degree)
