@@ -134,14 +134,19 @@ def packed_state_names(stepper) -> tuple[str, ...]:
 
 
 def _stepped(
-    stepper, inputs: tuple[str, ...], outputs: tuple[str, ...], name: str
+    stepper,
+    inputs: tuple[str, ...],
+    outputs: tuple[str, ...],
+    name: str,
+    states: tuple[str, ...] | None = None,
 ) -> DiscreteSystem:
-    """A packed system (any :class:`~hystcomp.models.system.Stepper`) as a DiscreteSystem.
+    """A stepper of one input and one output as a DiscreteSystem.
 
-    The state is the stepper's :attr:`~hystcomp.models.system.Stepper.state`, the packed
-    array's state part; one step of the stepper's own kernel gives both the output and the
-    next state. ``stepper`` is this system's own (made for it, at its initial state): the
-    two functions set its state, step it and read it.
+    The state is the stepper's public ``state`` (for a packed system, the packed array's
+    state part, its slots named by :func:`packed_state_names` unless ``states`` names
+    them); one step of the stepper gives both the output and the next state. ``stepper``
+    is this system's own (made for it, at its initial state): the two functions set its
+    state, step it and read it.
     """
     initial = stepper.state
 
@@ -163,7 +168,7 @@ def _stepped(
         inputs=inputs,
         outputs=outputs,
         name=name,
-        states=packed_state_names(stepper),
+        states=packed_state_names(stepper) if states is None else states,
     )
 
 
@@ -303,26 +308,9 @@ def _dynamic_compensator(obj, dt: float) -> DiscreteSystem:
     if obj.sample_rate is not None:
         _check_rate(dt, obj.sample_rate, "the dynamics'", "identify them at the loop's rate")
     stepper = obj.stepper()
-    initial = stepper.state
     n_dyn = stepper.dynamics_inverse.state.size
-
-    def step(s: np.ndarray, u: np.ndarray) -> float:
-        stepper.state = s
-        return stepper.step(float(np.ravel(u)[0]))
-
-    def update(s, u):
-        step(s, u)
-        return stepper.state
-
-    return DiscreteSystem(
-        state=initial,
-        update=update,
-        output=step,
-        inputs=("x_ref",),
-        outputs=("v",),
-        name=f"inverse_dynamics_{obj.kind}",
-        states=(*_indexed("inverse_dynamics", n_dyn), *packed_state_names(stepper.hysteresis)),
-    )
+    names = (*_indexed("inverse_dynamics", n_dyn), *packed_state_names(stepper.hysteresis))
+    return _stepped(stepper, ("x_ref",), ("v",), f"inverse_dynamics_{obj.kind}", names)
 
 
 def _check_rate(dt: float, rate: float, whose: str, fix: str) -> None:

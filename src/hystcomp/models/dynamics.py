@@ -69,7 +69,13 @@ from hystcomp.models.dynamic_compensator import (
     DynamicStepper,
     inverse_fir,
 )
-from hystcomp.models.estimator import learned_values, set_learned
+from hystcomp.models.estimator import (
+    check_document,
+    learned_values,
+    model_document,
+    read_fit_report,
+    set_learned,
+)
 
 __all__ = [
     "MATCH_HZ",
@@ -468,24 +474,14 @@ class LinearDynamics:
 
     def to_dict(self) -> dict[str, Any]:
         """Kind, parameters and fit report, ready for JSON (see :mod:`hystcomp.io.models`)."""
-        out: dict[str, Any] = {"kind": self.kind, "hyperparameters": {}}
-        out["parameters"] = self.parameters()
-        report = getattr(self, "fit_report_", None)
-        if report is not None:
-            out["fit_report"] = dict(report)
-        return out
+        return model_document(self, hyperparameters={}, parameters=self.parameters())
 
     @classmethod
     def from_dict(cls, data: dict[str, Any]) -> LinearDynamics:
         """Inverse of :meth:`to_dict`."""
-        if not (isinstance(data, dict) and isinstance(data.get("parameters"), dict)):
-            raise InvalidParameterError(
-                f"{cls.__name__}.from_dict needs a dict with a 'parameters' dict (as written "
-                f"by to_dict). Got {type(data).__name__}."
-            )
+        check_document(cls, data, "parameters", dict)
         model = cls.from_parameters(**data["parameters"])
-        if "fit_report" in data:
-            model.fit_report_ = dict(data["fit_report"])
+        read_fit_report(model, data)
         return model
 
     def __repr__(self) -> str:

@@ -133,6 +133,33 @@ def learned_values(model: object, names: tuple[str, ...]) -> dict[str, Any]:
     return {name: getattr(model, name + "_") for name in names}
 
 
+def model_document(model: Any, **parts: Any) -> dict[str, Any]:
+    """A model file's dictionary: the model's ``kind``, then ``parts``, then its
+    ``fit_report`` if it has one (:mod:`hystcomp.io.models` writes it as JSON)."""
+    out: dict[str, Any] = {"kind": model.kind, **parts}
+    report = getattr(model, "fit_report_", None)
+    if report is not None:
+        out["fit_report"] = dict(report)
+    return out
+
+
+def check_document(cls: type, data: Any, key: str, kind: type) -> None:
+    """Raise unless ``data`` is a dict whose ``key`` holds a ``kind`` (a model file's
+    dictionary for ``cls.from_dict``)."""
+    if not (isinstance(data, dict) and isinstance(data.get(key), kind)):
+        article = "an" if kind.__name__[0] in "aeiou" else "a"
+        raise InvalidParameterError(
+            f"{cls.__name__}.from_dict needs a dict with {article} {key!r} {kind.__name__} (as "
+            f"written by to_dict). Got {type(data).__name__}."
+        )
+
+
+def read_fit_report(model: Any, data: dict[str, Any]) -> None:
+    """Give ``model`` the fit report of its model file's dictionary, if it holds one."""
+    if "fit_report" in data:
+        model.fit_report_ = dict(data["fit_report"])
+
+
 class Estimator:
     """Base of the fitted models: voltage (V) in, displacement (µm) out, learned from data.
 
@@ -337,15 +364,7 @@ class Estimator:
 
     def to_dict(self) -> dict[str, Any]:
         """Kind, hyperparameters, parameters and fit report, ready for JSON."""
-        out = {
-            "kind": self.kind,
-            "hyperparameters": self.get_params(),
-            "parameters": self.parameters(),
-        }
-        report = getattr(self, "fit_report_", None)
-        if report is not None:
-            out["fit_report"] = dict(report)
-        return out
+        return model_document(self, hyperparameters=self.get_params(), parameters=self.parameters())
 
     @classmethod
     def from_dict(cls, data: dict[str, Any]) -> Self:
@@ -353,11 +372,7 @@ class Estimator:
 
         :func:`hystcomp.io.models.model_from_dict` checks a whole document (keys, JSON types) first.
         """
-        if not (isinstance(data, dict) and isinstance(data.get("parameters"), dict)):
-            raise InvalidParameterError(
-                f"{cls.__name__}.from_dict needs a dict with a 'parameters' dict (as written "
-                f"by to_dict). Got {type(data).__name__}."
-            )
+        check_document(cls, data, "parameters", dict)
         model = cls.from_parameters(**data["parameters"])
         derived = model._derived_hyperparameters()
         for name, value in data.get("hyperparameters", {}).items():
@@ -375,8 +390,7 @@ class Estimator:
                 )
             setattr(model, name, value)
         model._check_hyperparameters()  # every value, as fit() would check it
-        if "fit_report" in data:
-            model.fit_report_ = dict(data["fit_report"])
+        read_fit_report(model, data)
         return model
 
     _estimator_type = "regressor"  # what scikit-learn < 1.6 reads

@@ -32,6 +32,7 @@ from hystcomp.identify.scoring import transient_end
 from hystcomp.models.base import HysteresisModel
 from hystcomp.models.dynamic_compensator import DynamicCompensator
 from hystcomp.models.dynamics import LinearDynamics, with_dynamics
+from hystcomp.models.estimator import model_document, read_fit_report
 from hystcomp.models.mpi import ModifiedPrandtlIshlinskii
 from hystcomp.models.pi import PrandtlIshlinskii
 from hystcomp.models.preisach import Preisach
@@ -153,15 +154,9 @@ class HammersteinModel:
 
     def to_dict(self) -> dict[str, Any]:
         """Kind, both parts and the fit report, ready for JSON (:mod:`hystcomp.io.models`)."""
-        out: dict[str, Any] = {
-            "kind": self.kind,
-            "hysteresis": self.hysteresis.to_dict(),
-            "dynamics": self.dynamics.to_dict(),
-        }
-        report = getattr(self, "fit_report_", None)
-        if report is not None:
-            out["fit_report"] = dict(report)
-        return out
+        return model_document(
+            self, hysteresis=self.hysteresis.to_dict(), dynamics=self.dynamics.to_dict()
+        )
 
     @classmethod
     def from_dict(cls, data: dict[str, Any]) -> HammersteinModel:
@@ -170,8 +165,7 @@ class HammersteinModel:
         parts = {c.kind: c for c in (PrandtlIshlinskii, ModifiedPrandtlIshlinskii, Preisach)}
         hysteresis = parts[data["hysteresis"]["kind"]].from_dict(data["hysteresis"])
         model = cls(hysteresis, LinearDynamics.from_dict(data["dynamics"]))
-        if "fit_report" in data:
-            model.fit_report_ = dict(data["fit_report"])
+        read_fit_report(model, data)
         return model
 
     def __repr__(self) -> str:

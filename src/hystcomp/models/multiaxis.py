@@ -44,7 +44,12 @@ from hystcomp.identify.compensation import tracking_estimate
 from hystcomp.identify.coupling import fit_coupling, refine_coupling
 from hystcomp.identify.scoring import transient_end
 from hystcomp.models.base import HysteresisModel
-from hystcomp.models.estimator import Estimator
+from hystcomp.models.estimator import (
+    Estimator,
+    check_document,
+    model_document,
+    read_fit_report,
+)
 from hystcomp.models.mpi import ModifiedPrandtlIshlinskii
 from hystcomp.models.pi import PrandtlIshlinskii
 from hystcomp.models.preisach import Preisach
@@ -478,21 +483,12 @@ class MultiAxisModel(Estimator):
         params = self.get_params()
         if not isinstance(params["family"], str):
             params["family"] = params["family"].kind
-        out: dict[str, Any] = {"kind": self.kind, "hyperparameters": params}
-        out.update(self.parameters())
-        report = getattr(self, "fit_report_", None)
-        if report is not None:
-            out["fit_report"] = dict(report)
-        return out
+        return model_document(self, hyperparameters=params, **self.parameters())
 
     @classmethod
     def from_dict(cls, data: dict[str, Any]) -> Self:
         """Inverse of :meth:`to_dict`; every axis through its own ``from_dict``."""
-        if not isinstance(data, dict) or not isinstance(data.get("axes"), list):
-            raise InvalidParameterError(
-                f"{cls.__name__}.from_dict needs a dict with an 'axes' list (as written by "
-                f"to_dict). Got {type(data).__name__}."
-            )
+        check_document(cls, data, "axes", list)
         axes = []
         for i, doc in enumerate(data["axes"]):
             kind = doc.get("kind") if isinstance(doc, dict) else None
@@ -508,8 +504,7 @@ class MultiAxisModel(Estimator):
             if name in hyper:
                 setattr(model, name, hyper[name])
         model._check_hyperparameters()
-        if "fit_report" in data:
-            model.fit_report_ = dict(data["fit_report"])
+        read_fit_report(model, data)
         return model
 
     def __sklearn_tags__(self):  # pragma: no cover - read by scikit-learn only
