@@ -78,18 +78,31 @@ class HysteresisModel(PackedSystem, Estimator):
         slew_rate : float, optional
             Largest output slew rate in V/s (none by default).
         sample_rate : float, optional
-            Sample rate in Hz at which the compensator runs; sets the per-sample slew step.
+            Sample rate in Hz at which the compensator runs; sets the per-sample slew step
+            (by default that of ``dynamics``, else 20000; another than the dynamics' is
+            refused).
         voltage_range : (float, float), optional
             A narrower output clamp in V, inside ``voltage_range_`` (never wider).
         dynamics : LinearDynamics, optional
-            An inverse of the actuator's linear dynamics in series (then a
-            :class:`~hystcomp.models.dynamic_compensator.DynamicCompensator`).
+            Put an inverse of the actuator's linear dynamics (creep, first resonance) in
+            series: ``v = H^-1[D^-1[x_ref]]`` (beyond the paper; see
+            :mod:`hystcomp.models.dynamics`). Returns a
+            :class:`~hystcomp.models.dynamic_compensator.DynamicCompensator` then.
 
         Returns
         -------
         Compensator or DynamicCompensator
             The compensator, clamped to the voltage range.
         """
+
+    def _output_limits(
+        self, slew_rate, sample_rate, voltage_range, dynamics
+    ) -> tuple[float, tuple[float, float]]:
+        """The checked limits of a compensator's output, for :meth:`inverse`: the largest
+        step per sample (V; ``inf`` without a slew rate) and the clamp ``(lo, hi)`` (V)."""
+        owner = f"{type(self).__name__}.inverse"
+        rate = compensator_rate(sample_rate, dynamics, owner)
+        return slew_to_step(slew_rate, rate, owner), self._clamp_range(voltage_range, owner)
 
     def _clamp_range(self, voltage_range, owner: str) -> tuple[float, float]:
         """The compensator's clamp: ``voltage_range_``, or a ``voltage_range`` inside it.

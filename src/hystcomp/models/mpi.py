@@ -18,19 +18,17 @@ from hystcomp._hyperparameters import (
     Options,
 )
 from hystcomp._validation import as_vector, check_thresholds
-from hystcomp.identify.compensation import CV_FOLDS, tracking_scorer
+from hystcomp.identify.compensation import CV_FOLDS
 from hystcomp.identify.mpi import REGULARIZATION_GRID, fit_mpi_path
 from hystcomp.identify.pi import INITIAL_MEMORIES
-from hystcomp.models.base import DEFAULT_VOLTAGE_RANGE, fit_voltage_range
+from hystcomp.models.base import DEFAULT_VOLTAGE_RANGE
 from hystcomp.models.compensator import Compensator
 from hystcomp.models.dynamic_compensator import DynamicCompensator
-from hystcomp.models.estimator import fit_signals
 from hystcomp.models.inversion import check_invertible, invert_superposition
 from hystcomp.models.pi import (
     PrandtlIshlinskii,
     _checked_offsets,
     _checked_plays,
-    thinned_record,
 )
 
 
@@ -147,42 +145,29 @@ class ModifiedPrandtlIshlinskii(PrandtlIshlinskii):
         constraints="physical",
         initial_memory="auto",
     ):
-        self.n_operators = n_operators
+        super().__init__(
+            n_operators=n_operators,
+            voltage_range=voltage_range,
+            transient=transient,
+            margin=margin,
+            constraints=constraints,
+        )
         self.n_deadzones = n_deadzones
-        self.voltage_range = voltage_range
-        self.transient = transient
-        self.margin = margin
         self.regularization = regularization
-        self.constraints = constraints
         self.initial_memory = initial_memory
 
-    @fit_signals
-    def fit(self, v, x) -> Self:
-        """Identify the model from a measured record by eq. (19) (Section IV-A).
-
-        Delegates to :func:`hystcomp.identify.mpi.fit_mpi`, which finds the plays of ``H``
-        and the *inverse* dead-zones; the forward dead-zones ``deadzone_thresholds_``,
-        ``deadzone_weights_`` follow from eqs. (24)-(25) (:meth:`forward_deadzones`).
-
-        Parameters
-        ----------
-        v, x : array_like
-            Input voltage (V) and measured displacement (µm), one sample each per instant.
-
-        Returns
-        -------
-        ModifiedPrandtlIshlinskii
-            ``self``, fitted.
-        """
-        params = self._check_hyperparameters(fitting=True)
+    def _fits(self, v, x, params: dict[str, Any]) -> list:
+        """The candidate fits of eq. (19) (:func:`~hystcomp.identify.mpi.fit_mpi_path`): one
+        per value of the regularisation (the grid for ``"auto"``) and initial memory of the
+        plays (eq. 18's virgin plays, and with the physical constraints the descended ones
+        too, for ``"auto"``); :meth:`fit` keeps the one predicted to track best."""
         regularization = params["regularization"]
         penalties = REGULARIZATION_GRID if regularization == "auto" else (regularization,)
-        # eq. 18's virgin plays, and with the physical constraints the descended ones too
         if params["initial_memory"] != "auto":
             memories: tuple[str, ...] = (params["initial_memory"],)
         else:
             memories = INITIAL_MEMORIES if params["constraints"] == "physical" else ("virgin",)
-        fits = fit_mpi_path(
+        return fit_mpi_path(
             v,
             x,
             n_operators=params["n_operators"],
@@ -194,29 +179,10 @@ class ModifiedPrandtlIshlinskii(PrandtlIshlinskii):
             n_folds=CV_FOLDS,
             initial_memories=memories,
         )
-        # scored on the samples the fit used (a long record is thinned, see fit_mpi_path);
-        # they hold the extremes of the input
-        v_k, x_k, first = thinned_record(v, x, fits[0])
-        voltage_range = fit_voltage_range(params["voltage_range"], v_k)
-        score = tracking_scorer(v_k, x_k, start=first, folds=fits[0].folds)
-        candidates = []
-        for fit in fits:
-            candidate = self._from_fit(fit, voltage_range)
-            held_out = tuple(self._from_fit(part, voltage_range) for part in fit.held_out)
-            candidates.append((candidate, fit, score(candidate, held_out, estimate=False)))
-        # the smallest criterion (the first of equals), then its estimate on the record
-        model, fit, cv = min(candidates, key=lambda c: c[2]["criterion_um"])
-        est = {**score(model), **cv}
-        self._adopt_fit(
-            model,
-            v_k,
-            x_k,
-            first,
-            est,
-            regularization=fit.regularization,
-            initial_memory=fit.initial_memory,
-        )
-        return self
+
+    def _fit_extra(self, fit) -> dict[str, Any]:
+        """The report names the chosen fit's ``regularization`` and ``initial_memory``."""
+        return {"regularization": fit.regularization, "initial_memory": fit.initial_memory}
 
     def _from_fit(self, fit, voltage_range) -> Self:
         """The model of an :class:`~hystcomp.identify.mpi.MPIFit`, its forward dead-zones
@@ -271,9 +237,18 @@ class ModifiedPrandtlIshlinskii(PrandtlIshlinskii):
         """The analytic inverse MPI, eq. (23): ``v = v_0 + H^-1[S^-1[x - x_0]]``, clamped.
 
         ``S^-1`` is a dead-zone superposition and ``H^-1`` a PI model, both from eqs. 24-25
-        (and eq. 26 for the initial states). ``slew_rate`` (V/s), ``sample_rate`` (Hz) and
-        ``voltage_range`` (a narrower clamp, V) and ``dynamics`` (an inverse of the linear
-        dynamics in series) are as in :meth:`PrandtlIshlinskii.inverse`.
+        (and eq. 26 for the initial states).
+
+        Parameters
+        ----------
+        slew_rate, sample_rate, voltage_range, dynamics
+            The output's limits (V/s, Hz, V) and the dynamics in series, as in
+            :meth:`HysteresisModel.inverse <hystcomp.models.base.HysteresisModel.inverse>`.
+
+        Returns
+        -------
+        Compensator or DynamicCompensator
+            The compensator, clamped to the voltage range.
 
         Raises
         ------

@@ -34,10 +34,8 @@ from hystcomp.identify.scoring import error_report
 from hystcomp.models.base import (
     DEFAULT_VOLTAGE_RANGE,
     HysteresisModel,
-    compensator_rate,
     fit_voltage_range,
     input_range_report,
-    slew_to_step,
 )
 from hystcomp.models.compensator import Compensator
 from hystcomp.models.dynamic_compensator import DynamicCompensator
@@ -149,16 +147,21 @@ class PrandtlIshlinskii(HysteresisModel):
 
     @fit_signals
     def fit(self, v, x) -> Self:
-        """Identify the model from a measured record (Section IV-A, eqs. 12, 16, 18).
+        """Identify the model from a measured record (Section IV-A).
 
-        Delegates to :func:`hystcomp.identify.pi.fit_pi` (constrained least squares, with
-        the invertibility of eqs. 24-26 guaranteed), then sets the learned attributes and
-        ``fit_report_``.
+        The constrained least squares of :meth:`_fits` (for PI
+        :func:`hystcomp.identify.pi.fit_pi`, eqs. 12, 16, 18; for MPI
+        :func:`hystcomp.identify.mpi.fit_mpi_path`, eq. 19), with the invertibility of
+        eqs. 24-26 guaranteed; of several candidate fits, the one predicted to track best
+        by cross-validation (``fit_report_["criterion_um"]``,
+        :func:`hystcomp.identify.compensation.tracking_scorer`). Then sets the learned
+        attributes and ``fit_report_``.
 
         Parameters
         ----------
         v, x : array_like
-            Input voltage (V) and measured displacement (µm), one sample each per instant.
+            The record, as in :meth:`HysteresisModel.fit
+            <hystcomp.models.base.HysteresisModel.fit>`.
 
         Returns
         -------
@@ -166,23 +169,49 @@ class PrandtlIshlinskii(HysteresisModel):
             ``self``, fitted.
         """
         params = self._check_hyperparameters(fitting=True)
-        fit = fit_pi(
-            v,
-            x,
-            n_operators=params["n_operators"],
-            transient=params["transient"],
-            margin=params["margin"],
-            constraints=params["constraints"],
-            n_folds=CV_FOLDS,
-        )
-        # the samples the fit ran over: they hold the extremes of the input (thin)
-        v_k, x_k, first = thinned_record(v, x, fit)
+        fits = self._fits(v, x, params)
+        # scored on the samples the fits ran over (a long record is thinned, see
+        # fit_mpi_path); they hold the extremes of the input
+        v_k, x_k, first = thinned_record(v, x, fits[0])
         voltage_range = fit_voltage_range(params["voltage_range"], v_k)
-        fitted = self._from_fit(fit, voltage_range)
-        score = tracking_scorer(v_k, x_k, start=first, folds=fit.folds)
-        held_out = tuple(self._from_fit(part, voltage_range) for part in fit.held_out)
-        self._adopt_fit(fitted, v_k, x_k, first, score(fitted, held_out))
+        score = tracking_scorer(v_k, x_k, start=first, folds=fits[0].folds)
+
+        candidates = [  # (model, fit, the models fitted with a fold left out)
+            (
+                self._from_fit(fit, voltage_range),
+                fit,
+                tuple(self._from_fit(part, voltage_range) for part in fit.held_out),
+            )
+            for fit in fits
+        ]
+        if len(candidates) == 1:
+            model, fit, held_out = candidates[0]
+            est = score(model, held_out)
+        else:  # the smallest criterion (the first of equals), then its estimate on the record
+            scored = [(m, f, score(m, held, estimate=False)) for m, f, held in candidates]
+            model, fit, cv = min(scored, key=lambda c: c[2]["criterion_um"])
+            est = {**score(model), **cv}
+        self._adopt_fit(model, v_k, x_k, first, est, **self._fit_extra(fit))
         return self
+
+    def _fits(self, v, x, params: dict[str, Any]) -> list:
+        """The candidate fits of the record, from the checked hyperparameters ``params``:
+        one :class:`~hystcomp.identify.pi.PIFit` (:func:`~hystcomp.identify.pi.fit_pi`)."""
+        return [
+            fit_pi(
+                v,
+                x,
+                n_operators=params["n_operators"],
+                transient=params["transient"],
+                margin=params["margin"],
+                constraints=params["constraints"],
+                n_folds=CV_FOLDS,
+            )
+        ]
+
+    def _fit_extra(self, fit) -> dict[str, Any]:
+        """What the fit report says of the chosen fit beyond the errors (nothing for PI)."""
+        return {}
 
     def _from_fit(self, fit, voltage_range) -> Self:
         """The model of a :class:`~hystcomp.identify.pi.PIFit` (see :meth:`_set_fitted`)."""
@@ -270,19 +299,14 @@ class PrandtlIshlinskii(HysteresisModel):
 
         Parameters
         ----------
-        slew_rate : float, optional
-            Largest output slew rate in V/s (none by default).
-        sample_rate : float, optional
-            Sample rate in Hz at which the compensator runs; sets the per-sample slew step
-            (by default that of ``dynamics``, else 20000; another than the dynamics' is
-            refused).
-        voltage_range : (float, float), optional
-            A narrower output clamp in V, inside ``voltage_range_`` (never wider).
-        dynamics : LinearDynamics, optional
-            Put an inverse of the actuator's linear dynamics (creep, first resonance) in
-            series: ``v = H^-1[D^-1[x_ref]]`` (beyond the paper; see
-            :mod:`hystcomp.models.dynamics`). Returns a
-            :class:`~hystcomp.models.dynamic_compensator.DynamicCompensator` then.
+        slew_rate, sample_rate, voltage_range, dynamics
+            The output's limits and the dynamics in series, as in
+            :meth:`HysteresisModel.inverse <hystcomp.models.base.HysteresisModel.inverse>`.
+
+        Returns
+        -------
+        Compensator or DynamicCompensator
+            The compensator, clamped to the voltage range.
 
         Raises
         ------
@@ -292,10 +316,7 @@ class PrandtlIshlinskii(HysteresisModel):
         self._check_fitted()
         self._check_invertible()
         # the chain x -> (x - x_0) -> [S^-1 dead-zones] -> inverse plays (eqs. 24-26) -> + v_0
-        owner = type(self).__name__
-        sample_rate = compensator_rate(sample_rate, dynamics, f"{owner}.inverse")
-        max_step = slew_to_step(slew_rate, sample_rate, owner)
-        lo, hi = self._clamp_range(voltage_range, f"{owner}.inverse")
+        max_step, (lo, hi) = self._output_limits(slew_rate, sample_rate, voltage_range, dynamics)
         saturation = self._saturation()
         packed = chain.pack_chain(
             pre=None if saturation is None else invert_superposition(*saturation),

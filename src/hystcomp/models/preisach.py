@@ -39,7 +39,6 @@ from hystcomp.models.base import (
     HysteresisModel,
     compensator_rate,
     input_range_report,
-    slew_to_step,
 )
 from hystcomp.models.compensator import Compensator
 from hystcomp.models.dynamic_compensator import DynamicCompensator
@@ -467,19 +466,14 @@ class Preisach(HysteresisModel):
             opens at a reversal holds the voltage.
         rho : float, optional
             Gain in µm/V for ``"multiplicative"``; default :meth:`default_rho`.
-        slew_rate : float, optional
-            Largest output slew rate in V/s (none by default).
-        sample_rate : float, optional
-            Sample rate in Hz at which the compensator runs; sets the per-sample slew step
-            (by default that of ``dynamics``, else 20000; another than the dynamics' is
-            refused).
-        voltage_range : (float, float), optional
-            A narrower output clamp in V, inside ``voltage_range_`` (never wider).
-        dynamics : LinearDynamics, optional
-            Put an inverse of the actuator's linear dynamics (creep, first resonance) in
-            series: ``v = H^-1[D^-1[x_ref]]`` (beyond the paper; see
-            :mod:`hystcomp.models.dynamics`). Returns a
-            :class:`~hystcomp.models.dynamic_compensator.DynamicCompensator` then.
+        slew_rate, sample_rate, voltage_range, dynamics
+            The output's limits and the dynamics in series, as in
+            :meth:`HysteresisModel.inverse <hystcomp.models.base.HysteresisModel.inverse>`.
+
+        Returns
+        -------
+        PreisachCompensator or DynamicCompensator
+            The compensator, clamped to the voltage range.
         """
         if method is None:
             method = "exact" if dynamics is not None and rho is None else "multiplicative"
@@ -495,13 +489,12 @@ class Preisach(HysteresisModel):
         self._check_fitted()
         self._check_invertible()  # every method, and so C export, needs rising branches
         owner = type(self).__name__
-        clamp = self._clamp_range(voltage_range, f"{owner}.inverse")
+        max_step, clamp = self._output_limits(slew_rate, sample_rate, voltage_range, None)
         if method not in INVERSE_METHODS:
             raise InvalidParameterError(
                 f"The 'method' parameter of {owner}.inverse must be 'multiplicative' (eq. 10) "
                 f"or 'exact'. Got {method!r} instead."
             )
-        max_step = slew_to_step(slew_rate, compensator_rate(sample_rate, None, owner), owner)
         if method == "exact":
             if rho is not None:
                 raise InvalidParameterError(
