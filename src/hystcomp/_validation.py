@@ -87,15 +87,21 @@ def check_range(value, name: str, owner: str) -> tuple[float, float]:
     return low, high
 
 
-def as_vector(value, name: str, owner: str, *, length: int | None = None) -> np.ndarray:
-    """Return a read-only 1-D finite float64 copy of ``value`` or raise."""
+def real_array(value, name: str, owner: str, what: str) -> np.ndarray:
+    """Return a float64 copy of ``value``, or raise a message that says it must be ``what``
+    (text, booleans and complex numbers are not numbers here)."""
     try:
-        arr = _real_array(value, copy=True)
+        return _real_array(value, copy=True)
     except (TypeError, ValueError, OverflowError):
         raise InvalidTypeError(
-            f"The {name!r} parameter of {owner} must be a 1-D array of real numbers. "
+            f"The {name!r} parameter of {owner} must be {what}. "
             f"Got a {type(value).__name__} that does not convert to numbers."
         ) from None
+
+
+def as_vector(value, name: str, owner: str, *, length: int | None = None) -> np.ndarray:
+    """Return a read-only 1-D finite float64 copy of ``value`` or raise."""
+    arr = real_array(value, name, owner, "a 1-D array of real numbers")
     if arr.ndim != 1 or arr.size == 0:
         raise InvalidParameterError(
             f"The {name!r} parameter of {owner} must be a non-empty 1-D array. "

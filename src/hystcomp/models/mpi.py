@@ -22,8 +22,6 @@ from hystcomp.identify.compensation import CV_FOLDS
 from hystcomp.identify.mpi import REGULARIZATION_GRID, fit_mpi_path
 from hystcomp.identify.pi import INITIAL_MEMORIES
 from hystcomp.models.base import DEFAULT_VOLTAGE_RANGE
-from hystcomp.models.compensator import Compensator
-from hystcomp.models.dynamic_compensator import DynamicCompensator
 from hystcomp.models.inversion import check_invertible, invert_superposition
 from hystcomp.models.pi import (
     PrandtlIshlinskii,
@@ -230,37 +228,6 @@ class ModifiedPrandtlIshlinskii(PrandtlIshlinskii):
         owner = type(self).__name__
         check_invertible(self.weights_, f"The hysteresis operator H of this {owner} model")
         check_invertible(self.deadzone_weights_, f"The saturation operator S of this {owner} model")
-
-    def inverse(
-        self, *, slew_rate=None, sample_rate=None, voltage_range=None, dynamics=None
-    ) -> Compensator | DynamicCompensator:
-        """The analytic inverse MPI, eq. (23): ``v = v_0 + H^-1[S^-1[x - x_0]]``, clamped.
-
-        ``S^-1`` is a dead-zone superposition and ``H^-1`` a PI model, both from eqs. 24-25
-        (and eq. 26 for the initial states).
-
-        Parameters
-        ----------
-        slew_rate, sample_rate, voltage_range, dynamics
-            The output's limits (V/s, Hz, V) and the dynamics in series, as in
-            :meth:`HysteresisModel.inverse <hystcomp.models.base.HysteresisModel.inverse>`.
-
-        Returns
-        -------
-        Compensator or DynamicCompensator
-            The compensator, clamped to the voltage range.
-
-        Raises
-        ------
-        NotInvertibleError
-            If a partial sum of the play weights or of the dead-zone weights is not positive.
-        """
-        return super().inverse(
-            slew_rate=slew_rate,
-            sample_rate=sample_rate,
-            voltage_range=voltage_range,
-            dynamics=dynamics,
-        )
 
     @staticmethod
     def forward_deadzones(inverse_thresholds, inverse_weights) -> tuple[np.ndarray, np.ndarray]:

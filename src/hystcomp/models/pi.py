@@ -295,7 +295,11 @@ class PrandtlIshlinskii(HysteresisModel):
     def inverse(
         self, *, slew_rate=None, sample_rate=None, voltage_range=None, dynamics=None
     ) -> Compensator | DynamicCompensator:
-        """The analytic inverse PI (eqs. 24-26) as a compensator clamped to the voltage range.
+        """The analytic inverse (eqs. 24-26) as a compensator clamped to the voltage range.
+
+        For PI the inverse plays of eqs. (24)-(26); for MPI eq. (23),
+        ``v = v_0 + H^-1[S^-1[x - x_0]]``, with ``S^-1`` a dead-zone superposition and
+        ``H^-1`` a PI model, both from eqs. (24)-(25) (and eq. 26 for the initial states).
 
         Parameters
         ----------
@@ -311,7 +315,8 @@ class PrandtlIshlinskii(HysteresisModel):
         Raises
         ------
         NotInvertibleError
-            If a partial sum of the weights is not positive; its ``index`` names it.
+            If a partial sum of the play weights (or, for MPI, of the dead-zone weights) is
+            not positive; its ``index`` names it.
         """
         self._check_fitted()
         self._check_invertible()

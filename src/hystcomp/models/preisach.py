@@ -25,12 +25,12 @@ from hystcomp._kernels import preisach as pk
 from hystcomp._validation import (
     MAX_MAGNITUDE,
     _first_out_of_bounds,
-    _real_array,
     as_vector,
     check_range,
     check_real,
+    real_array,
 )
-from hystcomp.errors import InvalidParameterError, InvalidTypeError
+from hystcomp.errors import InvalidParameterError
 from hystcomp.identify.compensation import compensation_error
 from hystcomp.identify.preisach import FIT_METHODS, identify_preisach
 from hystcomp.identify.scoring import error_report, transient_end
@@ -561,13 +561,7 @@ def _frozen(arr: np.ndarray) -> np.ndarray:
 
 
 def _check_table(table, owner) -> np.ndarray:
-    try:
-        arr = _real_array(table, copy=True)
-    except (TypeError, ValueError, OverflowError):
-        raise InvalidTypeError(
-            f"The 'table' parameter of {owner} must be a square 2-D array of numbers. "
-            f"Got a {type(table).__name__} that does not convert to one."
-        ) from None
+    arr = real_array(table, "table", owner, "a square 2-D array of numbers")
     if arr.ndim != 2 or arr.shape[0] != arr.shape[1] or arr.shape[0] < 2:
         raise InvalidParameterError(
             f"The 'table' parameter of {owner} must be a square 2-D array of at least 2 x 2 "
