@@ -303,7 +303,7 @@ class DynamicCompensator:
         """
         return self.hysteresis.simulate(self.dynamics_inverse.simulate(x_ref))
 
-    def run(self, x_ref):
+    def run(self, x_ref) -> CompensatorRun:
         """Like :meth:`simulate`, and also count the samples out of reach.
 
         Returns a ``CompensatorRun`` (see :meth:`hystcomp.models.compensator.Compensator.run`)

@@ -4,7 +4,12 @@ A :class:`PackedSystem` (a forward model or a compensator) holds a packed array 
 :mod:`hystcomp._kernels.chain` for play chains, :mod:`hystcomp._kernels.preisach` for
 Preisach systems) whose state part is the initial state. It is immutable: ``simulate`` runs a copy, so
 calling it twice gives the same answer; a :class:`Stepper` owns its own copy and can be reset
-or copied. The :class:`Stepper` serves every packed system of the package through the
+or copied, and its state read and set (:attr:`Stepper.state`).
+
+Every stepper of the package has that state API, whatever it steps (a packed system, the
+inverse of the dynamics, both in series, many axes, a bank of channels, the simulated
+axis): ``state`` (a copy of the state as a 1-D float64 array; set it to go back to a saved
+one), ``copy()`` (an independent stepper in the same state) and ``reset()``. The :class:`Stepper` serves every packed system of the package through the
 kernels its class names.
 """
 
