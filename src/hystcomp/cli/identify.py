@@ -272,7 +272,7 @@ def identify(
     if is_multiaxis(data, columns):  # t, v1..vN, x1..xN: N coupled axes
         from hystcomp.cli._multiaxis import identify_multiaxis, refuse
 
-        why: str | None = "an N-axis record"
+        why = "an N-axis record"
         refuse("--model dynamics", kind == "dynamics" or None, why)
         for name, value in (("--holdout", holdout), ("--dynamics-record", dynamics_record)):
             refuse(name, value, why)
