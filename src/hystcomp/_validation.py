@@ -89,7 +89,27 @@ def check_range(value, name: str, owner: str) -> tuple[float, float]:
 
 def real_array(value, name: str, owner: str, what: str) -> np.ndarray:
     """Return a float64 copy of ``value``, or raise a message that says it must be ``what``
-    (text, booleans and complex numbers are not numbers here)."""
+    (text, booleans and complex numbers are not numbers here).
+
+    Parameters
+    ----------
+    value : array_like
+        The parameter's value.
+    name, owner : str
+        The parameter and what it belongs to, for the message.
+    what : str
+        What it must be, for the message (``"a 1-D array of real numbers"``).
+
+    Returns
+    -------
+    ndarray
+        A float64 copy, of any shape.
+
+    Raises
+    ------
+    InvalidTypeError
+        If ``value`` does not convert to real numbers.
+    """
     try:
         return _real_array(value, copy=True)
     except (TypeError, ValueError, OverflowError):

@@ -109,10 +109,23 @@ def set_learned(model: object, names: tuple[str, ...], **learned: Any) -> None:
     """Set a model's learned attributes, ``name_`` for each of ``names``: the one path by
     which ``fit``, ``from_parameters`` and the model files write them.
 
-    ``learned`` names each of ``names`` (without the trailing underscore), and nothing else.
     An array that the caller may still change is copied first, so that every array of the
     model is its own and read-only. The values are taken as they are: ``from_parameters``
     validates them before, and a fit computed them under its constraints.
+
+    Parameters
+    ----------
+    model : object
+        The model whose attributes are set.
+    names : tuple of str
+        Its learned parameters, without the trailing underscore.
+    **learned
+        A value for each of ``names``, and nothing else.
+
+    Raises
+    ------
+    TypeError
+        If ``learned`` does not name exactly ``names`` (a programming error).
     """
     if set(learned) != set(names):  # a programming error in a model class, not a user's
         raise TypeError(
@@ -129,13 +142,38 @@ def set_learned(model: object, names: tuple[str, ...], **learned: Any) -> None:
 
 def learned_values(model: object, names: tuple[str, ...]) -> dict[str, Any]:
     """A model's learned attributes by name (without the underscore), as
-    :func:`set_learned` takes them."""
+    :func:`set_learned` takes them.
+
+    Parameters
+    ----------
+    model : object
+        A fitted model.
+    names : tuple of str
+        The learned parameters to read, without the trailing underscore.
+
+    Returns
+    -------
+    dict
+        Name to value.
+    """
     return {name: getattr(model, name + "_") for name in names}
 
 
 def model_document(model: Any, **parts: Any) -> dict[str, Any]:
     """A model file's dictionary: the model's ``kind``, then ``parts``, then its
-    ``fit_report`` if it has one (:mod:`hystcomp.io.models` writes it as JSON)."""
+    ``fit_report`` if it has one (:mod:`hystcomp.io.models` writes it as JSON).
+
+    Parameters
+    ----------
+    model : object
+        A model with a ``kind`` (and maybe a ``fit_report_``).
+    **parts
+        The document's entries after ``kind``, in their order.
+
+    Returns
+    -------
+    dict
+    """
     out: dict[str, Any] = {"kind": model.kind, **parts}
     report = getattr(model, "fit_report_", None)
     if report is not None:
@@ -145,7 +183,24 @@ def model_document(model: Any, **parts: Any) -> dict[str, Any]:
 
 def check_document(cls: type, data: Any, key: str, kind: type) -> None:
     """Raise unless ``data`` is a dict whose ``key`` holds a ``kind`` (a model file's
-    dictionary for ``cls.from_dict``)."""
+    dictionary for ``cls.from_dict``).
+
+    Parameters
+    ----------
+    cls : type
+        The class whose ``from_dict`` reads ``data`` (named in the message).
+    data : object
+        The document.
+    key : str
+        The entry it must hold.
+    kind : type
+        The type of that entry (``dict``, ``list``).
+
+    Raises
+    ------
+    InvalidParameterError
+        If it does not.
+    """
     if not (isinstance(data, dict) and isinstance(data.get(key), kind)):
         article = "an" if kind.__name__[0] in "aeiou" else "a"
         raise InvalidParameterError(
@@ -155,7 +210,15 @@ def check_document(cls: type, data: Any, key: str, kind: type) -> None:
 
 
 def read_fit_report(model: Any, data: dict[str, Any]) -> None:
-    """Give ``model`` the fit report of its model file's dictionary, if it holds one."""
+    """Give ``model`` the fit report of its model file's dictionary, if it holds one.
+
+    Parameters
+    ----------
+    model : object
+        The model read from ``data``.
+    data : dict
+        Its model file's dictionary.
+    """
     if "fit_report" in data:
         model.fit_report_ = dict(data["fit_report"])
 

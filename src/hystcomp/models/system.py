@@ -226,7 +226,27 @@ def fast_block(kernel, p, work, checked):
 
 def checked_state(value, size: int, stepper: object) -> np.ndarray:
     """``value`` as the state of ``stepper``, a 1-D array of ``size`` floats, or raise (for
-    the ``state`` setters of the steppers)."""
+    the ``state`` setters of the steppers).
+
+    Parameters
+    ----------
+    value : array_like
+        The state to set.
+    size : int
+        How many values the stepper's state has.
+    stepper : object
+        The stepper (its class is named in the message).
+
+    Returns
+    -------
+    ndarray
+        ``value`` as a float64 array.
+
+    Raises
+    ------
+    InvalidParameterError
+        If ``value`` is not of shape ``(size,)``.
+    """
     value = np.asarray(value, dtype=np.float64)
     if value.shape != (size,):
         raise InvalidParameterError(
