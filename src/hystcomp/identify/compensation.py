@@ -245,6 +245,10 @@ def swing_mask(v, start: int = 0, share: float = SWING) -> np.ndarray:
     return mask
 
 
+def _weighted_rms(error: np.ndarray, weight: np.ndarray) -> float:
+    return float(np.sqrt(np.sum(weight * error**2) / np.sum(weight)))
+
+
 def tracking_estimate(model, v, x, *, start: int = 0) -> dict:
     """How well ``model.inverse()`` will track a reference over most of its range, in µm rms.
 
@@ -255,7 +259,9 @@ def tracking_estimate(model, v, x, *, start: int = 0) -> dict:
 
     * ``e_swing``: the model's error against the record on its swings over at least half
       the input range (:func:`swing_mask`), where a reference over the range drives the
-      stage;
+      stage; each sample weighted by the displacement the model travels there, as a
+      reference at constant speed spends equal time on each micrometre (a sinusoid's record
+      dwells at its turns, a triangle's does not);
     * ``e_inverse``: the compensator's error on its own model for a triangle over 5-90 %
       of the model's reach, with :data:`REFERENCE_PERIOD` samples a period: the one-sample
       lag of eq. 10, and any part out of reach.
@@ -263,11 +269,10 @@ def tracking_estimate(model, v, x, *, start: int = 0) -> dict:
     Beside it, ``held_out_rms_um`` (from the fit, where the fit has one): the model's
     error on the reversal segments of a cross-validation, each fitted without them, which
     a reference that turns inside the range meets; ``flatters`` is True when that is more
-    than :data:`FLATTERS` times the estimate and :data:`FLATTERS_FLOOR` of the line's. On the tuning stages of
-    ``benchmarks/bench_accuracy.py`` (six stages of none of the families, four records,
-    three models) the estimate lies within 1.5x of the measured tracking of a 1 Hz
-    triangle in 93 % of the cells, and is never more than 2x optimistic (``python
-    benchmarks/bench_accuracy.py --estimate``).
+    than :data:`FLATTERS` times the estimate and :data:`FLATTERS_FLOOR` of the line's.
+    Its calibration against measured tracking on stages of none of the families is drawn
+    in the docs (``docs/estimate_calibration.png``, ``python benchmarks/bench_accuracy.py
+    --estimate --figure``).
 
     Parameters
     ----------
@@ -292,10 +297,15 @@ def tracking_estimate(model, v, x, *, start: int = 0) -> dict:
     mask = swing_mask(v, start)
     if not mask.any():  # no swing over half the range: the whole record
         mask[start:] = True
-    residual = np.asarray(model.simulate(v), dtype=np.float64) - x
-    swing = float(np.sqrt(np.mean(residual[mask] ** 2)))
+    fitted = np.asarray(model.simulate(v), dtype=np.float64)
+    # a reference at constant speed spends equal time on every micrometre: weight each
+    # sample by the displacement the model travels there, not by the record's dwell
+    weight = np.abs(np.gradient(fitted)) * mask if v.size > 1 else mask.astype(np.float64)
+    if not weight.sum() > 0.0:
+        weight = mask.astype(np.float64)
+    swing = _weighted_rms(fitted - x, weight)
     a, b = straight_line(v[start:], x[start:])
-    line = float(np.sqrt(np.mean((a * v[mask] + b - x[mask]) ** 2)))
+    line = _weighted_rms(a * v + b - x, weight)
     lo, hi = model.voltage_range_
     swept = np.asarray(model.simulate(np.array([lo, hi, lo, hi])), dtype=np.float64)
     bottom, top = float(swept[2]), float(swept[3])
