@@ -55,6 +55,11 @@ class PreisachStepper(Stepper):
     input sample holds the last output (before the first sample: ``x_0`` for a model,
     ``v_min`` clamped to the output range for a compensator) and is counted in
     :attr:`nonfinite_count`.
+
+    Parameters
+    ----------
+    packed : numpy.ndarray
+        The packed Preisach system (parameters and initial state).
     """
 
     kernels = pk.PREISACH_KERNELS
@@ -218,6 +223,25 @@ class Preisach(HysteresisModel):
         ``theta`` has ``d (d + 3) / 2`` entries for degree ``d`` (9 for eq. 5). ``table`` is
         a square array of ``X(alpha_i, beta_j)`` on ``n`` equally spaced voltages over
         ``voltage_range``; only its lower triangle (diagonal included) is read.
+
+        Parameters
+        ----------
+        theta : array_like, optional
+            The coefficients of the polynomial Everett function, eq. (5) order, µm/V^k.
+        table : array_like, optional
+            The Everett function on an equally spaced grid, µm (square; its lower triangle is
+            read).
+        voltage_range : tuple of (float, float), optional
+            The amplifier's range, V.
+        output_offset : float, optional
+            The displacement at the start state, µm.
+        max_extrema : int, optional
+            The bound on the memory of dominant extrema.
+
+        Returns
+        -------
+        Preisach
+            The model, as if fitted.
         """
         owner = cls.__name__
         if (theta is None) == (table is None):
@@ -256,6 +280,16 @@ class Preisach(HysteresisModel):
         Evaluation takes the degree of X and the memory bound from the hyperparameters, so
         a document whose ``theta`` has the size of another degree, or whose ``max_extrema``
         is not an int >= 3, is refused here rather than failing later.
+
+        Parameters
+        ----------
+        data : dict
+            A dictionary as :meth:`to_dict` writes it.
+
+        Returns
+        -------
+        Preisach
+            The model, validated.
         """
         model = super().from_dict(data)
         check_int(model.max_extrema, "max_extrema", cls.__name__, minimum=3, maximum=pk.MAX_DEPTH)
@@ -337,7 +371,13 @@ class Preisach(HysteresisModel):
             )
 
     def parameters(self) -> dict:
-        """The learned parameters as plain Python values (``theta`` or ``table``)."""
+        """The learned parameters as plain Python values (``theta`` or ``table``).
+
+        Returns
+        -------
+        dict
+            ``{"theta": [...]}`` or ``{"table": [[...]]}``, with ``output_offset``.
+        """
         out = super().parameters()
         return {name: value for name, value in out.items() if value is not None}
 
@@ -380,7 +420,20 @@ class Preisach(HysteresisModel):
         check_rising_everett(grid, nodes, what, cells="voltages")
 
     def everett_function(self, alpha, beta) -> np.ndarray:
-        """``X(alpha, beta)`` in µm (eq. 2) at voltages clamped to the plane (broadcast)."""
+        """``X(alpha, beta)`` in µm (eq. 2) at voltages clamped to the plane (broadcast).
+
+        Parameters
+        ----------
+        alpha : array_like
+            Upper switching voltages, V.
+        beta : array_like
+            Lower switching voltages, V.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``X(alpha, beta)``, µm, broadcast over the two.
+        """
         lo, hi = self.voltage_range_
         a, b = np.broadcast_arrays(np.asarray(alpha, float), np.asarray(beta, float))
         a_flat = np.ascontiguousarray(np.clip(a, lo, hi)).ravel()
@@ -414,6 +467,11 @@ class Preisach(HysteresisModel):
         model (steepest slope 1.32x the chord) it is the chord, within 4 % of the
         least-squares slope of x against v over the identification records (0.306 against
         0.310 and 0.319 µm/V).
+
+        Returns
+        -------
+        float
+            The gain ``rho``, µm/V.
         """
         self._check_fitted()
         lo, hi = self.voltage_range_
@@ -471,6 +529,11 @@ class Preisach(HysteresisModel):
             series: ``v = H^-1[D^-1[x_ref]]`` (beyond the paper; see
             :mod:`hystcomp.models.dynamics`). Returns a
             :class:`~hystcomp.models.dynamic_compensator.DynamicCompensator` then.
+
+        Returns
+        -------
+        PreisachCompensator or DynamicCompensator
+            The compensator; with ``dynamics``, in series with their inverse.
         """
         if method is None:
             method = "exact" if dynamics is not None and rho is None else "multiplicative"
@@ -515,6 +578,19 @@ class PreisachCompensator(Compensator):
     Built by :meth:`Preisach.inverse`; the output is always inside ``voltage_range``, and
     before the first sample it is ``v_min`` (the model's start state) clamped to it. Batch
     ``simulate`` and the stepper run the same kernel, bit for bit.
+
+    Parameters
+    ----------
+    model : Preisach
+        The forward model it inverts.
+    method : str
+        ``"multiplicative"`` (eq. 10) or ``"exact"``.
+    rho : float or None
+        The gain of eq. (10), µm/V (None for the exact inverse).
+    max_step : float
+        Largest output change per sample, V.
+    clamp : tuple of (float, float)
+        The output clamp, V.
 
     Attributes
     ----------

@@ -45,6 +45,19 @@ def check_packed_chain(packed, owner: str) -> np.ndarray:
 
     The kernels read the array without bounds checks, so an array of another layout would
     make them read or write outside it. Raises InvalidTypeError or InvalidParameterError.
+
+    Parameters
+    ----------
+    packed : array_like
+        A packed chain: counts, thresholds, weights and states, as :mod:`hystcomp._kernels.chain`
+        lays them out.
+    owner : str
+        The class named in an error message.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``packed`` as float64.
     """
     fix = "build it with model.inverse() (or take the .packed of one)"
     try:
@@ -90,7 +103,20 @@ def check_packed_chain(packed, owner: str) -> np.ndarray:
 
 def block(u, owner: str) -> np.ndarray:
     """A block of samples for a block kernel: 1-D, contiguous, writeable float64, or raise
-    (text, booleans, objects, more than one dimension)."""
+    (text, booleans, objects, more than one dimension).
+
+    Parameters
+    ----------
+    u : array_like
+        A block of input samples.
+    owner : str
+        The class named in an error message.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``u`` as a 1-D, contiguous, writeable float64 array.
+    """
     try:
         arr = np.asarray(u)
     except (TypeError, ValueError):  # ragged nesting
@@ -118,7 +144,22 @@ _UNIT_STRIDE = (8,)
 
 def output_block(out, u: np.ndarray, owner: str) -> np.ndarray:
     """``out`` if a block kernel can write the outputs of ``u`` into it, else raise: a
-    writeable, C-contiguous float64 array as long as ``u`` that does not overlap it."""
+    writeable, C-contiguous float64 array as long as ``u`` that does not overlap it.
+
+    Parameters
+    ----------
+    out : numpy.ndarray or None
+        Where the caller wants the outputs written (a new array if None).
+    u : numpy.ndarray
+        The block of inputs.
+    owner : str
+        The class named in an error message.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``out``, checked, or a new array as long as ``u``.
+    """
     if not (isinstance(out, np.ndarray) and out.dtype == np.float64):
         raise InvalidTypeError(
             f"The 'out' parameter of {owner} must be a float64 NumPy array. Got "
@@ -145,7 +186,20 @@ def output_block(out, u: np.ndarray, owner: str) -> np.ndarray:
 def checked_step(kernel, p):
     """``step(u) = kernel(p, u)`` for a float ``u`` (the fast path: one type test), and
     for any other real number after conversion; text, bools and arrays are refused (the
-    compiled kernel alone would parse a string)."""
+    compiled kernel alone would parse a string).
+
+    Parameters
+    ----------
+    kernel : callable
+        A compiled step kernel, ``kernel(p, u)``.
+    p : numpy.ndarray
+        The packed system (its state advances).
+
+    Returns
+    -------
+    callable
+        ``step(u) -> float``.
+    """
 
     def step(u):
         if u.__class__ is float:
@@ -158,7 +212,22 @@ def checked_step(kernel, p):
 
 
 def checked_pair_step(kernel, p, q):
-    """:func:`checked_step` for a kernel over two packed systems: ``step(u) = kernel(p, q, u)``."""
+    """:func:`checked_step` for a kernel over two packed systems: ``step(u) = kernel(p, q, u)``.
+
+    Parameters
+    ----------
+    kernel : callable
+        A compiled step kernel over two packed systems, ``kernel(p, q, u)``.
+    p : numpy.ndarray
+        The first packed system (its state advances).
+    q : numpy.ndarray
+        The second packed system.
+
+    Returns
+    -------
+    callable
+        ``step(u) -> float``.
+    """
 
     def step(u):
         if u.__class__ is float:
@@ -180,6 +249,22 @@ def fast_block(kernel, p, work, checked):
     a few type tests in Python and one compiled call, which checks the lengths and the
     overlap itself (status 0: done). Anything else goes to ``checked(u, out)``, which
     converts or refuses it with a message.
+
+    Parameters
+    ----------
+    kernel : callable
+        A block kernel.
+    p : numpy.ndarray
+        The packed system (its state advances).
+    work : numpy.ndarray
+        Scratch space for the kernel.
+    checked : callable
+        The slow path, ``checked(u, out)``, that converts or refuses other inputs.
+
+    Returns
+    -------
+    callable
+        ``step_block(u, out=None) -> numpy.ndarray``.
     """
     compiled = None  # a stepper that never takes this path compiles nothing for it
 
@@ -246,6 +331,11 @@ class Stepper(Rebound):
     its state lies; it is the play chain's here, the Preisach system's in
     :class:`~hystcomp.models.preisach.PreisachStepper` and the simulated axis's in
     :class:`~hystcomp.plant.twin.TwinStepper`.
+
+    Parameters
+    ----------
+    packed : numpy.ndarray
+        The packed system (parameters and initial state); the stepper works on a copy.
     """
 
     kernels = chain.CHAIN_KERNELS
@@ -340,7 +430,13 @@ class Stepper(Rebound):
         self._p[:] = self._initial
 
     def copy(self) -> Stepper:
-        """An independent stepper in the same state."""
+        """An independent stepper in the same state.
+
+        Returns
+        -------
+        Stepper
+            A new stepper in this one's state; stepping either leaves the other as it is.
+        """
         twin = type(self)(self._initial)
         twin._p[:] = self._p
         return twin
@@ -423,5 +519,11 @@ class PackedSystem(ABC):
         return out
 
     def stepper(self) -> Stepper:
-        """A :class:`Stepper` (of ``stepper_class``) starting from the initial state."""
+        """A :class:`Stepper` (of ``stepper_class``) starting from the initial state.
+
+        Returns
+        -------
+        Stepper
+            A stepper in the initial state.
+        """
         return self.stepper_class(self._packed())
