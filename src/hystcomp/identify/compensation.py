@@ -68,6 +68,20 @@ def inside_training(v, folds, fold: int) -> np.ndarray:
     measures the model's extrapolation, not its error on the branches a reference meets:
     those samples are not scored.
 
+    Parameters
+    ----------
+    v : array_like
+        The record's input, V.
+    folds : array_like of int
+        The fold of every sample (-1 for none), :func:`~hystcomp.identify.scoring.reversal_folds`.
+    fold : int
+        The held-out fold.
+
+    Returns
+    -------
+    numpy.ndarray
+        A boolean mask over the samples: in ``fold`` and inside the other folds' input range.
+
     Examples
     --------
     >>> inside_training(np.array([0.0, 5.0, 10.0, 5.0]), np.array([0, 1, 1, 0]), 1).tolist()
@@ -102,6 +116,25 @@ def tracking_scorer(v, x, *, start: int = 0, max_samples=MAX_SCORED_SAMPLES, fol
     ``score(model, held_out, estimate=False)`` leaves out the inverse's run over the whole
     record: the score then holds the held-out figures and ``criterion_um`` only, enough to
     rank candidates at a fraction of the cost.
+
+    Parameters
+    ----------
+    v : array_like
+        The record's voltage, V.
+    x : array_like
+        The record's displacement, µm.
+    start : int, optional
+        The first sample scored (after the start-up transient).
+    max_samples : int, optional
+        The record is thinned to about this many samples for the inverse's run.
+    folds : array_like of int, optional
+        The fold of every sample, for the held-out forward error.
+
+    Returns
+    -------
+    callable
+        ``score(model, held_out=(), estimate=True) -> dict`` with the estimates in µm
+        (``criterion_um``, and ``held_out_rms_um`` with held-out fits).
     """
     owner = "compensation_error"
     v, x = as_signal_pair(v, x, ("v", "x"), owner, min_samples=2)
@@ -225,6 +258,20 @@ def swing_mask(v, start: int = 0, share: float = SWING) -> np.ndarray:
     """Samples of the record's swings of at least ``share`` of its input span (after
     ``start``): the monotone stretches between turning points (reversals under 5 % of
     the span ignored) that travel that far.
+
+    Parameters
+    ----------
+    v : array_like
+        The record's input, V.
+    start : int, optional
+        The first sample considered (after the start-up transient).
+    share : float, optional
+        The least travel of a swing, as a share of the input span.
+
+    Returns
+    -------
+    numpy.ndarray
+        A boolean mask over the samples: True on the swings that travel that far.
 
     Examples
     --------

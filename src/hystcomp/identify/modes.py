@@ -194,6 +194,20 @@ def keeps_second_mode(one: ModalFit, two: ModalFit, top_hz: float) -> bool:
     Its residual is at most :data:`RESIDUAL_RATIO` of one mode's, its second mode is a
     resonance (damping ratio below :data:`MAX_SECOND_DAMPING`) within the lines' band (at
     most ``top_hz``) with at least :data:`MIN_SHARE` of the static gain.
+
+    Parameters
+    ----------
+    one : ModalFit
+        The fit of one mode.
+    two : ModalFit
+        The fit of two modes.
+    top_hz : float
+        The highest frequency of the lines, Hz.
+
+    Returns
+    -------
+    bool
+        True if the second mode is kept.
     """
     if len(two.modes) < 2:
         return False

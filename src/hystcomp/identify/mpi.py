@@ -179,6 +179,17 @@ def absorb_bias(weights, initial_state, input_offset: float, bias: float):
     with ``c = b / sum(w)``, ``v_0' = v_0 - c`` and ``y_0' = y_0 + c`` (shift equivariance of
     eq. 11). Needs ``sum(w) != 0`` (guaranteed by the invertibility constraint).
 
+    Parameters
+    ----------
+    weights : array_like
+        The play weights ``w_i``.
+    initial_state : array_like
+        The plays' initial states ``y_0``, V.
+    input_offset : float
+        The input offset ``v_0``, V.
+    bias : float
+        The constant ``b`` added to the superposition.
+
     Returns
     -------
     initial_state, input_offset

@@ -76,6 +76,18 @@ from hystcomp.identify.scoring import (
 def paper_thresholds(n_operators: int, span: float) -> np.ndarray:
     """Eq. (16)/(17): ``r_i = i / (n+1) * span`` for ``i = 0..n`` (``n_operators = n + 1``).
 
+    Parameters
+    ----------
+    n_operators : int
+        The number of plays, ``n + 1``.
+    span : float
+        The input span (``v_max``, eq. 16) or ``max{x_p}`` (eq. 17).
+
+    Returns
+    -------
+    numpy.ndarray
+        The thresholds, rising from 0.
+
     Examples
     --------
     >>> paper_thresholds(4, 120.0).tolist()
@@ -98,6 +110,20 @@ def play_thresholds(n_operators: int, span: float, constraints: str) -> np.ndarr
     the 1 Hz tracking error in most cells (from the paper's triangles on the Bouc-Wen stage:
     PI from 0.52x to 0.46x, MPI from 0.52x to 0.48x).
 
+    Parameters
+    ----------
+    n_operators : int
+        The number of plays.
+    span : float
+        The input span, V.
+    constraints : str
+        ``"paper"`` or ``"physical"``.
+
+    Returns
+    -------
+    numpy.ndarray
+        The thresholds, V, rising from 0.
+
     Examples
     --------
     >>> play_thresholds(4, 120.0, "paper").tolist()
@@ -113,7 +139,18 @@ INITIAL_MEMORIES = ("virgin", "descended")
 
 
 def check_initial_memory(initial_memory) -> str:
-    """The ``initial_memory`` option: one of :data:`INITIAL_MEMORIES`."""
+    """The ``initial_memory`` option: one of :data:`INITIAL_MEMORIES`.
+
+    Parameters
+    ----------
+    initial_memory : str
+        The option as given.
+
+    Returns
+    -------
+    str
+        ``initial_memory``, checked.
+    """
     if initial_memory not in INITIAL_MEMORIES:
         raise InvalidParameterError(
             f"The 'initial_memory' parameter must be one of {INITIAL_MEMORIES}. "
@@ -131,6 +168,20 @@ def initial_play_states(u0: float, thresholds, initial_memory: str) -> np.ndarra
     the top of its band, ``y_i = u0 + r_i``, as after a descent from far above (for the
     plays, the state of a Preisach model whose every relay is off, the start of
     :class:`~hystcomp.Preisach`): every loop from ``u0`` closes there again.
+
+    Parameters
+    ----------
+    u0 : float
+        The first input of the plays, V.
+    thresholds : array_like
+        The play thresholds, V.
+    initial_memory : str
+        ``"virgin"`` or ``"descended"``.
+
+    Returns
+    -------
+    numpy.ndarray
+        The initial states, V.
 
     Examples
     --------
@@ -150,6 +201,27 @@ class PreparedRecord:
     them, or for a record longer than :data:`~hystcomp.identify.scoring.MAX_SAMPLES` its
     turning points and a regular subset, :func:`~hystcomp.identify.scoring.thin`); ``start``
     indexes them.
+
+    Parameters
+    ----------
+    v : numpy.ndarray
+        The voltages the fit uses, V.
+    x : numpy.ndarray
+        The displacements the fit uses, µm.
+    input_offset : float
+        The voltage subtracted before the plays, V.
+    u : numpy.ndarray
+        The plays' input ``v - input_offset``, V.
+    start : int
+        The first of the kept samples in the fit's cost (after the start-up transient).
+    input_span : float
+        The span of the input, V.
+    slope : float
+        The straight line's slope, µm/V.
+    samples : numpy.ndarray
+        The indices of the kept samples in the record.
+    weights : numpy.ndarray, optional
+        The samples' weights in the fit (None: all equal).
     """
 
     v: np.ndarray
@@ -174,6 +246,26 @@ def prepare_record(
     ``weighted``, the kept samples get weights under which every part of the input range
     counts the same (:func:`~hystcomp.identify.scoring.range_weights`); otherwise every
     sample weighs the same.
+
+    Parameters
+    ----------
+    v : array_like
+        The record's voltage, V.
+    x : array_like
+        The record's displacement, µm.
+    n_weights : int
+        The number of weights to fit (the record must hold more samples).
+    transient : int or None
+        The first sample of the fit (found from the record if None).
+    owner : str
+        The class named in an error message.
+    weighted : bool, optional
+        Whether every part of the input range should weigh the same.
+
+    Returns
+    -------
+    PreparedRecord
+        The record, ready for the fit.
     """
     v = as_signal(v, "v", min_samples=2)
     x = as_signal(x, "x", min_samples=2)

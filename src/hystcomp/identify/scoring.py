@@ -76,7 +76,24 @@ def _first_near_an_end(v: np.ndarray) -> int:
 
 
 def check_transient(transient, v: np.ndarray, owner: str, *, min_used: int) -> int:
-    """The first sample of the fit: ``transient`` validated, or :func:`transient_end`."""
+    """The first sample of the fit: ``transient`` validated, or :func:`transient_end`.
+
+    Parameters
+    ----------
+    transient : int or None
+        The first sample of the fit as the user gave it (found from the record if None).
+    v : numpy.ndarray
+        The record's voltage, V.
+    owner : str
+        The class named in an error message.
+    min_used : int
+        The fewest samples the fit needs after the transient.
+
+    Returns
+    -------
+    int
+        The first sample of the fit.
+    """
     start = (
         _first_near_an_end(v)
         if transient is None
@@ -100,7 +117,18 @@ MAX_SAMPLES = 20_000
 
 
 def input_noise(v: np.ndarray) -> float:
-    """Robust estimate of white noise on ``v`` (V) from the MAD of second differences."""
+    """Robust estimate of white noise on ``v`` (V) from the MAD of second differences.
+
+    Parameters
+    ----------
+    v : numpy.ndarray
+        The record's voltage, V.
+
+    Returns
+    -------
+    float
+        The noise's standard deviation, V.
+    """
     if v.size < 4:
         return 0.0
     d2 = np.diff(v, 2)
@@ -108,14 +136,40 @@ def input_noise(v: np.ndarray) -> float:
 
 
 def default_tolerance(v: np.ndarray) -> float:
-    """Dead band of the turning-point search: ``max(1e-3 * span, 8 * noise)`` in V."""
+    """Dead band of the turning-point search: ``max(1e-3 * span, 8 * noise)`` in V.
+
+    Parameters
+    ----------
+    v : numpy.ndarray
+        The record's voltage, V.
+
+    Returns
+    -------
+    float
+        The dead band, V.
+    """
     return max(1e-3 * float(np.ptp(v)), 8.0 * input_noise(v))
 
 
 def turning_indices(v: np.ndarray, tolerance: float) -> tuple[np.ndarray, bool]:
     """``(indices, first_is_max)``: the alternating extrema of ``v``, reversals smaller than
     ``tolerance`` ignored; the last index is where ``v`` stands at its end (see
-    :func:`hystcomp._kernels.reversals.turning_points`)."""
+    :func:`hystcomp._kernels.reversals.turning_points`).
+
+    Parameters
+    ----------
+    v : numpy.ndarray
+        The signal, V.
+    tolerance : float
+        The dead band, V: smaller reversals are ignored.
+
+    Returns
+    -------
+    indices : numpy.ndarray
+        The indices of the alternating extrema, the last sample's index last.
+    first_is_max : bool
+        Whether the first extremum is a maximum.
+    """
     idx = np.empty(v.size, dtype=np.int64)
     count, first_is_max = turning_points(v, tolerance, idx)
     return idx[:count], bool(first_is_max)
@@ -134,6 +188,18 @@ def largest_swings(levels) -> tuple[float, float]:
     rate-independent hysteresis model with wipe-out sees them: a turning point beyond the
     one before last wipes out the minor loop between them, so a climb through small dips
     counts as one rise (the first level, where the record's memory is known, stays).
+
+    Parameters
+    ----------
+    levels : sequence of float
+        Turning points, in order.
+
+    Returns
+    -------
+    rise : float
+        The largest rise.
+    fall : float
+        The largest fall.
 
     Examples
     --------
@@ -176,6 +242,18 @@ def coverage_warning(v, start: int = 0) -> str | None:
     0.555x measured); the records passed (the paper's triangles and sinusoids, random
     turning points, ``excite rich``, a random walk that turns back across the range) at a
     median 0.55x, more than 2x in 2 of 75.
+
+    Parameters
+    ----------
+    v : array_like
+        The record's voltage, V.
+    start : int, optional
+        The first sample after the start-up transient.
+
+    Returns
+    -------
+    str or None
+        The reason, or None if the record rises, falls and turns back inside its range.
 
     Examples
     --------
@@ -233,6 +311,20 @@ def thin(v, start: int = 0, max_samples: int = MAX_SAMPLES) -> np.ndarray:
     weights the record as the whole does. Before ``start`` (a start-up transient, out of the
     cost) only the turning points are kept, to set the model's state.
 
+    Parameters
+    ----------
+    v : array_like
+        The record's input, V.
+    start : int, optional
+        The first sample of the fit; before it only turning points are kept.
+    max_samples : int, optional
+        About how many samples to keep.
+
+    Returns
+    -------
+    numpy.ndarray
+        The kept indices, rising.
+
     Examples
     --------
     >>> thin(np.array([0.0, 1.0, 2.0, 3.0, 2.0, 1.0, 2.0]), max_samples=2).tolist()
@@ -281,6 +373,18 @@ def range_weights(u, start: int = 0) -> np.ndarray:
     0.50x and 0.49x, with the square root of the weights 0.55x, with their 1.5th power
     0.56x.
 
+    Parameters
+    ----------
+    u : array_like
+        The fit's input, V.
+    start : int, optional
+        The first sample in the fit's cost.
+
+    Returns
+    -------
+    numpy.ndarray
+        One weight per sample, averaging 1 over ``u[start:]``.
+
     Examples
     --------
     >>> w = range_weights(np.r_[np.zeros(30), np.linspace(0.0, 1.0, 24)])
@@ -307,6 +411,20 @@ def reversal_folds(v, start: int, n_folds: int) -> np.ndarray:
     every fold holds ascending and descending branches from all over the record, and a
     model fitted on the other folds must predict whole branches it has not seen. Samples
     before ``start`` get -1.
+
+    Parameters
+    ----------
+    v : array_like
+        The record's input, V.
+    start : int
+        The first sample dealt out (earlier ones get -1).
+    n_folds : int
+        The number of folds.
+
+    Returns
+    -------
+    numpy.ndarray
+        The fold of every sample (int).
 
     Examples
     --------
@@ -445,6 +563,20 @@ def error_report(x, x_model, start: int = 0) -> dict:
 def straight_line(v, x) -> tuple[float, float]:
     """Least-squares line ``x = a v + b`` (a in µm/V, b in µm): the no-hysteresis baseline.
 
+    Parameters
+    ----------
+    v : array_like
+        Voltage, V.
+    x : array_like
+        Displacement, µm.
+
+    Returns
+    -------
+    a : float
+        The slope, µm/V.
+    b : float
+        The intercept, µm.
+
     Examples
     --------
     >>> a, b = straight_line([0.0, 1.0, 2.0], [1.0, 3.0, 5.0])
@@ -465,6 +597,19 @@ def holdout_report(model, v, x, n_fit: int, start: int = 0) -> dict:
     The model is run over the whole record (so that its state is right when the held-out
     part begins) and scored on ``n_fit..`` only. The baseline is the straight line
     :func:`straight_line` fitted on the same samples as the model (``start..n_fit``).
+
+    Parameters
+    ----------
+    model : HysteresisModel
+        The model fitted on ``v[:n_fit]``.
+    v : array_like
+        The whole record's voltage, V.
+    x : array_like
+        The whole record's displacement, µm.
+    n_fit : int
+        The number of samples the model was fitted on.
+    start : int, optional
+        The first sample of the fit (after the start-up transient).
 
     Returns
     -------
