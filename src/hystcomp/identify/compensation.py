@@ -27,16 +27,11 @@ of a cross-validation over the record's reversal segments
 (:func:`~hystcomp.identify.scoring.reversal_folds`, :data:`CV_FOLDS` folds, each fit on the
 other folds) rates each candidate by ``criterion_um``: the geometric mean of the held-out
 forward error and the held-out inverse error above, on the branches each fit did not see.
-On the panel of ``benchmarks/bench_accuracy.py`` (5 actuators of none of the model
-families, 4 excitations) it ranks the candidate PI and MPI fits of a record as their
-measured 1 Hz tracking does with a median Spearman rank correlation of 0.96 (mean 0.88,
-worst cell 0.29), where the fit error reaches 0.93 (0.86, 0.29) and the inverse's estimate
-on the whole record 0.91 (0.81, 0.25); the MPI regularisation it chooses tracks within
-0.002x of the uncompensated error of the best of the grid in every cell (fit error 0.002x,
-the estimate alone 0.012x; before the MPI fit chose its plays' initial memory too, 0.015x,
-0.042x and 0.025x). The estimate alone is weakest on a Preisach actuator with
-output saturation, where a voltage error at the saturated top counts more than the
-tracking error it causes; the held-out forward error is not.
+It ranks candidate fits closer to their measured tracking than the fit error or the
+inverse's estimate alone do (Benchmarks, "Ranking candidate fits"). The estimate alone is
+weakest on a Preisach actuator with output saturation, where a voltage error at the
+saturated top counts more than the tracking error it causes; the held-out forward error is
+not.
 """
 
 from __future__ import annotations
@@ -310,11 +305,9 @@ def tracking_estimate(model, v, x, *, start: int = 0) -> dict:
     Beside it, ``held_out_rms_um`` (from the fit, where the fit has one): the model's
     error on the reversal segments of a cross-validation, each fitted without them, which
     a reference that turns inside the range meets; ``flatters`` is True when that is more
-    than :data:`FLATTERS` times the estimate and :data:`FLATTERS_FLOOR` of the line's. On the tuning stages of
-    ``benchmarks/bench_accuracy.py`` (six stages of none of the families, four records,
-    three models) the estimate lies within 1.5x of the measured tracking of a 1 Hz
-    triangle in 93 % of the cells, and is never more than 2x optimistic (``python
-    benchmarks/bench_accuracy.py --estimate``).
+    than :data:`FLATTERS` times the estimate and :data:`FLATTERS_FLOOR` of the line's. How
+    close the estimate comes to the measured tracking is in the documentation
+    (Benchmarks, "The tracking estimate").
 
     Parameters
     ----------

@@ -150,7 +150,7 @@ def scaled_amplitudes(
 
     Returns
     -------
-    numpy.ndarray
+    tuple of float
         The amplitudes for ``voltage_range``, V.
     """
     lo, hi = check_range(voltage_range, "voltage_range", "scaled_amplitudes")
@@ -179,11 +179,8 @@ def random_turning_points(
     at ``rate`` V/s (240 V/s: the slope of the paper's 120 V triangle at 1 Hz), as in
     :func:`rich_sequence`.
 
-    Ramps rather than half-cosine sweeps of random duration: on the actuator panel of
-    ``benchmarks/bench_accuracy.py`` (5 actuators of none of the model families), PI fitted
-    to half-cosine sweeps tracked a 1 Hz triangle worse (mean 0.36x the uncompensated rms
-    against 0.30x from ramps, worst 0.45x against 0.37x), MPI and Preisach alike (0.19x and
-    0.11x both ways).
+    Ramps rather than half-cosine sweeps of random duration: a PI model fitted to ramps
+    tracks better, MPI and Preisach models alike (Benchmarks, "Excitation signals").
 
     Parameters
     ----------

@@ -34,14 +34,8 @@ from hystcomp._lti import resonance_response, resonance_zoh
 #: The second mode lies at least this multiple of the first's frequency above it.
 SEPARATION = 1.15
 #: Keep two modes when their residual (rms of the relative complex error on the lines) is at
-#: most this share of one mode's. Measured (the ratio, two modes' residual over one's): 0.02
-#: to 0.11 on the two-mode stage of the dynamics panel (``narrow1200``; behind MPI and
-#: Preisach as ``fit_pair`` fits it, and on the voltage), 0.002 to 0.07 on linear stages of
-#: 1 kHz with a second mode of 2 to 30 % at 1.5 to 4 kHz; 0.54 to 1.0 on the panel's five
-#: single-mode stages, 0.76 to 1.0 on the simulated axis (``creep_twin`` at 630 and
-#: 780 Hz), 0.78 to 1.0 on linear single-mode stages (300 Hz to 1.5 kHz, zeta 0.02 to 1.5,
-#: 5 to 20 kHz, latencies 0 and 2). 0.25 is about the geometric middle of the gap (0.11 ..
-#: 0.54); see docs/dynamics.md.
+#: most this share of one mode's: about the geometric middle of the gap between the ratios
+#: measured on two-mode and on single-mode stages (docs/dynamics.md, "A second mode").
 RESIDUAL_RATIO = 0.25
 #: A second mode is kept only if it is a resonance (damped less than this) and holds at
 #: least :data:`MIN_SHARE` of the static gain.

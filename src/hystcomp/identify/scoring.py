@@ -109,10 +109,8 @@ def check_transient(transient, v: np.ndarray, owner: str, *, min_used: int) -> i
 
 
 #: Records longer than this are thinned (:func:`thin`) before a PI or MPI fit. A
-#: rate-independent loop is described by far fewer samples than a 20 kHz record holds: on
-#: the panel of ``benchmarks/bench_accuracy.py`` (records of 80,000 to 480,000 samples)
-#: fits on every turning point and about 20,000 regular samples track within 0.001x of
-#: fits on every sample, at a quarter of the cost or less.
+#: rate-independent loop is described by far fewer samples than a 20 kHz record holds
+#: (Benchmarks, "Thinning a record").
 MAX_SAMPLES = 20_000
 
 
@@ -234,14 +232,8 @@ def coverage_warning(v, start: int = 0) -> str | None:
     * turn back inside the range. A single loop, or a staircase up and down, turns only at
       the ends, so no branch after a reversal inside the range (a minor loop) is seen.
 
-    On the panel of ``benchmarks/bench_accuracy.py`` (five stages of none of the model
-    families, the three models; ``--coverage``), the records flagged here (a random walk
-    that drifts across the range once, one loop, a staircase up and down) tracked its 1 Hz
-    triangle at a median 1.21x their estimate, and at more than 2x in 13 of 45 cells (up to
-    45x: MPI from one loop on the Duhem stage, 0.012x the uncompensated error estimated,
-    0.555x measured); the records passed (the paper's triangles and sinusoids, random
-    turning points, ``excite rich``, a random walk that turns back across the range) at a
-    median 0.55x, more than 2x in 2 of 75.
+    The records flagged here track far worse than their estimate more often than the
+    records passed (Benchmarks, "Records that flatter the estimate").
 
     Parameters
     ----------
@@ -366,12 +358,9 @@ def range_weights(u, start: int = 0) -> np.ndarray:
     ``u[start:]``. Samples before ``start`` get the weight of their part (they are out of
     the cost anyway).
 
-    The PI fit with physical constraints uses it (:func:`hystcomp.identify.pi.fit_pi`); on
-    the panel of ``benchmarks/bench_accuracy.py`` (5 actuators of none of the families, 4
-    excitations) it brings the worst 1 Hz tracking of a PI compensator from 0.62x to 0.48x
-    the uncompensated error. With a cap of 10 the worst cell is 0.49x, with 12 or 48 parts
-    0.50x and 0.49x, with the square root of the weights 0.55x, with their 1.5th power
-    0.56x.
+    The PI fit with physical constraints uses it (:func:`hystcomp.identify.pi.fit_pi`); the
+    cap, the number of parts and the power of the weights were chosen on the benchmark
+    panel (Benchmarks, "The PI fit").
 
     Parameters
     ----------

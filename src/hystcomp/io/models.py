@@ -303,8 +303,8 @@ def load_model(path: str | os.PathLike) -> Model:
     Returns
     -------
     model
-        The model the file holds: a PI, MPI or Preisach model, linear dynamics, a Hammerstein pair,
-        a multi-axis model or a channel bank, fitted.
+        The model the file holds, fitted: a PI, MPI or Preisach model, linear dynamics,
+        a Hammerstein pair or a multi-axis model (the kinds of :data:`MODEL_KINDS`).
 
     Raises
     ------

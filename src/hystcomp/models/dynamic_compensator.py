@@ -459,8 +459,8 @@ class DynamicStepper(Rebound):
     A non-finite reference leaves the filter as it was and holds the last voltage.
     :meth:`step` is bound to one compiled kernel that runs both stages on their states
     (:data:`hystcomp._kernels.dynamics.PAIR_STEPS`), behind the same type test of the sample
-    as the hysteresis stepper's: one call from Python a sample, under 200 ns
-    (``python benchmarks/run.py dynamics_speed``), and the bits of :meth:`step_block`.
+    as the hysteresis stepper's: one call from Python a sample (Benchmarks, "Speed"), and
+    the bits of :meth:`step_block`.
 
     Parameters
     ----------

@@ -674,8 +674,7 @@ def with_dynamics(
     inverse of the dynamics is scaled to unit gain there, ``D^-1 |D(1 Hz)|``, and adds only
     what the hysteresis model lacks, the creep slower than 1 Hz and the fast dynamics. It
     cannot remove the creep faster than 1 Hz that such a model holds, which the pair does
-    (on a Preisach stage with 3 % creep, MPI at 1 Hz: 0.020 µm as a pair, 0.112 µm with
-    the true dynamics matched this way, 0.057 µm without dynamics). Creep scales the
+    (Benchmarks, "Dynamics"). Creep scales the
     displacement from rest, so the scaling is about rest for a PI or MPI model whose loops
     close there (one that starts descended,
     :func:`hystcomp.identify.pi.initial_play_states`), and about the middle of the

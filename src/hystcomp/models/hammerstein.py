@@ -12,8 +12,8 @@ consistent pair, a Hammerstein model:
   lag taken out, ``D^-1[x]`` (:meth:`LinearDynamics.remove`). A hysteresis model fitted
   on the raw 1 Hz record already holds the creep and lag of that record, and ``D^-1``
   would correct them a second time;
-* the two fits alternate until ``H`` no longer changes (:func:`fit_pair`; one or two
-  rounds on the panel of ``benchmarks/bench_dynamics_panel.py``).
+* the two fits alternate until ``H`` no longer changes (:func:`fit_pair`, at most
+  :data:`MAX_ROUNDS` rounds).
 
 The inverse of a pair inverts ``D`` with its unit steady-state gain; a hysteresis model and
 dynamics identified apart (``model.inverse(dynamics=dyn)``) are matched at 1 Hz instead

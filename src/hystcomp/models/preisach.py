@@ -95,37 +95,12 @@ class Preisach(HysteresisModel):
     ``Preisach(fit_method="reversal-curves", everett="polynomial", zero_diagonal=False)``.
     ``hystcomp compare`` runs it for Table I with ``zero_diagonal=True``, ``X(v, v) = 0`` as
     eq. (2) implies: fitted free on the twin, the cubic's ``X(v, v)`` reaches 0.55 µm, a step
-    of the output at each reversal (its report gives both fits' tracking). The defaults were chosen by the measured tracking of a 1 Hz
-    triangle on the panel of ``benchmarks/bench_accuracy.py`` (5 actuators of none of the
-    model families x 4 excitations; rms error over the uncompensated one, worst / median
-    cell; ``python benchmarks/bench_accuracy.py --preisach``):
-
-    ==========================================  ============  ============
-    fit                                         worst         median
-    ==========================================  ============  ============
-    paper: reversal curves, cubic (sinusoids)   0.51          0.16
-    reversal curves, 25 x 25 table (sinusoids)  0.48          0.11
-    least squares, cubic                        0.31          0.16
-    least squares, 13 x 13 table                0.14          0.081
-    least squares, 17 x 17 table                0.14          0.080
-    least squares, 25 x 25 table (default)      0.16          0.074
-    least squares, 33 x 33 table                0.27          0.069
-    ==========================================  ============  ============
-
-    The reversal-curve fits have the sinusoids' 5 cells only, the others all 20. Since
-    those figures were measured, a model whose branch turns back has no compensator
-    (:meth:`inverse` refuses it, whatever the method): both reversal-curve fits have one
-    on the Preisach and Krasnosel'skii-Pokrovskii stages (by 0.03 to 0.23 µm, near a
-    reversal or an end of the range), where the exact inverse jumped 5 to 26 V in one
-    sample of a slow ramp (0.02 V with the twin's fits) and eq. (10) missed the model's
-    own output by up to 0.9 to 3.4 µm on a sinusoid (0.4 to 0.5 µm), so ``fit`` refuses
-    them there and the benchmark leaves those cells out. Least
-    squares with a table tracks at least as well as the cubic in every cell (better in 19 of
-    20: a cubic cannot follow a density that is not polynomial) and better than the paper's
-    fit on the paper's own record on every actuator (0.01 to 0.16x against 0.13 to 0.51x).
-    Of the grids, 25 nodes per axis has the best median; 13 and 17 have a slightly lower
-    worst cell (the Duhem stage from the sinusoids, 0.14x against 0.16x), and 33 over-fits
-    there (0.27x).
+    of the output at each reversal (its report gives both fits' tracking). The defaults were
+    chosen by the measured tracking of a 1 Hz triangle on the panel of
+    ``benchmarks/bench_accuracy.py`` (Benchmarks, "The Preisach fit"): least squares with a
+    table tracks at least as well as the cubic (a cubic cannot follow a density that is not
+    polynomial), and 25 nodes per axis has the best median. A model whose branch turns back
+    has no compensator (:meth:`inverse` refuses it, whatever the method).
 
     Parameters
     ----------
@@ -455,18 +430,11 @@ class Preisach(HysteresisModel):
         (which bound every branch's slope when the density is non-negative) exceeds
         :data:`RHO_STEEPEST` (2) times the chord, ``rho`` is that slope over
         :data:`RHO_STEEPEST`, so that the factor stays within -1 and the recursion never
-        amplifies an error. With the chord, a fit to a stage whose descending branch is
-        2.5x the chord steep (the Coleman-Hodgdon stage of ``benchmarks/panel.py``) made the
-        voltage move against the reference on 583 of 60001 samples of its 1 Hz triangles
-        (3 with this ``rho``), and its tracking error moved by 10 % with the last bits of
-        the model (0.161 to 0.176 of the uncompensated error, by CPU; 0.146 now). The price
-        is more lag where H is flat: +14 % rms on a random cubic model whose steepest
-        slope, near a reversal, is 2.2x the chord.
+        amplifies an error; the price is more lag where H is flat (Benchmarks, "The gain
+        rho").
 
         It is a property of the model, so any model file (or preset) has it; on the paper's
-        model (steepest slope 1.32x the chord) it is the chord, within 4 % of the
-        least-squares slope of x against v over the identification records (0.306 against
-        0.310 and 0.319 µm/V).
+        model, whose branches are nowhere twice as steep as the chord, it is the chord.
 
         Returns
         -------
@@ -503,9 +471,8 @@ class Preisach(HysteresisModel):
             By default ``"multiplicative"``, the paper's compensator, alone; ``"exact"``
             with ``dynamics`` (unless ``rho`` is given). In series with the inverse of the
             dynamics, eq. (10)'s one-sample lag overshoots the voltage on the fast rises that
-            inverse asks for, and the hysteresis memory keeps the overshoot: after a step the
-            error left from 20 ms to 3 s is 0.46-0.51x of the error without the dynamics with
-            eq. (10), 0.09-0.15x with the exact inverse (``benchmarks/bench_dynamics.py``).
+            inverse asks for, and the hysteresis memory keeps the overshoot, which the exact
+            inverse does not (Benchmarks, "Dynamics").
             ``"multiplicative"``: the paper's approximate inverse multiplicative structure,
             eq. (10): ``v[k] = (x_ref[k] - Gamma(v[k-1])) / rho`` with
             ``Gamma(v) = H(v) - rho v`` and H's memory advanced by each applied ``v[k]``.

@@ -317,11 +317,9 @@ class Stepper(Rebound):
     is counted in :attr:`nonfinite_count`; nothing is raised inside a real-time loop.
 
     For speed, each stepper binds :meth:`step` to the compiled step kernel and its own state
-    when it is made (no method lookup, no dispatch on argument types): a call from Python
-    costs about a quarter of a microsecond, 0.5 % of a 20 kHz period, for the play chains
-    and for the Preisach model and its multiplicative inverse; the exact Preisach inverse
-    adds its root search per sample (``python benchmarks/run.py realtime`` and ``...
-    preisach``). One test that the sample is a float guards it (the compiled kernel alone
+    when it is made (no method lookup, no dispatch on argument types; the cost of a call is
+    in the documentation, Benchmarks, "Speed"); the exact Preisach inverse adds its root
+    search per sample. One test that the sample is a float guards it (the compiled kernel alone
     would parse the text ``"1.0"``); that small Python frame is the only cost above the
     bare kernel (the ``realtime`` benchmark gives the ratio). A loop that has its samples
     in blocks can use :meth:`step_block`, faster per sample.
