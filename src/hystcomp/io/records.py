@@ -574,7 +574,8 @@ def uneven_sampling(t, what: str) -> str | None:
     Returns
     -------
     str or None
-        The reason (the largest gap and where), or None if the sampling is even.
+        The reason (how many steps differ from the median, the first of them), or None if
+        the sampling is even.
     """
     steps = np.diff(np.asarray(t, dtype=np.float64))
     if steps.size == 0:

@@ -305,7 +305,7 @@ class DynamicsInverseStepper(Rebound):
         outputs : numpy.ndarray
             The filter's outputs, µm.
         cut : numpy.ndarray
-            Whether the clamp to the displacement range cut each output (bool).
+            1.0 where the clamp to the displacement range counted the sample, else 0.0.
         """
         u = block(x_ref, "step_block")
         out = np.empty_like(u)

@@ -575,7 +575,8 @@ class LinearDynamics:
         Returns
         -------
         dict
-            ``{"kind": "dynamics", "parameters": ..., "fit_report": ...}``.
+            ``{"kind": "dynamics", "hyperparameters": {}, "parameters": ...}``, and
+            ``"fit_report"`` for a fitted model.
         """
         out: dict[str, Any] = {"kind": self.kind, "hyperparameters": {}}
         out["parameters"] = self.parameters()

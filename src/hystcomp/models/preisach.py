@@ -351,7 +351,8 @@ class Preisach(HysteresisModel):
         Returns
         -------
         dict
-            ``{"theta": [...]}`` or ``{"table": [[...]]}``, with ``output_offset``.
+            ``theta`` or ``table`` (the one the model has), ``voltage_range`` and
+            ``output_offset``, as :meth:`from_parameters` takes them.
         """
         out = super().parameters()
         return {name: value for name, value in out.items() if value is not None}
