@@ -3,9 +3,8 @@
 Beyond the paper. :func:`hystcomp.identify.dynamics.fit_dynamics` fits one resonance to the
 multisine's lines; a stage with a second mode in its band (a stack and its flexure, a
 mount) then gets a resonance between the two, too lightly damped, and a latency that takes
-up the second mode's phase (on the ``narrow1200`` stage of ``benchmarks/dynamics_panel.py``,
-1200 Hz and 3100 Hz holding 8 % of the static gain: 1184 Hz, zeta 0.033, a latency of -1
-sample, 73 % of the response explained). So, after the one-mode fit, two modes in parallel
+up the second mode's phase (docs/dynamics.md, "A second mode", gives the figures on the
+two-mode stage of ``benchmarks/dynamics_panel.py``). So, after the one-mode fit, two modes in parallel
 are fitted to the same lines (:func:`fit_modes`), each a second-order section of unit
 static gain, ``R = (1 - g) R1 + g R2``, the latency free with them, and
 :func:`keeps_second_mode` decides.

@@ -392,8 +392,8 @@ class Stepper(Rebound):
             Where to write the outputs: a writeable, contiguous float64 array as long as
             ``u``, not overlapping it, allocated once and passed on every call. With ``u`` a
             contiguous float64 array too, the call takes the fast path: a few type tests and
-            one compiled call (about a third of the time of a call that allocates; ``python
-            benchmarks/run.py realtime``). Anything else is checked and converted as without
+            one compiled call, faster than a call that allocates (Benchmarks, "Speed").
+            Anything else is checked and converted as without
             ``out``.
 
         Returns
