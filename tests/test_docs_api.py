@@ -242,3 +242,41 @@ def test_documented_parameters_are_the_signatures():
         if wanted - documented:
             wrong.append(f"{path}: undocumented {sorted(wanted - documented)}")
     assert wrong == []
+
+
+#: A benchmark ratio such as "0.48x" or "12x": figures belong in docs/benchmarks.md.
+RATIO = re.compile(r"\b\d+(\.\d+)?x\b")
+
+
+def test_docstrings_hold_no_benchmark_ratios():
+    # docstrings say what the code does; how well it does it is measured and kept in the docs
+    found = [
+        path
+        for path, obj in public_callables().items()
+        if _checked(path) and RATIO.search(inspect.getdoc(obj) or "")
+    ]
+    found += [
+        name
+        for name in public_modules(NOT_CHECKED)
+        if _checked(name) and RATIO.search(importlib.import_module(name).__doc__ or "")
+    ]
+    assert found == [], "move the figures to docs/benchmarks.md"
+
+
+def test_error_messages_hold_no_benchmark_ratios():
+    # a message names the argument, what was found and the fix; no measured figure
+    src = Path(hystcomp.__file__).parent
+    found = []
+    for path in sorted(src.rglob("*.py")):
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            is_warning = isinstance(node, ast.Call) and "warn" in ast.unparse(node.func)
+            if not (isinstance(node, ast.Raise) or is_warning):
+                continue
+            text = " ".join(
+                c.value
+                for c in ast.walk(node)
+                if isinstance(c, ast.Constant) and isinstance(c.value, str)
+            )
+            if RATIO.search(text):
+                found.append(f"{path.relative_to(src)}:{node.lineno}")
+    assert found == []
