@@ -13,8 +13,8 @@ import hystcomp
 
 SRC = Path(hystcomp.__file__).parent
 
-#: Layers from the bottom up (DESIGN.md, "Layout"); a module's layer is that of the longest
-#: prefix listed. A module may import from its own layer and the layers below it.
+#: Layers from the bottom up (docs/architecture.md, "The layers"); a module's layer is that of
+#: the longest prefix listed. A module may import from its own layer and the layers below it.
 LAYERS = {
     "hystcomp.errors": 0,
     "hystcomp.paper": 0,

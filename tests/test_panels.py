@@ -24,6 +24,7 @@ HYSTERESIS = {
     "maxwell": 14.0,
     "narrow": 14.0,
     "ratedep": 14.0,
+    "jiles": 12.0,
 }
 #: Of each kind of the dynamics panel ("9 to 14 %", KP 9 %).
 DYNAMICS_HYSTERESIS = {"narrow": (13.0, 14.0), "boucwen": (12.5, 13.5), "maxwell": (13.0, 14.0)}

@@ -3,8 +3,8 @@
 The PI/MPI fits accumulate their Gram matrix from blocks of 2048 x 34 regressors
 (:func:`hystcomp.identify.lsq.normal_equations`). A multi-threaded BLAS splits each product
 over its threads and wakes them for every block: on a machine whose other cores are busy,
-each block waits for a thread that the scheduler has given to someone else, and a fit of a
-million samples took a median 12x (1x to 20x) the time it takes on one thread. These
+each block waits for a thread that the scheduler has given to someone else, and a fit
+takes many times as long as on one thread (Benchmarks, "Speed"). These
 products are too small to gain from threads, so they run on one
 (:func:`one_blas_thread`, with threadpoolctl), whatever the process's BLAS is set to; the
 process's setting is back when the block ends.

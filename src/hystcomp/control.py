@@ -74,7 +74,13 @@ class DiscreteSystem:
     states: tuple[str, ...] | None = None
 
     def state_names(self) -> list[str]:
-        """The name of each state slot (``states``, or ``state[i]``)."""
+        """The name of each state slot (``states``, or ``state[i]``).
+
+        Returns
+        -------
+        list of str
+            One name per state slot.
+        """
         if self.states is not None and len(self.states) == self.state.size:
             return list(self.states)
         return [f"state[{i}]" for i in range(self.state.size)]
@@ -91,6 +97,16 @@ def register(cls: type):
 
     ``dt`` is the sample time in s that :func:`to_control` was given. A later registration
     wins over an earlier one and over the built-in kinds.
+
+    Parameters
+    ----------
+    cls : type
+        The class whose instances the decorated function describes.
+
+    Returns
+    -------
+    callable
+        The decorator; it returns the function unchanged.
     """
 
     def decorate(function):

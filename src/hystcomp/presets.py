@@ -40,12 +40,28 @@ PAPER_MPI_INVERSE_DEADZONE_WEIGHTS = np.array(paper.MPI_INVERSE_DEADZONE_WEIGHTS
 
 
 def paper_identification_triangle(sample_rate: float = 1000.0) -> np.ndarray:
-    """The paper's identification input (eq. 19): triangles of 30..120 V at 1 Hz from 0 V."""
+    """The paper's identification input (eq. 19): triangles of 30..120 V at 1 Hz from 0 V.
+
+    Parameters
+    ----------
+    sample_rate : float, optional
+        Samples per second, Hz.
+
+    Returns
+    -------
+    numpy.ndarray
+        The voltage, V: four triangles of 30, 60, 90 and 120 V peak, 1 s each.
+    """
     return triangle_sequence(sample_rate=sample_rate)[1]
 
 
 def paper_pi() -> PrandtlIshlinskii:
     """The PI model of eq. (20): 16 plays on 0..120 V.
+
+    Returns
+    -------
+    PrandtlIshlinskii
+        The model of eq. (20).
 
     Examples
     --------
@@ -61,7 +77,18 @@ def paper_pi() -> PrandtlIshlinskii:
 
 
 def paper_mpi_with(max_displacement: float) -> ModifiedPrandtlIshlinskii:
-    """The MPI of eqs. (21)-(22) with eq. (17)'s thresholds for ``max{x_p} = max_displacement`` µm."""
+    """The MPI of eqs. (21)-(22) with eq. (17)'s thresholds for ``max{x_p} = max_displacement`` µm.
+
+    Parameters
+    ----------
+    max_displacement : float
+        ``max{x_p}`` of eq. (17), the largest measured displacement, µm.
+
+    Returns
+    -------
+    ModifiedPrandtlIshlinskii
+        The model of eqs. (21)-(22) with those dead-zone thresholds.
+    """
     r_inv = paper_thresholds(paper.N_DEADZONES, max_displacement)  # eq. (17)
     rs, ws = ModifiedPrandtlIshlinskii.forward_deadzones(r_inv, PAPER_MPI_INVERSE_DEADZONE_WEIGHTS)
     return ModifiedPrandtlIshlinskii.from_parameters(
@@ -81,6 +108,11 @@ PAPER_MPI_MAX_DISPLACEMENT = 35.886667354280206
 
 def paper_mpi() -> ModifiedPrandtlIshlinskii:
     """The MPI model of eqs. (21)-(22) (16 plays, 16 dead-zones) on 0..120 V.
+
+    Returns
+    -------
+    ModifiedPrandtlIshlinskii
+        The model of eqs. (21)-(22).
 
     Examples
     --------
@@ -115,6 +147,17 @@ def paper_preisach(*, zero_diagonal: bool = False) -> Preisach:
       ``theta_2 = -(theta_3 + theta_4)``, ``theta_5 = -(theta_6 + theta_7 + theta_8)``),
       which keeps the initial ascending curve ``X(v, 0)`` and the major loop's end points and
       changes a descending branch by ``X(beta, beta)`` (at most 0.7 µm).
+
+    Parameters
+    ----------
+    zero_diagonal : bool, optional
+        Subtract ``X(beta, beta)`` so that ``X(v, v) = 0``, as eq. (2) implies (eq. 6 as printed if
+        False).
+
+    Returns
+    -------
+    Preisach
+        The model of eqs. (5)-(6).
 
     Examples
     --------

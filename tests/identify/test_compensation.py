@@ -209,3 +209,26 @@ def test_a_long_record_is_fitted_on_its_turning_points_and_a_grid(monkeypatch):
     assert model.fit_report_["n_samples"] < 0.3 * v.size  # scored where the fit ran
     assert model.fit_report_["rms_error_um"] < 1e-6  # exact: thinning loses nothing
     np.testing.assert_allclose(model.simulate(v), x, atol=1e-6)
+
+
+def test_the_estimate_does_not_depend_on_how_long_the_record_dwells_at_its_turns():
+    """A reference at constant speed spends equal time on every micrometre, so the estimate
+    weighs the record's samples by the displacement travelled: the same loops recorded as
+    triangles or as sinusoids (which dwell at their turns, where a misfit model errs most)
+    give the same estimate; the plain mean over samples would not."""
+    from hystcomp.identify.compensation import tracking_estimate
+
+    twin = Twin(seed=0)
+    model = presets.paper_mpi()  # a model of another stage: it errs most near the turns
+    n = 20_000
+    phase = np.arange(3 * n) % n / n
+    triangle = 120.0 * (1.0 - np.abs(1.0 - 2.0 * phase))
+    sinusoid = 60.0 * (1.0 - np.cos(2.0 * np.pi * phase))
+    estimates, plain = [], []
+    for v in (triangle, sinusoid):
+        x = twin.run(v)
+        estimates.append(tracking_estimate(model, v, x, start=n)["swing_rms_um"])
+        mask = np.arange(v.size) >= n
+        plain.append(float(np.sqrt(np.mean((model.simulate(v) - x)[mask] ** 2))))
+    assert estimates[1] == pytest.approx(estimates[0], rel=0.002)
+    assert abs(plain[1] / plain[0] - 1.0) > 0.01

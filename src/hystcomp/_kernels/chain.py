@@ -24,7 +24,7 @@ Speed: a batch run takes the samples in blocks and the chain stage by stage. The
 are stateless, so each is a pass over the block that vectorises over samples; the plays are
 the only recurrence and go sample by sample, vectorised over operators (their count is
 padded to :data:`PLAY_MULTIPLE` with operators of zero weight, so the vector loop has no
-scalar remainder). See ``benchmarks/bench_realtime.py`` for the figures.
+scalar remainder). The figures are in the documentation (Benchmarks, "Speed").
 
 These functions trust their input; validation happens in the public classes above.
 """
@@ -121,7 +121,7 @@ def deadzone_block(x, shift, r, w, out):
 
     A one-sample block (a streaming step) is folded: its sum is kept in a register, not in
     ``out`` (which a step's caller passes as a slot of the packed array beside ``r`` and
-    ``w``, so the compiler reloaded it after every term, 3.4 ns each), and it stops at the
+    ``w``, so the compiler reloaded it after every term), and it stops at the
     first threshold the sample does not pass: every later term is ``w_j * 0``, which adds
     nothing. The terms it adds are those of the block loop, in the same order, so the bits
     are the same (the data-dependent exit also keeps the compiler from reordering the sum).

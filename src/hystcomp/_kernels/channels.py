@@ -43,7 +43,7 @@ from hystcomp._kernels.chain import CLAMP_TOLERANCE, PLAY_INPUT_LIMIT
 IN_OFFSET, OUT_OFFSET, LOW, HIGH, MAX_STEP = range(5)
 LAST, NONFINITE, CLAMPED = range(3)
 #: Channels per block (a vector loop over them; 16 plays' thresholds, weights and states of
-#: a block take 48 KiB, an L1 cache). 128 ran 1.3x faster than 64 on the project's machine.
+#: a block take 48 KiB, an L1 cache; 128 ran faster than 64: Benchmarks, "Speed").
 CHANNEL_BLOCK = 128
 #: Plays per pass over a block's channels (the running sum is loaded and stored once per
 #: pass): the bank's play count is a multiple of it.

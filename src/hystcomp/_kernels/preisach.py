@@ -610,7 +610,7 @@ def gram_update(rows, count, gram):
 
     A plain loop rather than BLAS: interleaved with :func:`preisach_rows` calls, a threaded
     BLAS wakes its threads for every block, which on a loaded machine costs far more than
-    the arithmetic (measured 20x slower); zeros, frequent in Preisach regressors, are skipped.
+    the arithmetic (Benchmarks, "Speed"); zeros, frequent in Preisach regressors, are skipped.
     """
     p = rows.shape[1]
     for r in range(count):

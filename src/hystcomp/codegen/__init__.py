@@ -47,6 +47,17 @@ def generate_c(
 ) -> tuple[str, str]:
     """The C99 header and source of ``compensator`` (see :func:`export_c`).
 
+    Parameters
+    ----------
+    compensator : Compensator, PreisachCompensator or DynamicCompensator
+        From ``model.inverse(...)``.
+    prefix : str, optional
+        NAME of the files, the state type and the functions; a C identifier.
+    source : str, optional
+        The model file, named in the header comment.
+    sample_rate : float, optional
+        Hz at which ``NAME_step`` is called, for the comments (the compensator's own if None).
+
     Returns
     -------
     (str, str)

@@ -152,6 +152,43 @@ class CTemplate:
     ``public`` are further functions of the interface, each ``(comment lines, definition)``:
     the header declares them after ``NAME_step``, with the comment, and the source defines
     them last. ``defines`` are lines of the header before the state struct (constants).
+
+    Parameters
+    ----------
+    kind : str
+        The kind of the compensator (``"pi"``, ``"mpi"``, ``"preisach"``), for the comments.
+    summary : list of str
+        Comment lines that describe the compensator in the header.
+    low : float
+        The lower end of the output clamp, V.
+    high : float
+        The upper end of the output clamp, V.
+    max_step : float, optional
+        Largest output change per sample, V (``inf``: no slew-rate limit).
+    initial_output : float, optional
+        The output before the first sample, V.
+    state_fields : list of str, optional
+        Declarations inside the state struct.
+    tables : list of str, optional
+        The ``static const`` tables of NAME.c.
+    locals : list of str, optional
+        Declarations at the top of ``NAME_step``.
+    reset_body : list of str, optional
+        The statements of ``NAME_reset``.
+    step_body : list of str, optional
+        The statements that assign the voltage ``v`` for a finite ``x_ref``.
+    after_body : list of str, optional
+        Statements run last, with the final ``v``.
+    functions : list of str, optional
+        Static helper functions, placed after the tables.
+    hold_on_overflow : bool, optional
+        Whether a non-finite ``v`` from a finite ``x_ref`` holds the last output.
+    count_clamped : bool, optional
+        Whether the common part counts clamped outputs.
+    public : list of (list of str, str), optional
+        Further interface functions, each ``(comment lines, definition)``.
+    defines : list of str, optional
+        Header lines before the state struct.
     """
 
     kind: str
@@ -175,6 +212,16 @@ class CTemplate:
 
 def check_prefix(prefix: str) -> str:
     """Return ``prefix`` if it can start C identifiers, else raise :class:`InvalidParameterError`.
+
+    Parameters
+    ----------
+    prefix : str
+        The name of the generated files, state type and functions.
+
+    Returns
+    -------
+    str
+        ``prefix``, unchanged.
 
     Examples
     --------
@@ -208,6 +255,16 @@ def check_prefix(prefix: str) -> str:
 def c_double(value: float) -> str:
     """A C double literal that reads back exactly (17 significant digits).
 
+    Parameters
+    ----------
+    value : float
+        A finite number.
+
+    Returns
+    -------
+    str
+        The C literal.
+
     Examples
     --------
     >>> c_double(0.1), c_double(3.0), c_double(-1e-20)
@@ -221,7 +278,22 @@ def c_double(value: float) -> str:
 
 
 def c_table(name: str, values, comment: str) -> str:
-    """A ``static const double`` table, four numbers to a line, with a comment above."""
+    """A ``static const double`` table, four numbers to a line, with a comment above.
+
+    Parameters
+    ----------
+    name : str
+        The table's C name (``{p}`` for the prefix).
+    values : array_like
+        The numbers, as doubles.
+    comment : str
+        The comment line above the table.
+
+    Returns
+    -------
+    str
+        The C definition.
+    """
     values = [c_double(v) for v in values]
     rows = [", ".join(values[i : i + 4]) for i in range(0, len(values), 4)]
     body = ",\n    ".join(rows)
@@ -239,6 +311,24 @@ def render(
 
     ``source`` (the model file) and ``sample_rate`` (Hz, at which ``NAME_step`` is called)
     only go into the comments.
+
+    Parameters
+    ----------
+    template : CTemplate
+        The compensator's contribution.
+    prefix : str
+        NAME, a C identifier.
+    source : str, optional
+        The model file, named in the comments.
+    sample_rate : float, optional
+        Hz at which ``NAME_step`` is called, for the comments.
+
+    Returns
+    -------
+    header : str
+        The text of ``NAME.h``.
+    source : str
+        The text of ``NAME.c``.
     """
     p = check_prefix(prefix)
     guard = f"{p.upper()}_H"

@@ -13,7 +13,18 @@ from hystcomp.codegen.c99 import CTemplate, c_double, c_table
 
 
 def chain_template(compensator) -> CTemplate:
-    """The :class:`~hystcomp.codegen.c99.CTemplate` of a PI or MPI :class:`Compensator`."""
+    """The :class:`~hystcomp.codegen.c99.CTemplate` of a PI or MPI :class:`Compensator`.
+
+    Parameters
+    ----------
+    compensator : Compensator
+        The inverse of a PI or MPI model.
+
+    Returns
+    -------
+    CTemplate
+        Its tables (thresholds, weights, initial states) and step.
+    """
     c = ck.unpack_chain(compensator.packed)
     lo, hi = compensator.voltage_range
     n_pre, n_play, n_post = c.pre_r.size, c.play_r.size, c.post_r.size

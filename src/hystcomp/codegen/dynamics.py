@@ -26,7 +26,20 @@ PRIME = """void {p}_prime({p}_state *s, double x_ref)
 
 
 def add_dynamics(template: CTemplate, inverse) -> CTemplate:
-    """``template`` with the inverse filter ``inverse`` (a DynamicsInverse) before its step."""
+    """``template`` with the inverse filter ``inverse`` (a DynamicsInverse) before its step.
+
+    Parameters
+    ----------
+    template : CTemplate
+        The hysteresis compensator's template.
+    inverse : DynamicsInverse
+        The inverse of the linear dynamics.
+
+    Returns
+    -------
+    CTemplate
+        The template of the compensator in series with the filter.
+    """
     p = inverse.packed
     n_fir, n_creep = int(p[dk.N_FIR]), int(p[dk.N_CREEP])
     taps = p[dk.HEADER : dk.HEADER + n_fir]

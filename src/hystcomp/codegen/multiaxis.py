@@ -148,6 +148,21 @@ def export_multiaxis_c(
 ) -> list[Path]:
     """Write the files of :func:`generate_multiaxis_c` into ``directory``, all or none.
 
+    Parameters
+    ----------
+    compensator : MultiAxisCompensator
+        From ``MultiAxisModel.inverse()``.
+    directory : str or os.PathLike
+        The output folder.
+    prefix : str
+        NAME, a C identifier.
+    source : str, optional
+        The model file, named in the comments.
+    sample_rate : float, optional
+        Hz at which ``NAME_step`` is called, for the comments.
+    inputs : sequence of path, optional
+        Files the caller read: refused as outputs.
+
     Returns
     -------
     list of Path

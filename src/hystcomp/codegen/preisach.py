@@ -30,6 +30,16 @@ def preisach_template(compensator) -> CTemplate:
 
     Both methods of :meth:`Preisach.inverse <hystcomp.models.preisach.Preisach.inverse>`:
     ``"multiplicative"`` (eq. 10) and ``"exact"``.
+
+    Parameters
+    ----------
+    compensator : PreisachCompensator
+        The inverse of a Preisach model, either method.
+
+    Returns
+    -------
+    CTemplate
+        Its tables (the Everett function), helper functions and step.
     """
     p = compensator.packed
     depth = int(p[pk.DEPTH])

@@ -19,7 +19,20 @@ from hystcomp.codegen.c99 import c_double
 def exact_functions(v_min: float, v_max: float) -> list[str]:
     """C definitions of ``{p}_branch``, ``{p}_root``, ``{p}_solve_up``, ``{p}_solve_down``
     and ``{p}_exact_input`` for a Preisach plane ``v_min .. v_max`` (V); they call
-    ``{p}_everett``."""
+    ``{p}_everett``.
+
+    Parameters
+    ----------
+    v_min : float
+        The lower end of the Preisach plane, V.
+    v_max : float
+        The upper end, V.
+
+    Returns
+    -------
+    list of str
+        The C definitions, one string each.
+    """
     ends = {"V_MIN": c_double(v_min), "V_MAX": c_double(v_max)}
     functions = [_BRANCH, _ROOT, _SOLVE_UP, _SOLVE_DOWN, _EXACT_INPUT]
     out = []

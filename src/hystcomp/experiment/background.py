@@ -56,6 +56,15 @@ class BackgroundJob:
 
     Start it with :meth:`start` (None where the platform cannot fork), take the result
     with :meth:`collect`.
+
+    Parameters
+    ----------
+    process : multiprocessing.Process
+        The forked process, started.
+    connection : multiprocessing.connection.Connection
+        The end of the pipe the result comes back on.
+    folder : pathlib.Path, optional
+        A temporary folder of the caller's, removed once the job is collected or cancelled.
     """
 
     def __init__(self, process, connection, folder: Path | None = None):
@@ -74,6 +83,20 @@ class BackgroundJob:
         is used: elsewhere a fork beside GUI or Objective-C libraries may hang).
         ``folder``, a temporary folder of the caller's for the job, is removed once the
         job is collected or cancelled.
+
+        Parameters
+        ----------
+        function : callable
+            What to compute; its result must pickle.
+        *args
+            Its arguments, inherited by the process as they are.
+        folder : pathlib.Path, optional
+            A temporary folder for the job, removed once it is collected or cancelled.
+
+        Returns
+        -------
+        BackgroundJob or None
+            The running job, or None where the platform does not fork.
         """
         if not sys.platform.startswith("linux"):
             return None
@@ -105,7 +128,18 @@ class BackgroundJob:
         """Wait for the result: ``function(*args)``, or None if the process failed or
         gave nothing within ``timeout`` seconds (it is ended then); the caller then does
         the job itself. It waits in polls of :data:`POLL` seconds, each a safe point for a
-        signal (:func:`hystcomp._signals.check`)."""
+        signal (:func:`hystcomp._signals.check`).
+
+        Parameters
+        ----------
+        timeout : float, optional
+            The longest wait, s.
+
+        Returns
+        -------
+        object
+            ``function(*args)``, or None if the process failed or timed out.
+        """
         reply = None
         try:
             deadline = time.monotonic() + timeout
@@ -164,7 +198,20 @@ def detach_output() -> None:
 
 def draw_in_background(function: Callable[..., Notes], *args) -> BackgroundJob | None:
     """A :class:`BackgroundJob` that draws ``function(*args, folder)`` into a folder of its
-    own (made and removed by the caller); its result is ``(notes, {file name: contents})``."""
+    own (made and removed by the caller); its result is ``(notes, {file name: contents})``.
+
+    Parameters
+    ----------
+    function : callable
+        ``function(*args, folder) -> notes``, which draws figures into ``folder``.
+    *args
+        Its arguments.
+
+    Returns
+    -------
+    BackgroundJob or None
+        The running job, or None where the platform does not fork.
+    """
     from hystcomp.io.atomic import new_temporary_folder
 
     folder = new_temporary_folder("hystcomp-figures-")

@@ -28,6 +28,11 @@ def linear_gain(v, x, *, method: str = "least-squares") -> float:
     method : {"least-squares", "end-point"}
         ``sum(v x) / sum(v^2)``, or ``max(x) / max(v)``.
 
+    Returns
+    -------
+    float
+        ``k_lin``, µm/V.
+
     Examples
     --------
     >>> linear_gain([0.0, 1.0, 2.0], [0.0, 0.3, 0.6])
@@ -74,7 +79,18 @@ class LinearCompensator:
         self.voltage_range = check_range(voltage_range, "voltage_range", "LinearCompensator")
 
     def simulate(self, x_ref) -> np.ndarray:
-        """The voltage (V) for the reference ``x_ref`` (µm)."""
+        """The voltage (V) for the reference ``x_ref`` (µm).
+
+        Parameters
+        ----------
+        x_ref : array_like
+            The reference, µm.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``x_ref / k_lin`` clamped to the voltage range, V.
+        """
         lo, hi = self.voltage_range
         return np.clip(as_signal(x_ref, "x_ref") / self.gain, lo, hi)
 

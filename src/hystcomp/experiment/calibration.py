@@ -37,6 +37,18 @@ def paper_everett(alpha, beta):
 
     The model's own eq. (5), :meth:`hystcomp.models.preisach.Preisach.everett_function` of
     :func:`hystcomp.presets.paper_preisach` (on its plane, 0..120 V).
+
+    Parameters
+    ----------
+    alpha : array_like
+        Upper switching voltages, V.
+    beta : array_like
+        Lower switching voltages, V.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``X_p(alpha, beta)``, µm.
     """
     return paper_preisach().everett_function(alpha, beta)
 
@@ -46,6 +58,20 @@ def paper_preisach_cycles(amplitudes, samples_per_period: int) -> tuple[np.ndarr
 
     Every cycle starts from 0 V, the bottom of the Preisach triangle, so its rising half is
     ``X_p(v, 0)`` and its falling half the first-order curve ``X_p(A, 0) - X_p(A, v)``.
+
+    Parameters
+    ----------
+    amplitudes : sequence of float
+        The sinusoids' amplitudes, V.
+    samples_per_period : int
+        Samples per cycle.
+
+    Returns
+    -------
+    v : numpy.ndarray
+        The voltage, V, the cycles one after the other.
+    x : numpy.ndarray
+        The paper's model's displacement, µm.
     """
     _, v = sinusoid_sequence(amplitudes, sample_rate=float(samples_per_period))
     x = np.empty_like(v)
@@ -61,7 +87,22 @@ def paper_preisach_cycles(amplitudes, samples_per_period: int) -> tuple[np.ndarr
 
 
 def major_loop(twin: Twin, samples: int = 2001) -> tuple[np.ndarray, np.ndarray]:
-    """Quasi-static loop over the whole voltage range, the second of two cycles from rest."""
+    """Quasi-static loop over the whole voltage range, the second of two cycles from rest.
+
+    Parameters
+    ----------
+    twin : Twin
+        The twin.
+    samples : int, optional
+        Samples of the rising half.
+
+    Returns
+    -------
+    v : numpy.ndarray
+        The voltage, V.
+    x : numpy.ndarray
+        The quasi-static displacement, µm.
+    """
     lo, hi = twin.voltage_range
     up = np.linspace(lo, hi, samples)
     cycle = np.concatenate([up, up[-2::-1]])
@@ -70,7 +111,18 @@ def major_loop(twin: Twin, samples: int = 2001) -> tuple[np.ndarray, np.ndarray]
 
 
 def loop_figures(twin: Twin) -> dict[str, float]:
-    """Stroke (µm) and hysteresis % (whole, saturation zone) of the quasi-static major loop."""
+    """Stroke (µm) and hysteresis % (whole, saturation zone) of the quasi-static major loop.
+
+    Parameters
+    ----------
+    twin : Twin
+        The twin.
+
+    Returns
+    -------
+    dict of str to float
+        ``stroke_um``, ``hysteresis_pct`` and ``saturation_zone_pct``.
+    """
     v, x = major_loop(twin)
     whole, zone = hysteresis_percent(v, x)
     lo, hi = twin.voltage_range
@@ -79,7 +131,20 @@ def loop_figures(twin: Twin) -> dict[str, float]:
 
 
 def resonance(params: TwinParameters) -> tuple[float, float]:
-    """Natural frequency (Hz) and damping ratio read from the poles of the discrete ``D``."""
+    """Natural frequency (Hz) and damping ratio read from the poles of the discrete ``D``.
+
+    Parameters
+    ----------
+    params : TwinParameters
+        The twin's parameters.
+
+    Returns
+    -------
+    frequency : float
+        The natural frequency, Hz.
+    damping : float
+        The damping ratio.
+    """
     ad, _ = dynamics_matrices(params)
     s = np.log(np.linalg.eigvals(ad).astype(complex)) * params.sample_rate
     wn = float(np.abs(s[0]))
@@ -105,6 +170,16 @@ def fit_twin_hysteresis(params: TwinParameters | None = None) -> TwinParameters:
     penalty terms that hold the stroke at :data:`TARGET_STROKE` (weight 1 per µm) and the
     saturation-zone hysteresis of the major loop at :data:`TARGET_SATURATION_ZONE`
     (weight 0.3 per %).
+
+    Parameters
+    ----------
+    params : TwinParameters, optional
+        The starting parameters (the defaults if None); only the hysteresis ones change.
+
+    Returns
+    -------
+    TwinParameters
+        The parameters with the fitted hysteresis.
     """
     from scipy.optimize import least_squares
 
@@ -131,13 +206,41 @@ def fit_twin_hysteresis(params: TwinParameters | None = None) -> TwinParameters:
 
 
 def paper_loop_difference(twin: Twin) -> float:
-    """Rms difference (µm) between the twin's and the paper's Preisach loops (Fig. 5)."""
+    """Rms difference (µm) between the twin's and the paper's Preisach loops (Fig. 5).
+
+    Parameters
+    ----------
+    twin : Twin
+        The twin.
+
+    Returns
+    -------
+    float
+        The rms difference, µm.
+    """
     v, x_paper = paper_preisach_cycles(FIT_AMPLITUDES, 400)
     return float(np.sqrt(np.mean((twin.hysteresis(v) - x_paper) ** 2)))
 
 
 def uncompensated_errors(twin: Twin, *, gain: float, amplitude: float, periods: int = 3):
-    """Rms and max error (µm) of ``v = x_ref / gain`` on 0..``amplitude`` triangles, per frequency."""
+    """Rms and max error (µm) of ``v = x_ref / gain`` on 0..``amplitude`` triangles, per frequency.
+
+    Parameters
+    ----------
+    twin : Twin
+        The twin.
+    gain : float
+        The linear gain ``k_lin``, µm/V.
+    amplitude : float
+        The triangles' height, µm.
+    periods : int, optional
+        Periods per run (the first is not measured).
+
+    Returns
+    -------
+    dict
+        For each frequency of :data:`FREQUENCIES` (Hz), ``(rms, max)`` in µm.
+    """
     lo, hi = twin.voltage_range
     baseline = LinearCompensator(gain, (lo, hi))
     out = {}
@@ -149,7 +252,20 @@ def uncompensated_errors(twin: Twin, *, gain: float, amplitude: float, periods: 
 
 
 def calibration_report(params: TwinParameters | None = None, seed: int = 0) -> str:
-    """The calibration figures of a twin, as text (see the module docstring)."""
+    """The calibration figures of a twin, as text (see the module docstring).
+
+    Parameters
+    ----------
+    params : TwinParameters, optional
+        The twin's parameters (the defaults if None).
+    seed : int, optional
+        The seed of the sensor noise.
+
+    Returns
+    -------
+    str
+        The report, several lines.
+    """
     twin = Twin(params, seed=seed)
     loop = loop_figures(twin)
     fn, zeta = resonance(twin.params)

@@ -113,7 +113,18 @@ class CompareConfig:
 
     @classmethod
     def quick(cls, **changes) -> CompareConfig:
-        """A short run for tests and a first look: 2 periods, four Preisach sinusoids."""
+        """A short run for tests and a first look: 2 periods, four Preisach sinusoids.
+
+        Parameters
+        ----------
+        **changes
+            Further settings to change by name.
+
+        Returns
+        -------
+        CompareConfig
+            The short configuration.
+        """
         changes = {"periods": 2, "preisach_amplitudes": FIG5_AMPLITUDES, **changes}
         return cls(**changes)
 
@@ -177,6 +188,20 @@ def identify_models(
     The Preisach fit is the paper's with ``X(v, v) = 0`` imposed, as eq. 2 implies (fitted
     free, the cubic's ``X(v, v)`` makes the output step at every reversal).
     :func:`paper_fits` gives eqs. 5, 12 and 19 as printed for the report.
+
+    Parameters
+    ----------
+    record_pi : Record
+        The twin's answer to the triangles.
+    record_preisach : Record
+        The twin's answer to the sinusoids.
+    config : CompareConfig, optional
+        The comparison's settings (the defaults if None).
+
+    Returns
+    -------
+    dict
+        ``{"preisach": ..., "pi": ..., "mpi": ...}``, the fitted models.
     """
     config = CompareConfig() if config is None else config
     pi = PrandtlIshlinskii(n_operators=config.n_operators)
@@ -195,7 +220,22 @@ def identify_models(
 def paper_fits(record_pi: Record, record_preisach: Record, config: CompareConfig) -> dict:
     """The three models fitted exactly as printed: eq. 5 fitted free to the reversal curves
     (``zero_diagonal=False``); eq. 12 and eq. 19 with the partial-sum constraints only, no
-    regularisation (``constraints="paper"``, ``regularization=0``)."""
+    regularisation (``constraints="paper"``, ``regularization=0``).
+
+    Parameters
+    ----------
+    record_pi : Record
+        The twin's answer to the triangles.
+    record_preisach : Record
+        The twin's answer to the sinusoids.
+    config : CompareConfig
+        The comparison's settings.
+
+    Returns
+    -------
+    dict
+        ``{"preisach": ..., "pi": ..., "mpi": ...}``, the models fitted as printed.
+    """
     return {
         "preisach": Preisach(
             degree=config.preisach_degree,
@@ -340,7 +380,22 @@ def run_comparison(
 def measure_identification(config: CompareConfig, twin: Twin | None = None):
     """``(record_pi, record_preisach)``: the twin's answers to the paper's identification
     signals, the triangles then the sinusoids, from ``twin`` (by default a new one of
-    ``config``'s parameters and seed, as :func:`run_comparison` starts with)."""
+    ``config``'s parameters and seed, as :func:`run_comparison` starts with).
+
+    Parameters
+    ----------
+    config : CompareConfig
+        The comparison's settings.
+    twin : Twin, optional
+        The twin to measure (a new one of ``config``'s if None).
+
+    Returns
+    -------
+    record_pi : Record
+        The answer to the triangles.
+    record_preisach : Record
+        The answer to the sinusoids.
+    """
     twin = Twin(config.twin, seed=config.seed) if twin is None else twin
     fs = twin.sample_rate
     record_pi = _measure(twin, triangle_sequence(sample_rate=fs))
@@ -352,7 +407,18 @@ def twin_pairs(config: CompareConfig):
     """What :func:`run_comparison` identifies for its dynamics part, from scratch: the
     records and models of ``config`` (the same seeded twin gives the same ones), then
     :func:`~hystcomp.experiment.compare_dynamics.identify_twin_pairs`. ``hystcomp compare``
-    runs it in a second process from its start."""
+    runs it in a second process from its start.
+
+    Parameters
+    ----------
+    config : CompareConfig
+        The comparison's settings.
+
+    Returns
+    -------
+    tuple of (Record, dict)
+        What :func:`~hystcomp.experiment.compare_dynamics.identify_twin_pairs` returns.
+    """
     from hystcomp.experiment.compare_dynamics import identify_twin_pairs
 
     record_pi, record_preisach = measure_identification(config)

@@ -69,7 +69,20 @@ class DynamicsComparison:
 def twin_dynamics_record(twin_params, seed: int) -> Record:
     """The twin's answer to the dynamics excitation, from a twin of its own at rest whose
     sensor noise is drawn from a stream of its own (``seed``, :data:`DYNAMICS_STREAM`): it
-    does not depend on how many runs came before (``--periods``, ``--quick``)."""
+    does not depend on how many runs came before (``--periods``, ``--quick``).
+
+    Parameters
+    ----------
+    twin_params : TwinParameters
+        The twin's parameters.
+    seed : int
+        The comparison's seed.
+
+    Returns
+    -------
+    Record
+        The record of the dynamics excitation.
+    """
     stream = int(np.random.SeedSequence([seed, DYNAMICS_STREAM]).generate_state(1)[0])
     twin = Twin(twin_params, seed=stream)
     t, v = dynamics_excitation(sample_rate=twin.sample_rate, voltage_range=twin.voltage_range)
@@ -83,6 +96,22 @@ def identify_twin_pairs(config, records, models) -> tuple[Record, dict]:
     (:func:`hystcomp.experiment.compare.twin_pairs` measures and identifies them again,
     as the comparison does, for ``hystcomp compare``'s second process). The inverses'
     designs go with the pairs (pickled).
+
+    Parameters
+    ----------
+    config : CompareConfig
+        The comparison's settings.
+    records : tuple of Record
+        ``(record_pi, record_preisach)``.
+    models : dict
+        The comparison's models, by method.
+
+    Returns
+    -------
+    record : Record
+        The dynamics record.
+    pairs : dict
+        Each method's pair, by method.
     """
     record_pi, record_preisach = records
     record = twin_dynamics_record(config.twin, config.seed)
@@ -102,7 +131,28 @@ def identify_twin_pairs(config, records, models) -> tuple[Record, dict]:
 
 def run_dynamics(twin, compensators, amplitude, *, periods, frequencies, identified):
     """The dynamics part of the comparison (see the module); ``compensators`` by method;
-    ``identified`` is what :func:`identify_twin_pairs` returns."""
+    ``identified`` is what :func:`identify_twin_pairs` returns.
+
+    Parameters
+    ----------
+    twin : Twin
+        The twin (with creep).
+    compensators : dict
+        The hysteresis compensators, by method.
+    amplitude : float
+        The references' height, µm.
+    periods : int
+        Periods per run.
+    frequencies : sequence of float
+        The triangles' frequencies, Hz.
+    identified : tuple
+        What :func:`identify_twin_pairs` returns.
+
+    Returns
+    -------
+    DynamicsComparison
+        The record, the pairs, the tracking results and the step.
+    """
     fs = twin.sample_rate
     record, pairs = identified
     with_dyn = {m: pairs[m].inverse() for m in WITH_DYNAMICS}
@@ -139,7 +189,18 @@ def run_dynamics(twin, compensators, amplitude, *, periods, frequencies, identif
 
 
 def dynamics_rows(dc: DynamicsComparison) -> list[dict]:
-    """CSV rows: frequency, method, rms and max error (µm)."""
+    """CSV rows: frequency, method, rms and max error (µm).
+
+    Parameters
+    ----------
+    dc : DynamicsComparison
+        The dynamics part's results.
+
+    Returns
+    -------
+    list of dict
+        One row per frequency and method.
+    """
     return [
         {"frequency_hz": f, "method": label, "rms_um": r.rms, "max_um": r.max}
         for f, row in dc.results.items()
@@ -148,7 +209,20 @@ def dynamics_rows(dc: DynamicsComparison) -> list[dict]:
 
 
 def dynamics_markdown(dc: DynamicsComparison, table1: dict) -> list[str]:
-    """The report's section on the dynamics: the pairs, the table, the step."""
+    """The report's section on the dynamics: the pairs, the table, the step.
+
+    Parameters
+    ----------
+    dc : DynamicsComparison
+        The dynamics part's results.
+    table1 : dict
+        Table I's rows, for the errors without dynamics.
+
+    Returns
+    -------
+    list of str
+        Markdown lines.
+    """
     found = []
     for method, pair in dc.pairs.items():
         d = pair.dynamics

@@ -21,6 +21,15 @@ def plot_bode(model, path, *, measured=None) -> None:
     the response measured at the multisine's lines when the model was identified (its
     ``fit_report_``), divided by the fit's free complex gain (the hysteresis model's gain
     and phase that the fit took up), so that it lies on the model where the model fits.
+
+    Parameters
+    ----------
+    model : LinearDynamics
+        A fitted model.
+    path : str or pathlib.Path
+        The figure's file.
+    measured : tuple of numpy.ndarray, optional
+        ``(frequencies, response)`` drawn as dots.
     """
     if measured is None:
         measured = measured_response(model)
@@ -57,7 +66,18 @@ def plot_bode(model, path, *, measured=None) -> None:
 
 
 def measured_response(model):
-    """``(frequencies, response)`` measured at identification, on the model's scale, or None."""
+    """``(frequencies, response)`` measured at identification, on the model's scale, or None.
+
+    Parameters
+    ----------
+    model : LinearDynamics
+        A fitted model.
+
+    Returns
+    -------
+    tuple of numpy.ndarray or None
+        ``(frequencies, response)``: Hz and complex, or None if the fit report has none.
+    """
     report = getattr(model, "fit_report_", {}) or {}
     found = report.get("measured_response")
     if not isinstance(found, dict) or not found.get("hz"):
@@ -78,6 +98,17 @@ def plot_step(t, x_ref, runs: dict, path) -> None:
     thousand points instead of every sample). Each panel has its legend. Runs with the
     inverse of the dynamics are dashed; in the first 10 ms the resonance makes the runs of
     one kind alike, so each run is drawn thinner than the one before and every one shows.
+
+    Parameters
+    ----------
+    t : array_like
+        Time, s.
+    x_ref : array_like
+        The step reference, µm.
+    runs : dict
+        ``{label: x}``, each run's displacement, µm.
+    path : str or pathlib.Path
+        The figure's file.
     """
     fig = new_figure((9.0, 4.0))
     fixed_layout(fig, left=0.746, right=0.15, top=0.683, bottom=0.61, wgap=0.786, cols=2)

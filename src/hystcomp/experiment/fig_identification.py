@@ -31,7 +31,18 @@ DPI = 150
 
 
 def check_figure_path(path) -> Path:
-    """``path`` as a Path if a figure can be saved there (by its suffix), else raise."""
+    """``path`` as a Path if a figure can be saved there (by its suffix), else raise.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The figure's file.
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``, checked.
+    """
     path = Path(os.fspath(path))
     if path.suffix.lower() not in FORMATS:
         raise InvalidParameterError(
@@ -51,6 +62,18 @@ MEASURED, FITTED, PREDICTED = "0.55", "tab:red", "tab:green"
 def turning_points(v, tolerance: float = 0.02) -> np.ndarray:
     """Indices where the input turns back by more than ``tolerance`` of its range (the
     extremes of each half-cycle), in order.
+
+    Parameters
+    ----------
+    v : array_like
+        The input.
+    tolerance : float, optional
+        The least reversal counted, a share of the input's range.
+
+    Returns
+    -------
+    numpy.ndarray
+        The indices, rising.
 
     Examples
     --------
@@ -225,7 +248,17 @@ def plot_identification_result(record, result, path) -> None:
     """The figure of ``hystcomp identify --plot``: :func:`plot_identification` of what
     :func:`~hystcomp.identify.workflow.identify_record` found, from the end of the
     start-up transient to the end of the record, the hold-out (if any) predicted by the
-    identified model."""
+    identified model.
+
+    Parameters
+    ----------
+    record : Record
+        The record identified.
+    result : IdentificationResult
+        What the identification found.
+    path : str or pathlib.Path
+        The figure's file.
+    """
     from hystcomp.identify.scoring import straight_line
 
     kept = slice(result.start, len(record))

@@ -41,6 +41,13 @@ def figure_9(results: dict, path: Path) -> None:
 
     ``results`` maps each method to its :class:`~hystcomp.experiment.tracking.TrackingResult`;
     the inset zooms on the saturation zone (top quarter of the reference range).
+
+    Parameters
+    ----------
+    results : dict
+        Each method's tracking result at one frequency.
+    path : pathlib.Path
+        The figure's file.
     """
     fig = new_figure((7.5, 6.0))
     fixed_layout(fig, left=0.75, right=0.15, top=0.4, bottom=0.6)
@@ -81,6 +88,13 @@ def figure_10(results: dict, path: Path) -> None:
     """Fig. 10: tracking (left) and tracking error (right) against time, one row per frequency.
 
     ``results[frequency][method]`` are tracking results; the measured window is shown.
+
+    Parameters
+    ----------
+    results : dict
+        ``results[frequency][method]``, each a tracking result.
+    path : pathlib.Path
+        The figure's file.
     """
     frequencies = sorted(results)
     fig = new_figure((11.0, 3.0 * len(frequencies) + 0.3))
@@ -160,6 +174,20 @@ def write_figures(comparison, out_dir: Path, names=None) -> dict[str, str | None
     (:func:`~hystcomp.experiment.fig_preisach.plot_preisach_loops`) and Fig. 8 for PI and
     MPI (:func:`~hystcomp.experiment.fig_identification.plot_identification`), in the order
     of :data:`FIGURES`; every one is drawn, so every value is None.
+
+    Parameters
+    ----------
+    comparison : Comparison
+        The comparison's results.
+    out_dir : pathlib.Path
+        The folder to draw into.
+    names : sequence of str, optional
+        The file names to draw (every one of :data:`FIGURES` if None).
+
+    Returns
+    -------
+    dict
+        ``{file name: None if drawn, else why not}``.
     """
     notes: dict[str, str | None] = {}
     for name, draw in FIGURES.items():

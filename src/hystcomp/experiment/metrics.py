@@ -30,6 +30,20 @@ def _pair(reference, output, min_samples):
 def tracking_errors(reference, output) -> tuple[float, float]:
     """The rms and the maximum of ``|output - reference|``, in the signals' unit (µm).
 
+    Parameters
+    ----------
+    reference : array_like
+        The reference, µm.
+    output : array_like
+        The measured displacement, µm.
+
+    Returns
+    -------
+    rms : float
+        The rms error, µm.
+    max : float
+        The largest absolute error, µm.
+
     Examples
     --------
     >>> t = np.arange(1000) / 1000
@@ -50,6 +64,15 @@ def branch_means(reference, output, *, n_bins=None) -> tuple[np.ndarray, ...]:
     mid-point, so that the turning points weigh the same on both branches. The reference
     range is cut into ``n_bins`` equal bins and each branch is averaged in each bin, which
     removes the sensor noise and puts both branches on the same abscissa.
+
+    Parameters
+    ----------
+    reference : array_like
+        The loop's abscissa (the reference, or the input).
+    output : array_like
+        The loop's ordinate (the displacement).
+    n_bins : int, optional
+        The number of bins (from the number of samples if None).
 
     Returns
     -------

@@ -119,7 +119,18 @@ class RasterResult:
     measured: slice = field(repr=False)
 
     def ratio(self, method: str) -> np.ndarray:
-        """Each axis's rms with ``method`` over its uncompensated rms."""
+        """Each axis's rms with ``method`` over its uncompensated rms.
+
+        Parameters
+        ----------
+        method : str
+            A method of the result.
+
+        Returns
+        -------
+        numpy.ndarray
+            One ratio per axis.
+        """
         return self.rms_um[method] / self.rms_um["uncompensated"]
 
     @property
@@ -128,7 +139,13 @@ class RasterResult:
         return float(self.rms_um["coupled"].sum() / self.rms_um["per-axis"].sum())
 
     def table(self) -> list[str]:
-        """The table ``hystcomp raster`` prints."""
+        """The table ``hystcomp raster`` prints.
+
+        Returns
+        -------
+        list of str
+            The table's lines.
+        """
         n = self.X_ref.shape[1]
         names = "XYZ"
         lines = [f"{'axis':<5}{'uncompensated':>15}{'per-axis':>17}{'coupled':>17}   (µm rms)"]
@@ -247,7 +264,15 @@ def raster_image(result: RasterResult, method: str, columns: int = 160) -> np.nd
 
 
 def plot_raster(result: RasterResult, path: str | Path) -> None:
-    """The raster image of a checkerboard grating, three ways, with each axis's rms."""
+    """The raster image of a checkerboard grating, three ways, with each axis's rms.
+
+    Parameters
+    ----------
+    result : RasterResult
+        The raster run.
+    path : str or pathlib.Path
+        The image's file.
+    """
     from hystcomp.experiment._layout import fixed_layout, new_figure, save_figure
 
     fig = new_figure((10.5, 4.0))

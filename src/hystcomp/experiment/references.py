@@ -72,5 +72,18 @@ def triangle_reference(
 
 
 def period_samples(frequency: float, sample_rate: float = DEFAULT_SAMPLE_RATE) -> int:
-    """Samples in one period of a reference at ``frequency`` (as the excitation rounds it)."""
+    """Samples in one period of a reference at ``frequency`` (as the excitation rounds it).
+
+    Parameters
+    ----------
+    frequency : float
+        The reference's frequency, Hz.
+    sample_rate : float, optional
+        Samples per second, Hz.
+
+    Returns
+    -------
+    int
+        Samples per period.
+    """
     return round(sample_rate / frequency)

@@ -33,7 +33,18 @@ from hystcomp.paper import LABELS, METHODS
 
 
 def table1_rows(comparison) -> list[dict]:
-    """Table I: one row per frequency and method (rms and max tracking error, µm)."""
+    """Table I: one row per frequency and method (rms and max tracking error, µm).
+
+    Parameters
+    ----------
+    comparison : Comparison
+        The comparison's results.
+
+    Returns
+    -------
+    list of dict
+        One row per frequency and method.
+    """
     return [
         {"frequency_hz": f, "method": m, "rms_um": r.rms, "max_um": r.max}
         for f, by_method in comparison.results.items()
@@ -42,7 +53,18 @@ def table1_rows(comparison) -> list[dict]:
 
 
 def hysteresis_rows(comparison) -> list[dict]:
-    """Hysteresis % at the lowest frequency, whole loop and saturation zone, per method."""
+    """Hysteresis % at the lowest frequency, whole loop and saturation zone, per method.
+
+    Parameters
+    ----------
+    comparison : Comparison
+        The comparison's results.
+
+    Returns
+    -------
+    list of dict
+        One row per method.
+    """
     low = min(comparison.results)
     return [
         {
@@ -87,7 +109,18 @@ def _figures(comparison, stage: Path, background) -> dict[str, str | None]:
 
 
 def format_table(comparison) -> str:
-    """Table I as text for the terminal: our rms/max beside the paper's."""
+    """Table I as text for the terminal: our rms/max beside the paper's.
+
+    Parameters
+    ----------
+    comparison : Comparison
+        The comparison's results.
+
+    Returns
+    -------
+    str
+        The table, several lines.
+    """
     lines = [
         f"{'f (Hz)':>7}  {'method':<14}{'rms (µm)':>10}{'paper':>9}{'max (µm)':>11}{'paper':>9}"
     ]
@@ -110,7 +143,18 @@ def format_table(comparison) -> str:
 
 def prepare_output_dir(out_dir) -> Path:
     """Create ``out_dir`` (and its parents) if needed; refuse a path that exists and is
-    not a folder, and an empty path."""
+    not a folder, and an empty path.
+
+    Parameters
+    ----------
+    out_dir : str or os.PathLike
+        The output folder.
+
+    Returns
+    -------
+    pathlib.Path
+        The folder, made if it was missing.
+    """
     if not os.fspath(out_dir):
         raise InvalidParameterError(
             "The output folder is an empty path. Name a folder for the results "
@@ -151,6 +195,20 @@ def write_outputs(comparison, out_dir, *, figures=None) -> list[Path]:
     :func:`~hystcomp.experiment.figures.write_figures` for this comparison (from its Table
     I) while the others are drawn here; its files are written as they came, or its figures
     are drawn here too if it failed.
+
+    Parameters
+    ----------
+    comparison : Comparison
+        The comparison's results.
+    out_dir : str or os.PathLike
+        The output folder.
+    figures : BackgroundJob, optional
+        A job drawing some of the figures.
+
+    Returns
+    -------
+    list of pathlib.Path
+        The files written.
     """
     out = prepare_output_dir(out_dir)
     with staging_folder(out) as stage:
@@ -201,7 +259,20 @@ def _order_text(order: list[str]) -> str:
 
 
 def report_markdown(comparison, figure_notes: dict[str, str | None]) -> str:
-    """The report: set-up, Table I beside the paper's, hysteresis, a reading, the figures."""
+    """The report: set-up, Table I beside the paper's, hysteresis, a reading, the figures.
+
+    Parameters
+    ----------
+    comparison : Comparison
+        The comparison's results.
+    figure_notes : dict
+        ``{file name: None if drawn, else why not}``.
+
+    Returns
+    -------
+    str
+        The report, Markdown.
+    """
     c = comparison
     low = min(c.results)
     parts = [

@@ -61,7 +61,20 @@ class TrackingResult:
 
 
 def check_compensator(compensator, name: str = "compensator"):
-    """A compensator: anything with ``simulate(x_ref) -> v`` and a ``voltage_range`` (V)."""
+    """A compensator: anything with ``simulate(x_ref) -> v`` and a ``voltage_range`` (V).
+
+    Parameters
+    ----------
+    compensator : object
+        The compensator.
+    name : str, optional
+        How the message names it.
+
+    Returns
+    -------
+    object
+        ``compensator``, unchanged.
+    """
     if not callable(getattr(compensator, "simulate", None)) or not hasattr(
         compensator, "voltage_range"
     ):

@@ -55,7 +55,20 @@ def prepare(config, compile_first: bool):
     """The job of :func:`start`: :func:`compile_later_kernels` if ``compile_first``, then
     :func:`~hystcomp.experiment.compare.twin_pairs` for ``config`` (the
     twin's kernel after the others: the first process compiles it first, so that here it
-    is loaded)."""
+    is loaded).
+
+    Parameters
+    ----------
+    config : CompareConfig
+        The comparison's settings.
+    compile_first : bool
+        Whether to compile the later kernels first.
+
+    Returns
+    -------
+    tuple of (Record, dict)
+        What :func:`~hystcomp.experiment.compare_dynamics.identify_twin_pairs` returns.
+    """
     from hystcomp.experiment.compare import twin_pairs
 
     if compile_first:
@@ -67,7 +80,13 @@ def load_shared(twin: TwinParameters) -> None:
     """Load here what a process forked next would load again: numba's compiler context
     (its start, 0.3 s, which imports SciPy's BLAS wrappers) and the twin's kernel, by
     running the twin for one sample. ``hystcomp compare`` calls it before it forks the
-    process that identifies the twin's dynamics, which both need."""
+    process that identifies the twin's dynamics, which both need.
+
+    Parameters
+    ----------
+    twin : TwinParameters
+        The twin's parameters.
+    """
     from hystcomp.plant.twin import Twin
 
     Twin(twin).run_noiseless([0.0])
@@ -81,6 +100,16 @@ def start(config) -> BackgroundJob | None:
     Its result is what :func:`~hystcomp.experiment.compare_dynamics.identify_twin_pairs`
     returns. It compiles first only if the cache lacks the play chain's batch kernel (a
     first run); otherwise this process first loads what both need (:func:`load_shared`).
+
+    Parameters
+    ----------
+    config : CompareConfig
+        The comparison's settings.
+
+    Returns
+    -------
+    BackgroundJob or None
+        The running job, or None where the platform does not fork.
     """
     if not sys.platform.startswith("linux") or not config.dynamics:
         return None

@@ -27,16 +27,11 @@ of a cross-validation over the record's reversal segments
 (:func:`~hystcomp.identify.scoring.reversal_folds`, :data:`CV_FOLDS` folds, each fit on the
 other folds) rates each candidate by ``criterion_um``: the geometric mean of the held-out
 forward error and the held-out inverse error above, on the branches each fit did not see.
-On the panel of ``benchmarks/bench_accuracy.py`` (5 actuators of none of the model
-families, 4 excitations) it ranks the candidate PI and MPI fits of a record as their
-measured 1 Hz tracking does with a median Spearman rank correlation of 0.96 (mean 0.88,
-worst cell 0.29), where the fit error reaches 0.93 (0.86, 0.29) and the inverse's estimate
-on the whole record 0.91 (0.81, 0.25); the MPI regularisation it chooses tracks within
-0.002x of the uncompensated error of the best of the grid in every cell (fit error 0.002x,
-the estimate alone 0.012x; before the MPI fit chose its plays' initial memory too, 0.015x,
-0.042x and 0.025x). The estimate alone is weakest on a Preisach actuator with
-output saturation, where a voltage error at the saturated top counts more than the
-tracking error it causes; the held-out forward error is not.
+It ranks candidate fits closer to their measured tracking than the fit error or the
+inverse's estimate alone do (Benchmarks, "Ranking candidate fits"). The estimate alone is
+weakest on a Preisach actuator with output saturation, where a voltage error at the
+saturated top counts more than the tracking error it causes; the held-out forward error is
+not.
 """
 
 from __future__ import annotations
@@ -67,6 +62,20 @@ def inside_training(v, folds, fold: int) -> np.ndarray:
     other segment's reach (the top of the paper's largest triangle, its only visit there)
     measures the model's extrapolation, not its error on the branches a reference meets:
     those samples are not scored.
+
+    Parameters
+    ----------
+    v : array_like
+        The record's input, V.
+    folds : array_like of int
+        The fold of every sample (-1 for none), :func:`~hystcomp.identify.scoring.reversal_folds`.
+    fold : int
+        The held-out fold.
+
+    Returns
+    -------
+    numpy.ndarray
+        A boolean mask over the samples: in ``fold`` and inside the other folds' input range.
 
     Examples
     --------
@@ -102,6 +111,25 @@ def tracking_scorer(v, x, *, start: int = 0, max_samples=MAX_SCORED_SAMPLES, fol
     ``score(model, held_out, estimate=False)`` leaves out the inverse's run over the whole
     record: the score then holds the held-out figures and ``criterion_um`` only, enough to
     rank candidates at a fraction of the cost.
+
+    Parameters
+    ----------
+    v : array_like
+        The record's voltage, V.
+    x : array_like
+        The record's displacement, µm.
+    start : int, optional
+        The first sample scored (after the start-up transient).
+    max_samples : int, optional
+        The record is thinned to about this many samples for the inverse's run.
+    folds : array_like of int, optional
+        The fold of every sample, for the held-out forward error.
+
+    Returns
+    -------
+    callable
+        ``score(model, held_out=(), estimate=True) -> dict`` with the estimates in µm
+        (``criterion_um``, and ``held_out_rms_um`` with held-out fits).
     """
     owner = "compensation_error"
     v, x = as_signal_pair(v, x, ("v", "x"), owner, min_samples=2)
@@ -226,6 +254,20 @@ def swing_mask(v, start: int = 0, share: float = SWING) -> np.ndarray:
     ``start``): the monotone stretches between turning points (reversals under 5 % of
     the span ignored) that travel that far.
 
+    Parameters
+    ----------
+    v : array_like
+        The record's input, V.
+    start : int, optional
+        The first sample considered (after the start-up transient).
+    share : float, optional
+        The least travel of a swing, as a share of the input span.
+
+    Returns
+    -------
+    numpy.ndarray
+        A boolean mask over the samples: True on the swings that travel that far.
+
     Examples
     --------
     >>> v = np.r_[np.linspace(0.0, 10.0, 11), np.linspace(9.0, 7.0, 3), np.linspace(8.0, 0.0, 9)]
@@ -245,6 +287,10 @@ def swing_mask(v, start: int = 0, share: float = SWING) -> np.ndarray:
     return mask
 
 
+def _weighted_rms(error: np.ndarray, weight: np.ndarray) -> float:
+    return float(np.sqrt(np.sum(weight * error**2) / np.sum(weight)))
+
+
 def tracking_estimate(model, v, x, *, start: int = 0) -> dict:
     """How well ``model.inverse()`` will track a reference over most of its range, in µm rms.
 
@@ -255,7 +301,9 @@ def tracking_estimate(model, v, x, *, start: int = 0) -> dict:
 
     * ``e_swing``: the model's error against the record on its swings over at least half
       the input range (:func:`swing_mask`), where a reference over the range drives the
-      stage;
+      stage; each sample weighted by the displacement the model travels there, as a
+      reference at constant speed spends equal time on each micrometre (a sinusoid's record
+      dwells at its turns, a triangle's does not);
     * ``e_inverse``: the compensator's error on its own model for a triangle over 5-90 %
       of the model's reach, with :data:`REFERENCE_PERIOD` samples a period: the one-sample
       lag of eq. 10, and any part out of reach.
@@ -263,11 +311,9 @@ def tracking_estimate(model, v, x, *, start: int = 0) -> dict:
     Beside it, ``held_out_rms_um`` (from the fit, where the fit has one): the model's
     error on the reversal segments of a cross-validation, each fitted without them, which
     a reference that turns inside the range meets; ``flatters`` is True when that is more
-    than :data:`FLATTERS` times the estimate and :data:`FLATTERS_FLOOR` of the line's. On the tuning stages of
-    ``benchmarks/bench_accuracy.py`` (six stages of none of the families, four records,
-    three models) the estimate lies within 1.5x of the measured tracking of a 1 Hz
-    triangle in 93 % of the cells, and is never more than 2x optimistic (``python
-    benchmarks/bench_accuracy.py --estimate``).
+    than :data:`FLATTERS` times the estimate and :data:`FLATTERS_FLOOR` of the line's. How
+    close the estimate comes to the measured tracking is in the documentation
+    (Benchmarks, "The tracking estimate").
 
     Parameters
     ----------
@@ -292,10 +338,15 @@ def tracking_estimate(model, v, x, *, start: int = 0) -> dict:
     mask = swing_mask(v, start)
     if not mask.any():  # no swing over half the range: the whole record
         mask[start:] = True
-    residual = np.asarray(model.simulate(v), dtype=np.float64) - x
-    swing = float(np.sqrt(np.mean(residual[mask] ** 2)))
+    fitted = np.asarray(model.simulate(v), dtype=np.float64)
+    # a reference at constant speed spends equal time on every micrometre: weight each
+    # sample by the displacement the model travels there, not by the record's dwell
+    weight = np.abs(np.gradient(fitted)) * mask if v.size > 1 else mask.astype(np.float64)
+    if not weight.sum() > 0.0:
+        weight = mask.astype(np.float64)
+    swing = _weighted_rms(fitted - x, weight)
     a, b = straight_line(v[start:], x[start:])
-    line = float(np.sqrt(np.mean((a * v[mask] + b - x[mask]) ** 2)))
+    line = _weighted_rms(a * v + b - x, weight)
     lo, hi = model.voltage_range_
     swept = np.asarray(model.simulate(np.array([lo, hi, lo, hi])), dtype=np.float64)
     bottom, top = float(swept[2]), float(swept[3])

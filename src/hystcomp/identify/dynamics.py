@@ -156,6 +156,25 @@ def dynamics_excitation(
     :data:`TRIANGLE_SPAN` of the range (those with fewer than 20 samples a period left
     out), each reached by a ramp at its own slope. 9.2 s in all.
 
+    Parameters
+    ----------
+    sample_rate : float, optional
+        Samples per second, Hz.
+    voltage_range : tuple of (float, float), optional
+        The amplifier's range, V.
+    amplitude : float, optional
+        The multisine's peak amplitude, V (a share of the range's span if None).
+    seed : int, optional
+        Not used by the signal, which is deterministic; kept for a uniform signature with the other
+        excitations.
+
+    Returns
+    -------
+    t : numpy.ndarray
+        Time, s, from 0.
+    v : numpy.ndarray
+        Voltage, V.
+
     Examples
     --------
     >>> t, v = dynamics_excitation()
@@ -237,13 +256,35 @@ def _parts(fs: float, lo: float, hi: float, amplitude: float) -> list[tuple[str,
 
 
 def multisine_lines(sample_rate: float) -> np.ndarray:
-    """The multisine's lines in Hz (integers: one period is 1 s)."""
+    """The multisine's lines in Hz (integers: one period is 1 s).
+
+    Parameters
+    ----------
+    sample_rate : float
+        The record's sample rate, Hz (lines stop at 0.4 of it).
+
+    Returns
+    -------
+    numpy.ndarray
+        The frequencies, Hz, whole numbers, rising.
+    """
     top = min(F_MAX, 0.4 * sample_rate)
     return np.unique(np.round(np.geomspace(F_MIN, top, N_LINES)))
 
 
 def creep_grid(hold: float) -> np.ndarray:
-    """Creep time constants (s): two per decade from 1 ms to the hold's length."""
+    """Creep time constants (s): two per decade from 1 ms to the hold's length.
+
+    Parameters
+    ----------
+    hold : float
+        The length of the record's hold, s.
+
+    Returns
+    -------
+    numpy.ndarray
+        The candidate time constants, s, rising.
+    """
     decades = math.log10(hold / 1e-3)
     return np.geomspace(1e-3, hold, max(2, round(2 * decades) + 1))
 
@@ -366,6 +407,18 @@ def record_layout(v, sample_rate: float) -> Layout:
     holds the multisine to its end). The triangles are those of the excitation for the
     record's voltage range (its rest and its mid-range level), kept where the command
     follows them (within 1 % of the range); a record without them has none.
+
+    Parameters
+    ----------
+    v : array_like
+        The record's command, V.
+    sample_rate : float
+        The record's sample rate, Hz.
+
+    Returns
+    -------
+    Layout
+        The sample indices of the step, the multisine, its periods and the triangles.
 
     Raises
     ------

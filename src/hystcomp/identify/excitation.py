@@ -67,6 +67,17 @@ def triangle_sequence(
     With the defaults this is the PI/MPI identification signal of Section IV-A (ii):
     triangles of 30, 60, 90 and 120 V at 1 Hz, 80,001 samples at 20 kHz.
 
+    Parameters
+    ----------
+    amplitudes : sequence of float, optional
+        The triangles' heights above ``v_min``, V.
+    frequency : float, optional
+        Periods per second, Hz.
+    sample_rate : float, optional
+        Samples per second, Hz.
+    v_min : float, optional
+        The level each triangle starts and ends at, V.
+
     Returns
     -------
     t, v : ndarray
@@ -99,6 +110,17 @@ def sinusoid_sequence(
     1 Hz sinusoids of amplitude 5, 10, ..., 120 V, each starting from ``v_min``, so that each
     descent from ``v_min + A`` traces a first-order descending curve.
 
+    Parameters
+    ----------
+    amplitudes : sequence of float, optional
+        The sinusoids' peak-to-peak amplitudes above ``v_min``, V.
+    frequency : float, optional
+        Hz.
+    sample_rate : float, optional
+        Samples per second, Hz.
+    v_min : float, optional
+        The level each sinusoid starts and ends at, V.
+
     Returns
     -------
     t, v : ndarray
@@ -115,7 +137,22 @@ def sinusoid_sequence(
 def scaled_amplitudes(
     amplitudes, paper_range=paper.VOLTAGE_RANGE, voltage_range=paper.VOLTAGE_RANGE
 ):
-    """The paper's amplitudes rescaled from 0..120 V to another ``voltage_range``."""
+    """The paper's amplitudes rescaled from 0..120 V to another ``voltage_range``.
+
+    Parameters
+    ----------
+    amplitudes : sequence of float
+        The paper's amplitudes, V on 0..120 V.
+    paper_range : tuple of (float, float), optional
+        The range they are given for, V.
+    voltage_range : tuple of (float, float), optional
+        The amplifier's range they are wanted for, V.
+
+    Returns
+    -------
+    tuple of float
+        The amplitudes for ``voltage_range``, V.
+    """
     lo, hi = check_range(voltage_range, "voltage_range", "scaled_amplitudes")
     paper_range = check_range(paper_range, "paper_range", "scaled_amplitudes")
     amplitudes = as_vector(amplitudes, "amplitudes", "scaled_amplitudes")
@@ -142,11 +179,8 @@ def random_turning_points(
     at ``rate`` V/s (240 V/s: the slope of the paper's 120 V triangle at 1 Hz), as in
     :func:`rich_sequence`.
 
-    Ramps rather than half-cosine sweeps of random duration: on the actuator panel of
-    ``benchmarks/bench_accuracy.py`` (5 actuators of none of the model families), PI fitted
-    to half-cosine sweeps tracked a 1 Hz triangle worse (mean 0.36x the uncompensated rms
-    against 0.30x from ramps, worst 0.45x against 0.37x), MPI and Preisach alike (0.19x and
-    0.11x both ways).
+    Ramps rather than half-cosine sweeps of random duration: a PI model fitted to ramps
+    tracks better, MPI and Preisach models alike (Benchmarks, "Excitation signals").
 
     Parameters
     ----------
@@ -221,6 +255,20 @@ def rich_turning_points(
     descent a reversal curve from a new level); the same from ``v_min`` upwards; then twice
     16 turning points drawn uniformly in the range. It ends at ``v_min``.
 
+    Parameters
+    ----------
+    v_min : float, optional
+        The lower end of the range, V.
+    v_max : float, optional
+        The upper end of the range, V.
+    seed : int, optional
+        The seed of the random turning points.
+
+    Returns
+    -------
+    numpy.ndarray
+        The turning points, V, from ``v_min`` back to ``v_min``.
+
     Examples
     --------
     >>> p = rich_turning_points()
@@ -259,6 +307,19 @@ def rich_sequence(
     levels in both directions (decaying loops from each end, then random turning points), so
     a model fitted to it has seen the minor loops a tracking reference produces. Ramps run at
     ``rate`` V/s (240 V/s: the slope of the paper's 120 V triangle at 1 Hz).
+
+    Parameters
+    ----------
+    rate : float, optional
+        The ramps' slope, V/s.
+    sample_rate : float, optional
+        Samples per second, Hz.
+    v_min : float, optional
+        The lower end of the range, V.
+    v_max : float, optional
+        The upper end of the range, V.
+    seed : int, optional
+        The seed of the random turning points.
 
     Returns
     -------

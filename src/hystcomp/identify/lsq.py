@@ -250,6 +250,28 @@ def constrained_lsq_path(
     The problem (centring, scaling, constraint rows) is set up once and only the ridge
     changes from one quadratic programme to the next, which is most of the cost of one
     (a path of penalties, :func:`~hystcomp.identify.mpi.fit_mpi_path`).
+
+    Parameters
+    ----------
+    gram : numpy.ndarray
+        The augmented Gram matrix of the regressors and the target.
+    ridges : sequence of float
+        The ridge penalties, one fit each.
+    blocks : sequence of (int, int, float)
+        ``(first, stop, bound)``: partial sums of ``theta[first:stop]`` must be ``>= bound``.
+    scales : array_like
+        Typical size of each non-constant regressor (its range), in its own units.
+    floors : sequence of (int, int, float), optional
+        ``(first, stop, bound)``: each of ``theta[first:stop]`` must be ``>= bound``.
+    caps : sequence of (int, int, float), optional
+        ``(first, stop, bound)``: partial sums of ``theta[first:stop]`` must be ``<= bound``.
+    flat_tol : float, optional
+        Relative variance under which a regressor counts as constant.
+
+    Returns
+    -------
+    list of LsqSolution
+        One solution per ridge, in order.
     """
     p = gram.shape[0] - 1
     c = _centred(gram)
@@ -305,6 +327,18 @@ def held_out_fits(grams, solve) -> tuple:
     The fits of a cross-validation over the folds of :func:`normal_equations` (with
     ``folds``), each on every fold but one. Empty if a fold has no sample or if the other
     folds do not determine a fit (an :class:`~hystcomp.errors.IdentificationError`).
+
+    Parameters
+    ----------
+    grams : array_like
+        Per-fold Gram matrices, shape ``(n_folds, p, p)``.
+    solve : callable
+        ``solve(gram) -> fit``, the fit on a Gram matrix.
+
+    Returns
+    -------
+    tuple
+        One fit per fold (fold ``f`` left out), or ``()``.
     """
     counts = grams[:, -2, -2]  # the constant regressor's square: the samples of each fold
     if not np.all(counts > 0):

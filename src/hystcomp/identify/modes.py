@@ -3,9 +3,8 @@
 Beyond the paper. :func:`hystcomp.identify.dynamics.fit_dynamics` fits one resonance to the
 multisine's lines; a stage with a second mode in its band (a stack and its flexure, a
 mount) then gets a resonance between the two, too lightly damped, and a latency that takes
-up the second mode's phase (on the ``narrow1200`` stage of ``benchmarks/dynamics_panel.py``,
-1200 Hz and 3100 Hz holding 8 % of the static gain: 1184 Hz, zeta 0.033, a latency of -1
-sample, 73 % of the response explained). So, after the one-mode fit, two modes in parallel
+up the second mode's phase (docs/dynamics.md, "A second mode", gives the figures on the
+two-mode stage of ``benchmarks/dynamics_panel.py``). So, after the one-mode fit, two modes in parallel
 are fitted to the same lines (:func:`fit_modes`), each a second-order section of unit
 static gain, ``R = (1 - g) R1 + g R2``, the latency free with them, and
 :func:`keeps_second_mode` decides.
@@ -34,14 +33,8 @@ from hystcomp._lti import resonance_response, resonance_zoh
 #: The second mode lies at least this multiple of the first's frequency above it.
 SEPARATION = 1.15
 #: Keep two modes when their residual (rms of the relative complex error on the lines) is at
-#: most this share of one mode's. Measured (the ratio, two modes' residual over one's): 0.02
-#: to 0.11 on the two-mode stage of the dynamics panel (``narrow1200``; behind MPI and
-#: Preisach as ``fit_pair`` fits it, and on the voltage), 0.002 to 0.07 on linear stages of
-#: 1 kHz with a second mode of 2 to 30 % at 1.5 to 4 kHz; 0.54 to 1.0 on the panel's five
-#: single-mode stages, 0.76 to 1.0 on the simulated axis (``creep_twin`` at 630 and
-#: 780 Hz), 0.78 to 1.0 on linear single-mode stages (300 Hz to 1.5 kHz, zeta 0.02 to 1.5,
-#: 5 to 20 kHz, latencies 0 and 2). 0.25 is about the geometric middle of the gap (0.11 ..
-#: 0.54); see docs/dynamics.md.
+#: most this share of one mode's: about the geometric middle of the gap between the ratios
+#: measured on two-mode and on single-mode stages (docs/dynamics.md, "A second mode").
 RESIDUAL_RATIO = 0.25
 #: A second mode is kept only if it is a resonance (damped less than this) and holds at
 #: least :data:`MIN_SHARE` of the static gain.
@@ -194,6 +187,20 @@ def keeps_second_mode(one: ModalFit, two: ModalFit, top_hz: float) -> bool:
     Its residual is at most :data:`RESIDUAL_RATIO` of one mode's, its second mode is a
     resonance (damping ratio below :data:`MAX_SECOND_DAMPING`) within the lines' band (at
     most ``top_hz``) with at least :data:`MIN_SHARE` of the static gain.
+
+    Parameters
+    ----------
+    one : ModalFit
+        The fit of one mode.
+    two : ModalFit
+        The fit of two modes.
+    top_hz : float
+        The highest frequency of the lines, Hz.
+
+    Returns
+    -------
+    bool
+        True if the second mode is kept.
     """
     if len(two.modes) < 2:
         return False

@@ -30,9 +30,7 @@ non-negative, as for the PI model (:mod:`hystcomp.identify.pi`), and the saturat
 monotone (every partial sum of ``w'_S`` above the margin) and smooth (the penalty below, on
 its changes of slope). No sign is imposed on ``w'_S`` itself: a piezo's loading curve is
 often convex at low voltage and saturating at high voltage, so ``S`` must be able to bend
-both ways. On the panel of ``benchmarks/bench_accuracy.py`` the worst 1 Hz tracking of an
-MPI compensator from the paper's triangles goes from 1.53x (eq. 19 as printed) to 0.48x
-the uncompensated error.
+both ways.
 
 Regularisation (a deviation from the paper; ``regularization=0`` is eq. 19 as printed). On a record of an
 actuator that is not exactly an MPI system, eq. (19) is ill-conditioned: the dead-zones of
@@ -50,21 +48,13 @@ default, fits every value of :data:`REGULARIZATION_GRID` at the cost of about on
 (:func:`fit_mpi_path`), each also on every fold but one of the record's reversal segments
 (``n_folds``, from the same pass), and keeps the one whose held-out fits predict the
 branches they did not see best, forward and through their inverse
-(:func:`hystcomp.identify.compensation.tracking_scorer`, ``criterion_um``). On the panel
-of ``benchmarks/bench_accuracy.py`` (5 actuators x 4 excitations) the value it chooses
-tracks within 0.002x of the uncompensated error of the best value of the grid in every cell
-(0.0004x on average; the smallest fit error, the former criterion, also 0.002x, and the
-inverse's estimate on the whole record 0.012x). With eq. (18)'s virgin plays only, where
-the fits are further from the actuators, the criterion came within 0.015x, the fit error
-within 0.042x: ``python benchmarks/bench_accuracy.py --rho``.
+(:func:`hystcomp.identify.compensation.tracking_scorer`, ``criterion_um``).
 With a second record of the actuator,
 :func:`hystcomp.identify.validation.choose_regularization` chooses by prediction instead.
 
 Samples weigh alike. The PI fit weights them so that every part of the input range counts
-the same (:func:`~hystcomp.identify.scoring.range_weights`); for MPI that is no gain, so
-eq. (19)'s unweighted sum stays: weighted, the worst cell of the panel of
-``benchmarks/bench_accuracy.py`` goes from 0.33x to 0.38x (the Bouc-Wen stage from the
-paper's triangles, 0.26x to 0.38x), the twin from 0.075x to 0.10x.
+the same (:func:`~hystcomp.identify.scoring.range_weights`); for MPI that is no gain (it
+tracks worse weighted), so eq. (19)'s unweighted sum stays.
 
 Initial memory (a deviation from eq. 18 with the physical constraints). Eq. (18) starts
 every play at zero, the *virgin* state of a demagnetised actuator: a loop from ``v_min``
@@ -76,20 +66,16 @@ descent from above (:func:`~hystcomp.identify.pi.initial_play_states`; for the p
 state of a Preisach model with every relay off, where :class:`~hystcomp.Preisach`
 starts), and
 ``ModifiedPrandtlIshlinskii`` keeps the one whose compensator is predicted to track best
-(the same criterion as the regularisation). On the panel it keeps the better of the two in
-all 20 cells: the twin from the paper's triangles goes from 0.24x to 0.075x the
-uncompensated error, the Bouc-Wen stage from 0.49x to 0.26x, and the Coleman-Hodgdon
-stage, which keeps 3.4 µm at 0 V after a loop, stays virgin. Table I's MPI row in
-``hystcomp compare`` goes from 0.41 to 0.16 µm at 1 Hz.
+(the same criterion as the regularisation).
 
 Limits of the family. ``S`` bends the loop as a function of the *output* level, so an
 actuator whose loop width depends on the *input* level in another way than its loading
 curve's slope (a Bouc-Wen stage whose hysteretic gain grows from nothing at 0 V) is beyond
-any MPI model. On the quasi-static hysteresis of the panel's Bouc-Wen stage (no creep,
-resonance or noise), the best MPI of 16 or 32 plays and dead-zones over every
-regularisation tracks the 1 Hz triangle at 0.25x the uncompensated error from the paper's
-triangles, and 0.33x when fitted on the tracked 0..120 V loop itself (on the twin, 0.07x
-and 0.08x; ``python benchmarks/bench_accuracy.py --limit``).
+any MPI model.
+
+Each of these choices was made on the tracking measured on the panel of
+``benchmarks/bench_accuracy.py``; the figures are in the documentation (Benchmarks, "The MPI
+fit").
 """
 
 from __future__ import annotations
@@ -182,6 +168,17 @@ def absorb_bias(weights, initial_state, input_offset: float, bias: float):
     ``b + sum_i w_i play_{r_i}(v - v_0; y_0)`` equals ``sum_i w_i play_{r_i}(v - v_0'; y_0')``
     with ``c = b / sum(w)``, ``v_0' = v_0 - c`` and ``y_0' = y_0 + c`` (shift equivariance of
     eq. 11). Needs ``sum(w) != 0`` (guaranteed by the invertibility constraint).
+
+    Parameters
+    ----------
+    weights : array_like
+        The play weights ``w_i``.
+    initial_state : array_like
+        The plays' initial states ``y_0``, V.
+    input_offset : float
+        The input offset ``v_0``, V.
+    bias : float
+        The constant ``b`` added to the superposition.
 
     Returns
     -------

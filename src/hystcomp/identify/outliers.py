@@ -115,6 +115,16 @@ def _confirmed(v: np.ndarray, found: np.ndarray, step: float) -> np.ndarray:
 def bulk_range(v) -> tuple[float, float]:
     """``(min, max)`` of ``v`` without its :func:`isolated_samples`.
 
+    Parameters
+    ----------
+    v : array_like
+        The record's input, V.
+
+    Returns
+    -------
+    tuple of (float, float)
+        The range without isolated samples, V.
+
     Examples
     --------
     >>> v = np.r_[np.linspace(0.0, 100.0, 1000), 1000.0]

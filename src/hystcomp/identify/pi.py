@@ -20,25 +20,22 @@ pairs of nearly cancelling plays to follow the mismatch, the loading curve gets 
 stretches and the inverse huge slopes there. ``constraints="physical"`` also keeps every
 weight beyond the first non-negative (``w_i >= 0``, ``i >= 1``): the initial loading curve
 is then convex without wiggles (its slope only grows), the loop width grows with amplitude
-as a piezo's does, and the inverse's slopes stay below ``1 / w_0``. On the panel of ``benchmarks/bench_accuracy.py``
-(five actuators of none of the families, four excitations) it brings the worst 1 Hz
-tracking of a PI compensator from 1.06x to 0.62x the uncompensated error (the paper's
-triangles: 1.06x to 0.46x on an asymmetric Bouc-Wen stage, 0.56x to 0.37x on the twin;
-with the thresholds below).
+as a piezo's does, and the inverse's slopes stay below ``1 / w_0``.
+
 The physical fit also spreads its thresholds over half the input span, where the plays
 can move (:func:`play_thresholds`), and weights the samples so that every part of the input
 range counts the same (:func:`~hystcomp.identify.scoring.range_weights`): the paper's
 signals linger at the bottom of the range, and the unweighted fit gave the top of the
-stroke away for it. The weighting took the panel's worst cell from 0.62x to 0.48x (the
-paper's sinusoids on a Krasnosel'skii-Pokrovskii stage; the twin from the paper's
-triangles: 0.37x to 0.33x).
+stroke away for it.
 
 The plays start as eq. (18) has them (:func:`initial_play_states`, ``"virgin"``). The MPI
 fit also tries the descended start and keeps the one predicted to track best
-(:mod:`hystcomp.identify.mpi`); for PI the same choice would take the twin's cells from
-0.33x to 0.17x, but it picks the worse memory in 5 of the panel's 20 cells, two of which
-then go over the 0.5x target (the Bouc-Wen stage from the paper's triangles 0.43x to 0.51x,
-the Krasnosel'skii-Pokrovskii stage from the sinusoids 0.48x to 0.50x), so PI keeps eq. 18.
+(:mod:`hystcomp.identify.mpi`); for PI that choice picks the worse memory too often, so PI
+keeps eq. 18.
+
+Each of these choices was made on the tracking measured on the panel of
+``benchmarks/bench_accuracy.py``; the figures are in the documentation (Benchmarks, "The PI
+fit").
 
 Records longer than :data:`~hystcomp.identify.scoring.MAX_SAMPLES` are fitted on every
 turning point and a regular subset of the samples (:func:`prepare_record`): the play
@@ -79,6 +76,18 @@ from hystcomp.identify.scoring import (
 def paper_thresholds(n_operators: int, span: float) -> np.ndarray:
     """Eq. (16)/(17): ``r_i = i / (n+1) * span`` for ``i = 0..n`` (``n_operators = n + 1``).
 
+    Parameters
+    ----------
+    n_operators : int
+        The number of plays, ``n + 1``.
+    span : float
+        The input span (``v_max``, eq. 16) or ``max{x_p}`` (eq. 17).
+
+    Returns
+    -------
+    numpy.ndarray
+        The thresholds, rising from 0.
+
     Examples
     --------
     >>> paper_thresholds(4, 120.0).tolist()
@@ -97,9 +106,22 @@ def play_thresholds(n_operators: int, span: float, constraints: str) -> np.ndarr
     frozen for good: eq. (16)'s ``r_i = i / (n+1) U`` leaves half of them without use (their
     regressors are constant, see :func:`~hystcomp.identify.lsq.constrained_lsq`). The
     physical fit spreads the same number of plays over ``r_i = i / (n+1) U / 2`` instead,
-    where the record has data: on the panel of ``benchmarks/bench_accuracy.py`` that lowers
-    the 1 Hz tracking error in most cells (from the paper's triangles on the Bouc-Wen stage:
-    PI from 0.52x to 0.46x, MPI from 0.52x to 0.48x).
+    where the record has data, which lowers the tracking error on most of the benchmark
+    panel's cells (Benchmarks, "The PI fit").
+
+    Parameters
+    ----------
+    n_operators : int
+        The number of plays.
+    span : float
+        The input span, V.
+    constraints : str
+        ``"paper"`` or ``"physical"``.
+
+    Returns
+    -------
+    numpy.ndarray
+        The thresholds, V, rising from 0.
 
     Examples
     --------
@@ -116,7 +138,18 @@ INITIAL_MEMORIES = ("virgin", "descended")
 
 
 def check_initial_memory(initial_memory) -> str:
-    """The ``initial_memory`` option: one of :data:`INITIAL_MEMORIES`."""
+    """The ``initial_memory`` option: one of :data:`INITIAL_MEMORIES`.
+
+    Parameters
+    ----------
+    initial_memory : str
+        The option as given.
+
+    Returns
+    -------
+    str
+        ``initial_memory``, checked.
+    """
     if initial_memory not in INITIAL_MEMORIES:
         raise InvalidParameterError(
             f"The 'initial_memory' parameter must be one of {INITIAL_MEMORIES}. "
@@ -134,6 +167,20 @@ def initial_play_states(u0: float, thresholds, initial_memory: str) -> np.ndarra
     the top of its band, ``y_i = u0 + r_i``, as after a descent from far above (for the
     plays, the state of a Preisach model whose every relay is off, the start of
     :class:`~hystcomp.Preisach`): every loop from ``u0`` closes there again.
+
+    Parameters
+    ----------
+    u0 : float
+        The first input of the plays, V.
+    thresholds : array_like
+        The play thresholds, V.
+    initial_memory : str
+        ``"virgin"`` or ``"descended"``.
+
+    Returns
+    -------
+    numpy.ndarray
+        The initial states, V.
 
     Examples
     --------
@@ -153,6 +200,27 @@ class PreparedRecord:
     them, or for a record longer than :data:`~hystcomp.identify.scoring.MAX_SAMPLES` its
     turning points and a regular subset, :func:`~hystcomp.identify.scoring.thin`); ``start``
     indexes them.
+
+    Parameters
+    ----------
+    v : numpy.ndarray
+        The voltages the fit uses, V.
+    x : numpy.ndarray
+        The displacements the fit uses, µm.
+    input_offset : float
+        The voltage subtracted before the plays, V.
+    u : numpy.ndarray
+        The plays' input ``v - input_offset``, V.
+    start : int
+        The first of the kept samples in the fit's cost (after the start-up transient).
+    input_span : float
+        The span of the input, V.
+    slope : float
+        The straight line's slope, µm/V.
+    samples : numpy.ndarray
+        The indices of the kept samples in the record.
+    weights : numpy.ndarray, optional
+        The samples' weights in the fit (None: all equal).
     """
 
     v: np.ndarray
@@ -177,6 +245,26 @@ def prepare_record(
     ``weighted``, the kept samples get weights under which every part of the input range
     counts the same (:func:`~hystcomp.identify.scoring.range_weights`); otherwise every
     sample weighs the same.
+
+    Parameters
+    ----------
+    v : array_like
+        The record's voltage, V.
+    x : array_like
+        The record's displacement, µm.
+    n_weights : int
+        The number of weights to fit (the record must hold more samples).
+    transient : int or None
+        The first sample of the fit (found from the record if None).
+    owner : str
+        The class named in an error message.
+    weighted : bool, optional
+        Whether every part of the input range should weigh the same.
+
+    Returns
+    -------
+    PreparedRecord
+        The record, ready for the fit.
     """
     v = as_signal(v, "v", min_samples=2)
     x = as_signal(x, "x", min_samples=2)

@@ -177,6 +177,25 @@ def everett_samples(curves, *, v_min: float, bin_width: float):
 
     Binning in ``beta`` weights every part of a curve alike, however slowly the input passed
     it (a sinusoid lingers near its extrema), and averages the sensor noise.
+
+    Parameters
+    ----------
+    curves : sequence
+        First-order descending curves, each with its ``alpha`` (V) and arrays ``beta`` (V) and
+        ``everett`` (µm).
+    v_min : float
+        The lower end of the Preisach plane, V.
+    bin_width : float
+        The width of the bins in ``beta``, V.
+
+    Returns
+    -------
+    alpha : numpy.ndarray
+        The switching-up voltage of each sample, V.
+    beta : numpy.ndarray
+        The switching-down voltage, V.
+    value : numpy.ndarray
+        ``X(alpha, beta)``, µm.
     """
     alphas, betas, values = [], [], []
     for curve in curves:
@@ -214,6 +233,26 @@ def fit_everett_polynomial(
     (``x_alpha,alpha = x_alpha``): for each degree ``k`` the coefficients sum to 0, so the
     ``beta**k`` one is eliminated, ``theta_(k,0) = -sum_(j>0) theta_(k-j,j)``, and the others
     are fitted. Without it this is the paper's plain least squares.
+
+    Parameters
+    ----------
+    alpha : array_like
+        Upper switching voltages of the samples, V.
+    beta : array_like
+        Lower switching voltages, V.
+    value : array_like
+        ``X(alpha, beta)``, µm.
+    degree : int
+        The polynomial's degree (3 is eq. 5).
+    voltage_range : tuple of (float, float)
+        The Preisach plane, V.
+    zero_diagonal : bool, optional
+        Whether to constrain ``X(v, v) = 0``.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``theta``, in the order of the monomials, µm/V^k.
 
     Raises
     ------
@@ -255,6 +294,24 @@ def fit_everett_table(alpha, beta, value, *, grid_size: int, voltage_range) -> n
     are ``X(alpha_i, beta_j)`` for ``j < i`` (the diagonal is 0 by eq. 2, the upper triangle
     the antisymmetric extension). A light second-difference penalty inside the triangle fills
     nodes that no curve reaches. Returns the full ``(grid_size, grid_size)`` table.
+
+    Parameters
+    ----------
+    alpha : array_like
+        Upper switching voltages of the samples, V.
+    beta : array_like
+        Lower switching voltages, V.
+    value : array_like
+        ``X(alpha, beta)``, µm.
+    grid_size : int
+        Nodes per axis.
+    voltage_range : tuple of (float, float)
+        The Preisach plane, V.
+
+    Returns
+    -------
+    numpy.ndarray
+        The table, µm, shape ``(grid_size, grid_size)``.
     """
     import scipy.sparse  # here: 0.2 s to import, and only the table fit needs it
     import scipy.sparse.linalg

@@ -89,7 +89,20 @@ class EverettBasis:
             self.size = self.n_seg * (self.n_seg + 1) // 2
 
     def evaluate(self, alpha, beta) -> np.ndarray:
-        """``X_m(alpha, beta)`` for every basis element, shape ``(n, size)``."""
+        """``X_m(alpha, beta)`` for every basis element, shape ``(n, size)``.
+
+        Parameters
+        ----------
+        alpha : array_like
+            Upper switching voltages, V.
+        beta : array_like
+            Lower switching voltages, V.
+
+        Returns
+        -------
+        numpy.ndarray
+            The basis functions' values, µm per unit coefficient, shape ``(n, size)``.
+        """
         alpha, beta = np.broadcast_arrays(np.asarray(alpha, float), np.asarray(beta, float))
         out = np.empty((alpha.size, self.size))
         for k, (a, b) in enumerate(zip(alpha.ravel(), beta.ravel(), strict=True)):
@@ -98,7 +111,27 @@ class EverettBasis:
 
     def rows(self, v, x, *, start=0, stride=1, block=BLOCK):
         """Regressor rows ``[R_0 .. R_(p-1), 1, x]`` of samples ``start, start + stride, ...``,
-        in blocks of at most ``block`` rows (a generator of views on one buffer)."""
+        in blocks of at most ``block`` rows (a generator of views on one buffer).
+
+        Parameters
+        ----------
+        v : array_like
+            The record's voltage, V.
+        x : array_like
+            The record's displacement, µm.
+        start : int, optional
+            The first sample.
+        stride : int, optional
+            Every how many samples a row is taken.
+        block : int, optional
+            The most rows in a block.
+
+        Yields
+        ------
+        numpy.ndarray
+            A block of rows, shape ``(rows, size + 2)``, a view on a buffer reused by the next
+            block.
+        """
         v = np.ascontiguousarray(v, dtype=np.float64)
         x = np.ascontiguousarray(x, dtype=np.float64)
         depth = pk.DEFAULT_DEPTH
@@ -126,7 +159,24 @@ class EverettBasis:
                 yield buffer[:count]
 
     def design(self, v, x=None, *, start=0, stride=1) -> np.ndarray:
-        """The regressors ``R`` as a dense ``(rows, size)`` matrix (for small records)."""
+        """The regressors ``R`` as a dense ``(rows, size)`` matrix (for small records).
+
+        Parameters
+        ----------
+        v : array_like
+            The record's voltage, V.
+        x : array_like, optional
+            Not used; the regressors depend on the voltage only.
+        start : int, optional
+            The first sample.
+        stride : int, optional
+            Every how many samples a row is taken.
+
+        Returns
+        -------
+        numpy.ndarray
+            The regressors, shape ``(rows, size)``.
+        """
         x = np.zeros(len(v)) if x is None else x
         parts = [
             block[:, : self.size].copy() for block in self.rows(v, x, start=start, stride=stride)
@@ -139,7 +189,29 @@ class EverettBasis:
         With ``folds`` (a fold ``0 .. n_folds - 1`` for every sample, -1 for none), one Gram
         matrix per fold over its own rows, and one over those of its rows whose input lies
         inside the range of the other folds (:func:`~hystcomp.identify.compensation.
-        inside_training`): shape ``(2, n_folds, p + 2, p + 2)``."""
+        inside_training`): shape ``(2, n_folds, p + 2, p + 2)``.
+
+        Parameters
+        ----------
+        v : array_like
+            The record's voltage, V.
+        x : array_like
+            The record's displacement, µm.
+        start : int, optional
+            The first sample.
+        stride : int, optional
+            Every how many samples a row is taken.
+        folds : array_like of int, optional
+            The fold of every sample (-1 for none).
+        n_folds : int, optional
+            The number of folds.
+
+        Returns
+        -------
+        numpy.ndarray
+            The Gram matrix, shape ``(size + 2, size + 2)``, or ``(2, n_folds, size + 2, size +
+            2)`` with ``folds``.
+        """
         size = self.size + 2
         if folds is None:
             gram = np.zeros((size, size))
@@ -172,6 +244,11 @@ class EverettBasis:
         ``-d2X/(da db) >= 0`` on a triangular grid of :data:`DENSITY_GRID` points per axis
         (diagonal included) and ``dX/da (v, v) >= 0`` on the diagonal; between the points
         a polynomial of low degree cannot dip far below 0.
+
+        Returns
+        -------
+        numpy.ndarray
+            The constraint rows, shape ``(constraints, size)``.
         """
         if self.kind == pk.BASIS_CELLS:
             return np.eye(self.size)
@@ -185,7 +262,13 @@ class EverettBasis:
 
     def smoothness_penalty(self) -> np.ndarray:
         """``D^T D`` of first differences of the density between neighbouring cells, and of the
-        reversible part between neighbouring diagonal segments (zero for the polynomial)."""
+        reversible part between neighbouring diagonal segments (zero for the polynomial).
+
+        Returns
+        -------
+        numpy.ndarray
+            The penalty matrix, shape ``(size, size)``.
+        """
         if self.kind == pk.BASIS_POLYNOMIAL:
             return np.zeros((self.size, self.size))
         n = self.n_seg
@@ -211,7 +294,20 @@ class EverettBasis:
         return diff.T @ diff
 
     def to_model(self, coef):
-        """``(theta, table)`` of :class:`~hystcomp.Preisach` for the coefficients ``coef``."""
+        """``(theta, table)`` of :class:`~hystcomp.Preisach` for the coefficients ``coef``.
+
+        Parameters
+        ----------
+        coef : array_like
+            The basis coefficients.
+
+        Returns
+        -------
+        theta : numpy.ndarray or None
+            The polynomial's coefficients, µm/V^k (None for a table).
+        table : numpy.ndarray or None
+            The table on the grid, µm (None for a polynomial).
+        """
         span = self.hi - self.lo
         if self.kind == pk.BASIS_POLYNOMIAL:
             fitted = {(int(i), int(j)): float(c) for (i, j), c in zip(self.exps, coef, strict=True)}

@@ -76,7 +76,24 @@ def _first_near_an_end(v: np.ndarray) -> int:
 
 
 def check_transient(transient, v: np.ndarray, owner: str, *, min_used: int) -> int:
-    """The first sample of the fit: ``transient`` validated, or :func:`transient_end`."""
+    """The first sample of the fit: ``transient`` validated, or :func:`transient_end`.
+
+    Parameters
+    ----------
+    transient : int or None
+        The first sample of the fit as the user gave it (found from the record if None).
+    v : numpy.ndarray
+        The record's voltage, V.
+    owner : str
+        The class named in an error message.
+    min_used : int
+        The fewest samples the fit needs after the transient.
+
+    Returns
+    -------
+    int
+        The first sample of the fit.
+    """
     start = (
         _first_near_an_end(v)
         if transient is None
@@ -92,15 +109,24 @@ def check_transient(transient, v: np.ndarray, owner: str, *, min_used: int) -> i
 
 
 #: Records longer than this are thinned (:func:`thin`) before a PI or MPI fit. A
-#: rate-independent loop is described by far fewer samples than a 20 kHz record holds: on
-#: the panel of ``benchmarks/bench_accuracy.py`` (records of 80,000 to 480,000 samples)
-#: fits on every turning point and about 20,000 regular samples track within 0.001x of
-#: fits on every sample, at a quarter of the cost or less.
+#: rate-independent loop is described by far fewer samples than a 20 kHz record holds
+#: (Benchmarks, "Thinning a record").
 MAX_SAMPLES = 20_000
 
 
 def input_noise(v: np.ndarray) -> float:
-    """Robust estimate of white noise on ``v`` (V) from the MAD of second differences."""
+    """Robust estimate of white noise on ``v`` (V) from the MAD of second differences.
+
+    Parameters
+    ----------
+    v : numpy.ndarray
+        The record's voltage, V.
+
+    Returns
+    -------
+    float
+        The noise's standard deviation, V.
+    """
     if v.size < 4:
         return 0.0
     d2 = np.diff(v, 2)
@@ -108,14 +134,40 @@ def input_noise(v: np.ndarray) -> float:
 
 
 def default_tolerance(v: np.ndarray) -> float:
-    """Dead band of the turning-point search: ``max(1e-3 * span, 8 * noise)`` in V."""
+    """Dead band of the turning-point search: ``max(1e-3 * span, 8 * noise)`` in V.
+
+    Parameters
+    ----------
+    v : numpy.ndarray
+        The record's voltage, V.
+
+    Returns
+    -------
+    float
+        The dead band, V.
+    """
     return max(1e-3 * float(np.ptp(v)), 8.0 * input_noise(v))
 
 
 def turning_indices(v: np.ndarray, tolerance: float) -> tuple[np.ndarray, bool]:
     """``(indices, first_is_max)``: the alternating extrema of ``v``, reversals smaller than
     ``tolerance`` ignored; the last index is where ``v`` stands at its end (see
-    :func:`hystcomp._kernels.reversals.turning_points`)."""
+    :func:`hystcomp._kernels.reversals.turning_points`).
+
+    Parameters
+    ----------
+    v : numpy.ndarray
+        The signal, V.
+    tolerance : float
+        The dead band, V: smaller reversals are ignored.
+
+    Returns
+    -------
+    indices : numpy.ndarray
+        The indices of the alternating extrema, the last sample's index last.
+    first_is_max : bool
+        Whether the first extremum is a maximum.
+    """
     idx = np.empty(v.size, dtype=np.int64)
     count, first_is_max = turning_points(v, tolerance, idx)
     return idx[:count], bool(first_is_max)
@@ -134,6 +186,18 @@ def largest_swings(levels) -> tuple[float, float]:
     rate-independent hysteresis model with wipe-out sees them: a turning point beyond the
     one before last wipes out the minor loop between them, so a climb through small dips
     counts as one rise (the first level, where the record's memory is known, stays).
+
+    Parameters
+    ----------
+    levels : sequence of float
+        Turning points, in order.
+
+    Returns
+    -------
+    rise : float
+        The largest rise.
+    fall : float
+        The largest fall.
 
     Examples
     --------
@@ -168,14 +232,20 @@ def coverage_warning(v, start: int = 0) -> str | None:
     * turn back inside the range. A single loop, or a staircase up and down, turns only at
       the ends, so no branch after a reversal inside the range (a minor loop) is seen.
 
-    On the panel of ``benchmarks/bench_accuracy.py`` (five stages of none of the model
-    families, the three models; ``--coverage``), the records flagged here (a random walk
-    that drifts across the range once, one loop, a staircase up and down) tracked its 1 Hz
-    triangle at a median 1.21x their estimate, and at more than 2x in 13 of 45 cells (up to
-    45x: MPI from one loop on the Duhem stage, 0.012x the uncompensated error estimated,
-    0.555x measured); the records passed (the paper's triangles and sinusoids, random
-    turning points, ``excite rich``, a random walk that turns back across the range) at a
-    median 0.55x, more than 2x in 2 of 75.
+    The records flagged here track far worse than their estimate more often than the
+    records passed (Benchmarks, "Records that flatter the estimate").
+
+    Parameters
+    ----------
+    v : array_like
+        The record's voltage, V.
+    start : int, optional
+        The first sample after the start-up transient.
+
+    Returns
+    -------
+    str or None
+        The reason, or None if the record rises, falls and turns back inside its range.
 
     Examples
     --------
@@ -233,6 +303,20 @@ def thin(v, start: int = 0, max_samples: int = MAX_SAMPLES) -> np.ndarray:
     weights the record as the whole does. Before ``start`` (a start-up transient, out of the
     cost) only the turning points are kept, to set the model's state.
 
+    Parameters
+    ----------
+    v : array_like
+        The record's input, V.
+    start : int, optional
+        The first sample of the fit; before it only turning points are kept.
+    max_samples : int, optional
+        About how many samples to keep.
+
+    Returns
+    -------
+    numpy.ndarray
+        The kept indices, rising.
+
     Examples
     --------
     >>> thin(np.array([0.0, 1.0, 2.0, 3.0, 2.0, 1.0, 2.0]), max_samples=2).tolist()
@@ -274,12 +358,21 @@ def range_weights(u, start: int = 0) -> np.ndarray:
     ``u[start:]``. Samples before ``start`` get the weight of their part (they are out of
     the cost anyway).
 
-    The PI fit with physical constraints uses it (:func:`hystcomp.identify.pi.fit_pi`); on
-    the panel of ``benchmarks/bench_accuracy.py`` (5 actuators of none of the families, 4
-    excitations) it brings the worst 1 Hz tracking of a PI compensator from 0.62x to 0.48x
-    the uncompensated error. With a cap of 10 the worst cell is 0.49x, with 12 or 48 parts
-    0.50x and 0.49x, with the square root of the weights 0.55x, with their 1.5th power
-    0.56x.
+    The PI fit with physical constraints uses it (:func:`hystcomp.identify.pi.fit_pi`); the
+    cap, the number of parts and the power of the weights were chosen on the benchmark
+    panel (Benchmarks, "The PI fit").
+
+    Parameters
+    ----------
+    u : array_like
+        The fit's input, V.
+    start : int, optional
+        The first sample in the fit's cost.
+
+    Returns
+    -------
+    numpy.ndarray
+        One weight per sample, averaging 1 over ``u[start:]``.
 
     Examples
     --------
@@ -307,6 +400,20 @@ def reversal_folds(v, start: int, n_folds: int) -> np.ndarray:
     every fold holds ascending and descending branches from all over the record, and a
     model fitted on the other folds must predict whole branches it has not seen. Samples
     before ``start`` get -1.
+
+    Parameters
+    ----------
+    v : array_like
+        The record's input, V.
+    start : int
+        The first sample dealt out (earlier ones get -1).
+    n_folds : int
+        The number of folds.
+
+    Returns
+    -------
+    numpy.ndarray
+        The fold of every sample (int).
 
     Examples
     --------
@@ -445,6 +552,20 @@ def error_report(x, x_model, start: int = 0) -> dict:
 def straight_line(v, x) -> tuple[float, float]:
     """Least-squares line ``x = a v + b`` (a in µm/V, b in µm): the no-hysteresis baseline.
 
+    Parameters
+    ----------
+    v : array_like
+        Voltage, V.
+    x : array_like
+        Displacement, µm.
+
+    Returns
+    -------
+    a : float
+        The slope, µm/V.
+    b : float
+        The intercept, µm.
+
     Examples
     --------
     >>> a, b = straight_line([0.0, 1.0, 2.0], [1.0, 3.0, 5.0])
@@ -465,6 +586,19 @@ def holdout_report(model, v, x, n_fit: int, start: int = 0) -> dict:
     The model is run over the whole record (so that its state is right when the held-out
     part begins) and scored on ``n_fit..`` only. The baseline is the straight line
     :func:`straight_line` fitted on the same samples as the model (``start..n_fit``).
+
+    Parameters
+    ----------
+    model : HysteresisModel
+        The model fitted on ``v[:n_fit]``.
+    v : array_like
+        The whole record's voltage, V.
+    x : array_like
+        The whole record's displacement, µm.
+    n_fit : int
+        The number of samples the model was fitted on.
+    start : int, optional
+        The first sample of the fit (after the start-up transient).
 
     Returns
     -------

@@ -89,6 +89,16 @@ def write_target(path: Path) -> Path:
     An output path that is a symbolic link keeps the link: the new contents replace the
     file it points to (atomically, in that file's folder), as ``open(path, "w")`` would,
     and a link to a missing file creates that file.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        An output path, possibly a symbolic link.
+
+    Returns
+    -------
+    pathlib.Path
+        The file the write replaces.
     """
     return Path(os.path.realpath(path)) if path.is_symlink() else path
 
@@ -132,12 +142,29 @@ def _new_temporary(make) -> Path:
 
 def new_temporary_folder(prefix: str) -> Path:
     """A new folder in the system's temporary folder, registered as a pending temporary
-    (removed if a signal ends the command); :func:`discard_temporary` removes it."""
+    (removed if a signal ends the command); :func:`discard_temporary` removes it.
+
+    Parameters
+    ----------
+    prefix : str
+        The start of the folder's name.
+
+    Returns
+    -------
+    pathlib.Path
+        The new, empty folder.
+    """
     return _new_temporary(lambda: tempfile.mkdtemp(prefix=prefix))
 
 
 def discard_temporary(path: Path) -> None:
-    """Remove a temporary of :func:`new_temporary_folder` (or file) and forget it."""
+    """Remove a temporary of :func:`new_temporary_folder` (or file) and forget it.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The temporary folder or file to remove.
+    """
     with contextlib.suppress(OSError):
         if path.is_dir() and not path.is_symlink():
             shutil.rmtree(path)
@@ -148,14 +175,28 @@ def discard_temporary(path: Path) -> None:
 
 def track_new_folder(path: Path) -> None:
     """Remember that ``path`` was made for a command's outputs: :func:`remove_pending`
-    removes it if it is still empty (see :func:`forget_folder`)."""
+    removes it if it is still empty (see :func:`forget_folder`).
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        A folder just made for a command's outputs.
+    """
     with _signals.lock():
         _MADE.add(Path(path))
 
 
 def forget_folder(path: Path, *, remove: bool) -> None:
     """Stop tracking ``path`` (:func:`track_new_folder`); ``remove``: remove it now if it
-    is empty (the command failed)."""
+    is empty (the command failed).
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        A folder registered with :func:`track_new_folder`.
+    remove : bool
+        Whether to remove it now if it is empty.
+    """
     with _signals.lock():
         _MADE.discard(Path(path))
         if remove:
@@ -169,6 +210,16 @@ def staging_folder(directory: Path):
 
     For a command that writes a set of files: write them there, then move them into place
     with :func:`replace_all`.
+
+    Parameters
+    ----------
+    directory : pathlib.Path
+        The folder the outputs go to, where the staging folder is made.
+
+    Yields
+    ------
+    pathlib.Path
+        The staging folder.
     """
     stage = _new_temporary(
         lambda: tempfile.mkdtemp(prefix=".hystcomp-", suffix=".tmp", dir=directory)
@@ -203,6 +254,17 @@ def atomic_paths(*paths: str | os.PathLike):
     All outputs of a command are written to temporary files first, so a failure anywhere
     leaves every existing file untouched and removes the temporary files. Each temporary
     name keeps its path's suffix, so writers that choose the format by suffix work on it.
+
+    Parameters
+    ----------
+    *paths : str or os.PathLike
+        The output files of one command.
+
+    Yields
+    ------
+    list of pathlib.Path
+        One temporary file per output, in the same order, each beside its output and with its
+        suffix.
 
     Raises
     ------
@@ -264,6 +326,11 @@ def replace_all(moves: list[tuple[Path, Path]]) -> None:
     renames onto temporary files (a writer inside another's atomic output) are not the
     command's own commit.
 
+    Parameters
+    ----------
+    moves : list of (pathlib.Path, pathlib.Path)
+        Pairs ``(new, path)``: the complete new file and the path it replaces.
+
     Raises
     ------
     OSError
@@ -323,6 +390,16 @@ def atomic_path(path: str | os.PathLike):
 
     A failure leaves any existing ``path`` untouched and removes the temporary file
     (:func:`atomic_paths` with one path).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The output file.
+
+    Yields
+    ------
+    pathlib.Path
+        The temporary file to write, beside ``path`` and with its suffix.
     """
     with atomic_paths(path) as (tmp,):
         yield tmp

@@ -54,7 +54,18 @@ PAIR_PARTS = {"hysteresis": ("pi", "mpi", "preisach"), "dynamics": ("dynamics",)
 
 
 def model_to_dict(model: Model) -> dict[str, Any]:
-    """The JSON document of a model (format, version, then the model's own dictionary)."""
+    """The JSON document of a model (format, version, then the model's own dictionary).
+
+    Parameters
+    ----------
+    model : model
+        A fitted model of a kind that :data:`MODEL_KINDS` lists.
+
+    Returns
+    -------
+    dict
+        ``{"format", "version", "kind", ...}``, ready for ``json.dumps``.
+    """
     if not isinstance(model, tuple(MODEL_KINDS.values())):
         raise InvalidTypeError(
             f"'model' must be one of hystcomp's models ({', '.join(sorted(MODEL_KINDS))}). "
@@ -65,6 +76,16 @@ def model_to_dict(model: Model) -> dict[str, Any]:
 
 def model_text(model: Model) -> str:
     """The model file's text (JSON) for ``model``.
+
+    Parameters
+    ----------
+    model : model
+        A fitted model of a kind that :data:`MODEL_KINDS` lists.
+
+    Returns
+    -------
+    str
+        The JSON text of the model file, ending in a newline.
 
     Raises
     ------
@@ -84,7 +105,15 @@ def model_text(model: Model) -> str:
 
 
 def save_model(model: Model, path: str | os.PathLike) -> None:
-    """Write ``model`` to ``path`` as JSON (atomically: a failure leaves ``path`` as it was)."""
+    """Write ``model`` to ``path`` as JSON (atomically: a failure leaves ``path`` as it was).
+
+    Parameters
+    ----------
+    model : model
+        A fitted model of a kind that :data:`MODEL_KINDS` lists.
+    path : str or os.PathLike
+        The model file to write (JSON).
+    """
     text = model_text(model)
     with atomic_path(path) as tmp:
         tmp.write_text(text, encoding="utf-8")
@@ -225,6 +254,18 @@ def _check_multiaxis(doc: dict, version: int, source: str) -> None:
 def model_from_dict(doc: Any, source: str = "the model document") -> Model:
     """Build a model from a JSON document, checking format, version, kind, keys and values.
 
+    Parameters
+    ----------
+    doc : Any
+        The parsed JSON document.
+    source : str, optional
+        How error messages name the document (the file's path).
+
+    Returns
+    -------
+    model
+        The model the document describes, validated.
+
     Raises
     ------
     ModelFileError
@@ -253,6 +294,17 @@ def _refuse_constant(name: str):
 
 def load_model(path: str | os.PathLike) -> Model:
     """Read a model file written by :func:`save_model` or the ``hystcomp`` command.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The model file (JSON).
+
+    Returns
+    -------
+    model
+        The model the file holds, fitted: a PI, MPI or Preisach model, linear dynamics,
+        a Hammerstein pair or a multi-axis model (the kinds of :data:`MODEL_KINDS`).
 
     Raises
     ------

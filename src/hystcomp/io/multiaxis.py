@@ -36,6 +36,16 @@ def axis_key(name) -> tuple[str, int] | None:
 
     >>> axis_key("X12"), axis_key("x"), axis_key("v0")
     (('x', 12), None, None)
+
+    Parameters
+    ----------
+    name : str
+        A column name.
+
+    Returns
+    -------
+    tuple of (str, int) or None
+        The key (``"v"`` or ``"x"``) and the axis number (from 1), or None for any other name.
     """
     match = _KEY.match(str(name).strip())
     if match is None:
@@ -45,6 +55,16 @@ def axis_key(name) -> tuple[str, int] | None:
 
 def parse_axis_columns(text: str) -> dict[str, int | str]:
     """Parse ``--columns`` of an N-axis file, such as ``t=1,v1=2,v2=3,x1=4,x2=5``.
+
+    Parameters
+    ----------
+    text : str
+        The ``--columns`` text, ``key=column`` pairs separated by commas.
+
+    Returns
+    -------
+    dict
+        Each key (``t``, ``v1``, ``x2``, ...) with its 1-based column number or its column name.
 
     Examples
     --------
@@ -90,7 +110,20 @@ def _header_names(path: Path) -> list[str]:
 
 def is_multiaxis(path, columns: dict | None = None) -> bool:
     """Whether ``path`` is an N-axis file: a column named ``v1`` or ``x1`` (any case), or
-    ``columns`` naming one."""
+    ``columns`` naming one.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A data file.
+    columns : dict, optional
+        The column mapping the user gave (``--columns``).
+
+    Returns
+    -------
+    bool
+        True for an N-axis file.
+    """
     if columns and any(axis_key(key) for key in columns):
         return True
     try:

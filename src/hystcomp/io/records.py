@@ -126,6 +126,11 @@ class Record:
 
         The frame holds copies, and its columns go back into ``fit``, ``simulate`` or
         ``score`` as they are.
+
+        Returns
+        -------
+        pandas.DataFrame
+            Columns ``t`` (s), ``v`` (V) and ``x`` (µm), one row per sample.
         """
         import pandas as pd  # a dependency, loaded when used
 
@@ -135,7 +140,18 @@ class Record:
 
 
 def rate_of(t) -> float:
-    """Sample rate in Hz of strictly increasing times ``t`` (s), from the median step."""
+    """Sample rate in Hz of strictly increasing times ``t`` (s), from the median step.
+
+    Parameters
+    ----------
+    t : array_like
+        Strictly increasing times, s.
+
+    Returns
+    -------
+    float
+        The sample rate, Hz.
+    """
     t = as_signal(t, "t", min_samples=2)
     with np.errstate(over="ignore", divide="ignore"):
         return float(1.0 / np.median(np.diff(t)))
@@ -145,6 +161,16 @@ def parse_columns(text: str | None) -> dict[str, int | str] | None:
     """Parse a column mapping such as ``"v=1,x=5"`` or ``"v=volts,x=disp"``.
 
     Numbers are 1-based column numbers; anything else is a column name.
+
+    Parameters
+    ----------
+    text : str or None
+        ``key=column`` pairs separated by commas (None for no mapping).
+
+    Returns
+    -------
+    dict or None
+        Each key with its 1-based column number or its column name; None if ``text`` is None.
 
     Examples
     --------
@@ -492,6 +518,20 @@ def x_unit_warning(x, source: str, given: str | None = None) -> str | None:
     nanometres (give ``--x-unit``). ``given``, the unit the user gave (``--x-unit``), if any:
     then the message asks to check it. Returns the message, or None if the span is plausible.
 
+    Parameters
+    ----------
+    x : array_like
+        The displacements as read, µm.
+    source : str
+        How the message names the file.
+    given : str, optional
+        The unit the user gave (``--x-unit``).
+
+    Returns
+    -------
+    str or None
+        The warning's text, or None if the span is plausible in µm.
+
     Examples
     --------
     >>> x_unit_warning([0.0, 2e-5], "rec.csv")[:52]
@@ -523,6 +563,19 @@ def uneven_sampling(t, what: str) -> str | None:
     acquisition, a merged file) breaks a discrete-time model of the dynamics, which takes
     every sample as one period after the last; rounding of a written time column stays
     well inside that.
+
+    Parameters
+    ----------
+    t : array_like
+        Increasing times, s.
+    what : str
+        How the message names the record.
+
+    Returns
+    -------
+    str or None
+        The reason (how many steps differ from the median, the first of them), or None if
+        the sampling is even.
     """
     steps = np.diff(np.asarray(t, dtype=np.float64))
     if steps.size == 0:
@@ -595,6 +648,20 @@ def read_record(path, *, columns=None, sample_rate=None, x_unit=None, progress=N
     Parameters are those of :func:`read_table`; ``columns`` may be the command line's
     text (``"t=2,v=4,x=3"``).
 
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The data file (``.csv``, ``.npz``, ``.mat`` or a text table).
+    columns : dict or str, optional
+        Which column holds ``t``, ``v`` and ``x`` (numbers from 1, or names), as a dict or as
+        ``"t=2,v=4,x=3"``.
+    sample_rate : float, optional
+        Samples per second, Hz; needed when the file has no time column.
+    x_unit : {"m", "mm", "um", "nm"}, optional
+        The unit of the displacement in the file, converted to µm.
+    progress : callable, optional
+        Called with the fraction read so far (0..1).
+
     Returns
     -------
     Record
@@ -635,7 +702,18 @@ def _columns(table, owner: str) -> dict[str, np.ndarray]:
 
 
 def format_csv(table: dict) -> str:
-    """A table of equally long columns as CSV text with a header row (shortest round-trip)."""
+    """A table of equally long columns as CSV text with a header row (shortest round-trip).
+
+    Parameters
+    ----------
+    table : dict of str to array_like
+        Column name -> values, all equally long, in the order of the header.
+
+    Returns
+    -------
+    str
+        The CSV text, a header row then one row per sample.
+    """
     cols = _columns(table, "format_csv")
     if len({c.size for c in cols.values()}) != 1:
         raise InvalidParameterError("The columns given to format_csv have different lengths.")
@@ -646,6 +724,16 @@ def format_csv(table: dict) -> str:
 
 def check_writable(path) -> Path:
     """``path`` as a Path if :func:`write_table` can write its format, else raise.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The output file.
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``, checked.
 
     Raises
     ------

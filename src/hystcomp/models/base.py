@@ -132,6 +132,11 @@ class HysteresisModel(PackedSystem, Estimator):
         :func:`~hystcomp.identify.workflow.identify_record`) or narrower. This is what the
         record really covered, from the fit report (``fit_report_["input_range_v"]``); a
         model built from parameters, or read from a file without it, returns None.
+
+        Returns
+        -------
+        tuple of (float, float) or None
+            ``(min v, max v)`` of the fitted record, in V; None for a model without a fit report.
         """
         report = getattr(self, "fit_report_", None)
         value = report.get(INPUT_RANGE_KEY) if isinstance(report, dict) else None
@@ -166,7 +171,22 @@ class HysteresisModel(PackedSystem, Estimator):
 
 
 def slew_to_step(slew_rate, sample_rate, owner) -> float:
-    """Largest voltage change per sample from a slew-rate limit in V/s (``inf`` if None)."""
+    """Largest voltage change per sample from a slew-rate limit in V/s (``inf`` if None).
+
+    Parameters
+    ----------
+    slew_rate : float or None
+        The amplifier's slew-rate limit, V/s; None for no limit.
+    sample_rate : float
+        The compensator's sample rate, Hz.
+    owner : str
+        The class named in an error message.
+
+    Returns
+    -------
+    float
+        The largest voltage change per sample, V (``inf`` without a limit).
+    """
     if slew_rate is None:
         return np.inf
     slew_rate = check_real(slew_rate, "slew_rate", owner, positive=True)
@@ -177,7 +197,22 @@ def slew_to_step(slew_rate, sample_rate, owner) -> float:
 def compensator_rate(sample_rate, dynamics, owner) -> float:
     """The sample rate (Hz) a compensator runs at: ``sample_rate``, else that of
     ``dynamics`` (a discrete-time model, which runs at its own rate only), else the
-    twin's 20 kHz; a ``sample_rate`` other than the dynamics' is refused."""
+    twin's 20 kHz; a ``sample_rate`` other than the dynamics' is refused.
+
+    Parameters
+    ----------
+    sample_rate : float or None
+        The rate asked for, Hz; None takes that of ``dynamics``, else the twin's 20 kHz.
+    dynamics : LinearDynamics or None
+        The linear dynamics in series with the compensator, which run at their own rate only.
+    owner : str
+        The class named in an error message.
+
+    Returns
+    -------
+    float
+        The compensator's sample rate, Hz.
+    """
     own = getattr(dynamics, "sample_rate_", None)
     if sample_rate is None:
         return paper.SAMPLE_RATE if own is None else float(own)
@@ -192,14 +227,39 @@ def compensator_rate(sample_rate, dynamics, owner) -> float:
 
 
 def input_range_report(v) -> dict[str, list[float]]:
-    """The fit report's entry for the input range (V) that ``v`` covers."""
+    """The fit report's entry for the input range (V) that ``v`` covers.
+
+    Parameters
+    ----------
+    v : array_like
+        The voltage record the model was fitted on, V.
+
+    Returns
+    -------
+    dict
+        ``{"input_range_v": [min v, max v]}``, the entry of ``fit_report_``.
+    """
     v = np.asarray(v, dtype=np.float64)
     return {INPUT_RANGE_KEY: [float(v.min()), float(v.max())]}
 
 
 def fit_voltage_range(voltage_range, v) -> tuple[float, float]:
     """The checked ``voltage_range`` hyperparameter, or the data's ``(min v, max v)`` if it
-    is None."""
+    is None.
+
+    Parameters
+    ----------
+    voltage_range : tuple of (float, float) or None
+        The amplifier's range, V, as the hyperparameter's constraint checked it; None to
+        take the data's.
+    v : array_like
+        The voltage record the model is fitted on, V.
+
+    Returns
+    -------
+    tuple of (float, float)
+        The range ``(low, high)``, V, with ``low < high``.
+    """
     if voltage_range is None:
         v = np.asarray(v, dtype=np.float64)
         return float(v.min()), float(v.max())

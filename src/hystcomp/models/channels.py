@@ -143,19 +143,51 @@ class ChannelBank:
         return len(self._groups)
 
     def stepper(self) -> BankStepper:
-        """A streaming bank: ``step(row) -> row`` (C values each), from the initial state."""
+        """A streaming bank: ``step(row) -> row`` (C values each), from the initial state.
+
+        Returns
+        -------
+        BankStepper
+            A stepper in the bank's initial state.
+        """
         return BankStepper(self)
 
     def run(self, U) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Outputs (n, C) for inputs ``U`` (n, C), from the initial state, and per channel the
-        counts of clamped outputs and of non-finite inputs held."""
+        counts of clamped outputs and of non-finite inputs held.
+
+        Parameters
+        ----------
+        U : array_like
+            Input samples, shape ``(n, C)``; a non-finite value holds that channel's last output.
+
+        Returns
+        -------
+        outputs : numpy.ndarray
+            The outputs, shape ``(n, C)``.
+        clamped : numpy.ndarray
+            Per channel, the number of outputs cut by its clamp (int, shape ``(C,)``).
+        held : numpy.ndarray
+            Per channel, the number of non-finite inputs held (int, shape ``(C,)``).
+        """
         s = self.stepper()
         out = s.step_block(U)
         return out, s.clamped_count, s.nonfinite_count
 
     def simulate(self, U) -> np.ndarray:
         """Outputs (n, C) for finite inputs ``U`` (n, C), from the initial state; the bank
-        is not changed."""
+        is not changed.
+
+        Parameters
+        ----------
+        U : array_like
+            Finite input samples, shape ``(n, C)``.
+
+        Returns
+        -------
+        numpy.ndarray
+            The outputs, shape ``(n, C)``, from the initial state.
+        """
         U = as_axes(
             U, "U", "ChannelBank.simulate", n_axes=self.n_channels, max_columns=MAX_CHANNELS
         )
@@ -167,7 +199,13 @@ class ChannelBank:
 
 
 class BankStepper:
-    """A :class:`ChannelBank` one sample at a time; owns its state (reset, copy, state)."""
+    """A :class:`ChannelBank` one sample at a time; owns its state (reset, copy, state).
+
+    Parameters
+    ----------
+    bank : ChannelBank
+        The bank to stream; the stepper starts from its initial state.
+    """
 
     def __init__(self, bank: ChannelBank):
         self._bank = bank
@@ -191,6 +229,17 @@ class BankStepper:
 
         With one structure among the channels (the common case) a step is one call of the
         compiled kernel, without numba's dispatch on argument types.
+
+        Parameters
+        ----------
+        u : array_like
+            One input sample per channel, in the channels' input unit (V for a model, µm for a
+            compensator).
+
+        Returns
+        -------
+        numpy.ndarray
+            One output sample per channel (float64, shape ``(C,)``).
         """
         try:
             self._row[0] = u
@@ -223,7 +272,18 @@ class BankStepper:
         return out
 
     def step_block(self, U) -> np.ndarray:
-        """Advance over a block of rows (n, C); returns the outputs (n, C)."""
+        """Advance over a block of rows (n, C); returns the outputs (n, C).
+
+        Parameters
+        ----------
+        U : array_like
+            Input samples, shape ``(n, C)``: one row per sample, one column per channel.
+
+        Returns
+        -------
+        numpy.ndarray
+            The outputs, shape ``(n, C)``; the stepper's state has advanced by ``n`` samples.
+        """
         U = as_axes(
             U, "U", "BankStepper.step_block", n_axes=self._n, finite=False, max_columns=MAX_CHANNELS
         )
@@ -236,7 +296,13 @@ class BankStepper:
             counters[:] = g.counters0
 
     def copy(self) -> BankStepper:
-        """An independent stepper in the same state."""
+        """An independent stepper in the same state.
+
+        Returns
+        -------
+        BankStepper
+            A new stepper whose state equals this one's; stepping either leaves the other as it is.
+        """
         twin = BankStepper(self._bank)
         twin.state = self.state
         return twin

@@ -50,6 +50,15 @@ class Compensator(PackedSystem):
 
     Built by ``model.inverse()``; the output is always inside ``voltage_range``.
 
+    Parameters
+    ----------
+    packed : numpy.ndarray
+        The packed inverse chain (parameters and initial state) that the kernels run.
+    kind : str
+        The kind of the model it inverts (``"pi"`` or ``"mpi"``).
+    voltage_range : tuple of (float, float)
+        The clamp on the output, V.
+
     Attributes
     ----------
     kind : str

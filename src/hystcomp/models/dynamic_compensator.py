@@ -58,6 +58,22 @@ def inverse_fir(resonance, bandwidth_hz: float, sample_rate: float):
     most ``MAX_PREVIEW``), ``f_n`` the first (lowest) mode, leaves room for the half
     period of the resonance that the taps span; zero taps at the ends are dropped, and the
     preview is the look-ahead of the first tap left.
+
+    Parameters
+    ----------
+    resonance : tuple of numpy.ndarray
+        ``(b, a)`` of the resonance ``R(z)`` in powers of ``z``.
+    bandwidth_hz : float
+        The upper end of the band to invert, Hz.
+    sample_rate : float
+        The sample rate, Hz.
+
+    Returns
+    -------
+    taps : numpy.ndarray
+        The non-negative taps, newest sample first, summing to 1.
+    preview : int
+        The look-ahead of the first tap, in samples.
     """
     from scipy.optimize import nnls
 
@@ -76,6 +92,24 @@ def band_fit(resonance, bandwidth_hz: float, sample_rate: float):
     ``P`` down to ``-P``). ``resonance`` is ``(b, a)`` in powers of ``z``, ``b`` one
     degree below ``a``: one mode's ``(b0 z + b1) / (z^2 + a1 z + a2)`` or the modes in
     parallel of :func:`hystcomp._lti.modal_tf`.
+
+    Parameters
+    ----------
+    resonance : tuple of numpy.ndarray
+        ``(b, a)`` of the resonance ``R(z)`` in powers of ``z``, ``b`` one degree below ``a``.
+    bandwidth_hz : float
+        The upper end of the band the inverse must be close to 1 on, Hz.
+    sample_rate : float
+        The sample rate, Hz.
+
+    Returns
+    -------
+    design : numpy.ndarray
+        The weighted regressors, real parts over imaginary parts (one column per tap).
+    target : numpy.ndarray
+        The weighted target, 1 on the band (real parts), 0 (imaginary parts).
+    lead : numpy.ndarray
+        The look-ahead of each tap in samples, from ``P`` down to ``-P``.
     """
     b, a = (np.asarray(c, dtype=np.float64) for c in resonance)
     fn = _resonance_hz(a, sample_rate)
@@ -115,6 +149,23 @@ class DynamicsInverse:
 
     Made by :meth:`~hystcomp.LinearDynamics.inverse`. :meth:`simulate` runs a known reference with
     :attr:`preview` samples of look-ahead; :meth:`stepper` streams.
+
+    Parameters
+    ----------
+    taps : array_like
+        The FIR taps (newest sample first) that invert the resonance, unitless.
+    lags : array_like
+        The per-sample decay factors of the creep modes, each in ``[0, 1)``.
+    weights : array_like
+        The creep weights, one per lag (fractions of the steady-state displacement).
+    preview : int
+        Samples of look-ahead of the FIR part.
+    rest : float, optional
+        The reference at which the filter starts at rest, µm.
+    output_range : tuple of (float, float), optional
+        The clamp on the output, µm (unbounded by default).
+    bias : float, optional
+        A constant added to the output, µm.
 
     Attributes
     ----------
@@ -167,11 +218,27 @@ class DynamicsInverse:
 
         The reference is held at its last value beyond its end; the filter starts at rest
         at :attr:`rest` and is primed with the first :attr:`preview` samples.
+
+        Parameters
+        ----------
+        x_ref : array_like
+            The reference displacement, µm.
+
+        Returns
+        -------
+        numpy.ndarray
+            What the dynamics need as input, µm, one sample per reference sample.
         """
         return _run_ahead(self.stepper(), x_ref, self.preview)
 
     def stepper(self) -> DynamicsInverseStepper:
-        """A streaming filter at rest."""
+        """A streaming filter at rest.
+
+        Returns
+        -------
+        DynamicsInverseStepper
+            A stepper at rest at :attr:`rest`.
+        """
         return DynamicsInverseStepper(self._packed, self.preview)
 
     def __repr__(self) -> str:
@@ -179,7 +246,15 @@ class DynamicsInverse:
 
 
 class DynamicsInverseStepper(Rebound):
-    """The inverse filter one sample at a time (same kernel as the batch run)."""
+    """The inverse filter one sample at a time (same kernel as the batch run).
+
+    Parameters
+    ----------
+    packed : numpy.ndarray
+        The packed filter (parameters and initial state), :attr:`DynamicsInverse.packed`.
+    preview : int
+        Samples of look-ahead of the FIR part.
+    """
 
     def __init__(self, packed: np.ndarray, preview: int):
         self._initial = packed
@@ -193,19 +268,53 @@ class DynamicsInverseStepper(Rebound):
         self.step = checked_step(step_function(dk.inverse_step), self._p)  # type: ignore[method-assign]
 
     def step(self, u: float) -> float:
-        """One reference sample ``u`` (µm, ``preview`` samples ahead) -> filter output; NaN
-        held out."""
+        """One reference sample (µm, ``preview`` samples ahead) -> filter output; NaN held out.
+
+        Parameters
+        ----------
+        u : float
+            The reference ``preview`` samples ahead, µm; a non-finite one holds the last output.
+
+        Returns
+        -------
+        float
+            The filter's output for now, µm.
+        """
         return dk.inverse_step(self._p, u)
 
     def step_block(self, x_ref) -> np.ndarray:
-        """A block of reference samples."""
+        """A block of reference samples.
+
+        Parameters
+        ----------
+        x_ref : array_like
+            Reference samples, µm.
+
+        Returns
+        -------
+        numpy.ndarray
+            The filter's outputs, µm, one per reference sample.
+        """
         u = block(x_ref, "step_block")
         out = np.empty_like(u)
         dk.inverse_run(self._p, u, out)
         return out
 
     def step_block_cuts(self, x_ref) -> tuple[np.ndarray, np.ndarray]:
-        """:meth:`step_block`, and where the clamp to the displacement range counted."""
+        """:meth:`step_block`, and where the clamp to the displacement range counted.
+
+        Parameters
+        ----------
+        x_ref : array_like
+            Reference samples, µm.
+
+        Returns
+        -------
+        outputs : numpy.ndarray
+            The filter's outputs, µm.
+        cut : numpy.ndarray
+            1.0 where the clamp to the displacement range counted the sample, else 0.0.
+        """
         u = block(x_ref, "step_block")
         out = np.empty_like(u)
         cuts = np.empty_like(u)
@@ -213,7 +322,13 @@ class DynamicsInverseStepper(Rebound):
         return out, cuts != 0.0
 
     def prime(self, x_ref) -> None:
-        """Feed the first ``preview`` reference samples, whose outputs come before time 0."""
+        """Feed the first ``preview`` reference samples, whose outputs come before time 0.
+
+        Parameters
+        ----------
+        x_ref : array_like
+            The first ``preview`` reference samples, µm.
+        """
         u = block(x_ref, "prime")
         if u.size > self.preview:
             raise InvalidSignalError(
@@ -241,7 +356,7 @@ class DynamicsInverseStepper(Rebound):
         Returns
         -------
         DynamicsInverseStepper
-            A copy whose state is its own: stepping one leaves the other as it is.
+            A new stepper in this one's state; stepping either leaves the other as it is.
         """
         other = type(self)(self._initial, self.preview)
         other._p[:] = self._p
@@ -272,6 +387,15 @@ class DynamicCompensator:
     hysteresis compensator's, so it stays clamped to :attr:`voltage_range` and its
     slew-rate limit holds. Made by ``model.inverse(dynamics=dyn)``.
 
+    Parameters
+    ----------
+    hysteresis : Compensator or PreisachCompensator
+        The hysteresis compensator (``model.inverse()``), which gives the output clamp.
+    dynamics_inverse : DynamicsInverse
+        The inverse of the linear dynamics, run before it.
+    sample_rate : float, optional
+        The rate both run at, Hz (that of the dynamics).
+
     Attributes
     ----------
     hysteresis : Compensator
@@ -300,6 +424,16 @@ class DynamicCompensator:
 
         The inverse of the dynamics looks :attr:`preview` samples ahead in ``x_ref``
         (held at its last value past the end).
+
+        Parameters
+        ----------
+        x_ref : array_like
+            The reference displacement, µm, one sample per period of :attr:`sample_rate`.
+
+        Returns
+        -------
+        numpy.ndarray
+            The voltage to apply, V, one sample per reference sample, inside :attr:`voltage_range`.
         """
         return self.hysteresis.simulate(self.dynamics_inverse.simulate(x_ref))
 
@@ -310,6 +444,17 @@ class DynamicCompensator:
         whose ``clamped`` counts the samples that either clamp cut (once each): the inverse
         of the dynamics' clamp to the model's displacement range (a reference out of the
         model's reach, or creep to undo beyond it) or the voltage range's.
+
+        Parameters
+        ----------
+        x_ref : array_like
+            The reference displacement, µm.
+
+        Returns
+        -------
+        CompensatorRun
+            ``(v, clamped, nonfinite)``: the voltage (V), the count of samples out of reach and the
+            count of non-finite reference samples held.
         """
         s = self.stepper()
         v = _run_ahead(s, x_ref, self.preview)
@@ -320,6 +465,12 @@ class DynamicCompensator:
 
         Call ``prime(x_ref[:preview])`` first when the reference is known ahead; fed the
         reference of *now* instead, the displacement lags it by :attr:`preview` samples.
+
+        Returns
+        -------
+        DynamicStepper
+            A stepper at rest, the filter at its rest reference and the hysteresis compensator in
+            its initial state.
         """
         return DynamicStepper(self.dynamics_inverse.stepper(), self.hysteresis.stepper())
 
@@ -333,8 +484,15 @@ class DynamicStepper(Rebound):
     A non-finite reference leaves the filter as it was and holds the last voltage.
     :meth:`step` is bound to one compiled kernel that runs both stages on their states
     (:data:`hystcomp._kernels.dynamics.PAIR_STEPS`), behind the same type test of the sample
-    as the hysteresis stepper's: one call from Python a sample, under 200 ns
-    (``python benchmarks/run.py dynamics_speed``), and the bits of :meth:`step_block`.
+    as the hysteresis stepper's: one call from Python a sample (Benchmarks, "Speed"), and
+    the bits of :meth:`step_block`.
+
+    Parameters
+    ----------
+    dynamics : DynamicsInverseStepper
+        The stepper of the inverse of the dynamics (the first stage).
+    hysteresis : Stepper or PreisachStepper
+        The stepper of the hysteresis compensator (the second stage).
     """
 
     def __init__(self, dynamics, hysteresis):
@@ -354,11 +512,33 @@ class DynamicStepper(Rebound):
         return checked_pair_step(step_function(kernel, arrays=2), self._dyn._p, self._hyst._p)
 
     def step(self, x_ref: float) -> float:
-        """One reference sample (µm, :attr:`preview` ahead) -> the voltage to apply now (V)."""
+        """One reference sample (µm, :attr:`preview` ahead) -> the voltage to apply now (V).
+
+        Parameters
+        ----------
+        x_ref : float
+            The reference displacement :attr:`preview` samples ahead, µm.
+
+        Returns
+        -------
+        float
+            The voltage to apply now, V.
+        """
         return self._bound_step()(x_ref)
 
     def step_block(self, x_ref) -> np.ndarray:
-        """A block of reference samples -> voltages."""
+        """A block of reference samples -> voltages.
+
+        Parameters
+        ----------
+        x_ref : array_like
+            Reference samples, µm, each :attr:`preview` samples ahead of its output.
+
+        Returns
+        -------
+        numpy.ndarray
+            The voltages, V, one per reference sample.
+        """
         r, cut = self._dyn.step_block_cuts(x_ref)
         if not cut.any():
             return self._hyst.step_block(r)
@@ -373,7 +553,13 @@ class DynamicStepper(Rebound):
         return out
 
     def prime(self, x_ref) -> None:
-        """Feed the first ``preview`` reference samples to the filter (no voltage is output)."""
+        """Feed the first ``preview`` reference samples to the filter (no voltage is output).
+
+        Parameters
+        ----------
+        x_ref : array_like
+            The first :attr:`preview` reference samples, µm.
+        """
         self._dyn.prime(x_ref)
 
     def reset(self) -> None:
@@ -387,7 +573,7 @@ class DynamicStepper(Rebound):
         Returns
         -------
         DynamicStepper
-            A copy of both stages: stepping one stepper leaves the other as it is.
+            A new stepper in this one's state; stepping either leaves the other as it is.
         """
         return type(self)(self._dyn.copy(), self._hyst.copy())
 

@@ -172,7 +172,34 @@ class LinearDynamics:
         the latency in whole samples beyond the sample-and-hold's one. The second mode
         (``second_resonance_hz``, ``second_damping_ratio``, ``second_mode_gain``) is given
         whole or not at all (None, the default and what model files written before it
-        existed hold: one mode)."""
+        existed hold: one mode).
+
+        Parameters
+        ----------
+        sample_rate : float
+            The sample rate the model runs at, Hz.
+        resonance_hz : float
+            The first resonance, Hz.
+        damping_ratio : float
+            Its damping ratio, unitless, in ``(0, 1)``.
+        creep_time_constants : sequence of float, optional
+            The creep modes' time constants, s.
+        creep_weights : sequence of float, optional
+            Their weights, as fractions of the steady-state displacement.
+        delay_samples : int, optional
+            The latency in whole samples beyond the sample-and-hold's one.
+        second_resonance_hz : float, optional
+            A second mode's resonance, Hz.
+        second_damping_ratio : float, optional
+            Its damping ratio.
+        second_mode_gain : float, optional
+            Its share of the steady-state gain.
+
+        Returns
+        -------
+        LinearDynamics
+            The model, as if fitted (``fit_report_`` empty).
+        """
         owner = cls.__name__
         model = cls()
         rate = check_real(sample_rate, "sample_rate", owner, positive=True)
@@ -251,6 +278,23 @@ class LinearDynamics:
         they are fitted behind a hysteresis model (its output ``H[v]`` in µm; see
         :class:`~hystcomp.models.hammerstein.HammersteinModel`). Sets the parameters and
         ``fit_report_``; returns ``self``.
+
+        Parameters
+        ----------
+        v : array_like
+            The voltage applied, V (the answer to ``hystcomp excite dynamics``).
+        x : array_like
+            The measured displacement, µm, one sample per voltage sample.
+        sample_rate : float
+            The record's sample rate, Hz.
+        u : array_like, optional
+            The input of the dynamics, µm, when they are fitted behind a hysteresis model (its
+            output ``H[v]``).
+
+        Returns
+        -------
+        LinearDynamics
+            ``self``, fitted.
         """
         result = fit_dynamics(v, x, sample_rate, u=u)
         fitted = type(self).from_parameters(**result.parameters)
@@ -285,11 +329,30 @@ class LinearDynamics:
 
     def resonance(self):
         """``(b, a)`` of ``R(z)``, every mode (see :func:`hystcomp._lti.modal_tf`; one mode:
-        :func:`hystcomp._lti.resonance_zoh`)."""
+        :func:`hystcomp._lti.resonance_zoh`).
+
+        Returns
+        -------
+        b : numpy.ndarray
+            The numerator of ``R(z)``, in powers of ``z``.
+        a : numpy.ndarray
+            The denominator of ``R(z)``, in powers of ``z``.
+        """
         return _lti.modal_tf(self.modes, self.sample_rate_)
 
     def frequency_response(self, frequencies) -> np.ndarray:
-        """``D(exp(j 2 pi f Ts))`` at ``frequencies`` in Hz (complex, unit gain at 0 Hz)."""
+        """``D(exp(j 2 pi f Ts))`` at ``frequencies`` in Hz (complex, unit gain at 0 Hz).
+
+        Parameters
+        ----------
+        frequencies : array_like
+            Frequencies, Hz.
+
+        Returns
+        -------
+        numpy.ndarray
+            The complex response at each frequency (unitless, 1 at 0 Hz).
+        """
         self._check_fitted()
         return _lti.frequency_response(
             as_vector(frequencies, "frequencies", "LinearDynamics.frequency_response"),
@@ -301,7 +364,21 @@ class LinearDynamics:
         )
 
     def simulate(self, u, *, initial: float | None = None) -> np.ndarray:
-        """The output of ``D`` for the input ``u``, from rest at ``initial`` (``u[0]`` if None)."""
+        """The output of ``D`` for the input ``u``, from rest at ``initial`` (``u[0]`` if None).
+
+        Parameters
+        ----------
+        u : array_like
+            The input of the dynamics, µm (the output of the hysteresis, or the voltage times a
+            linear gain).
+        initial : float, optional
+            The level the model is at rest at before the first sample, µm (``u[0]`` if None).
+
+        Returns
+        -------
+        numpy.ndarray
+            The displacement, µm, one sample per input sample.
+        """
         self._check_fitted()
         u = as_signal(u, "u")
         rest = float(u[0]) if initial is None else check_real(initial, "initial", "simulate")
@@ -316,7 +393,18 @@ class LinearDynamics:
         )
 
     def creep_fraction(self, seconds: float) -> float:
-        """How far a step response still has to rise after ``seconds``, as a fraction of its end."""
+        """How far a step response still has to rise after ``seconds``, as a fraction of its end.
+
+        Parameters
+        ----------
+        seconds : float
+            The time after a step, s.
+
+        Returns
+        -------
+        float
+            The part of the step response still to come, a fraction of its end value (0 to 1).
+        """
         self._check_fitted()
         seconds = check_real(seconds, "seconds", "LinearDynamics.creep_fraction")
         if seconds < 0.0:
@@ -337,6 +425,18 @@ class LinearDynamics:
         exactly at that rate and the latency as the nearest whole number of its samples;
         the resonance is left in: at the rates such records hold (1 Hz triangles) it is
         1 to within ``(f / f_n)^2``.
+
+        Parameters
+        ----------
+        x : array_like
+            A measured displacement, µm.
+        sample_rate : float, optional
+            The record's sample rate, Hz (the model's own if None).
+
+        Returns
+        -------
+        numpy.ndarray
+            The input of the dynamics, µm, one sample per sample of ``x``.
         """
         self._check_fitted()
         x = as_signal(x, "x")
@@ -452,7 +552,13 @@ class LinearDynamics:
 
     def parameters(self) -> dict[str, Any]:
         """The parameters as plain Python values (the second mode's only when there is one,
-        so that a model of one mode writes the file it always did)."""
+        so that a model of one mode writes the file it always did).
+
+        Returns
+        -------
+        dict
+            The parameters by name (those of :meth:`from_parameters`), as floats, ints and lists.
+        """
         self._check_fitted()
         out = {
             "sample_rate": self.sample_rate_,
@@ -469,16 +575,40 @@ class LinearDynamics:
         return out
 
     def get_params(self) -> dict[str, Any]:
-        """No hyperparameters: the model is its parameters."""
+        """No hyperparameters: the model is its parameters.
+
+        Returns
+        -------
+        dict
+            An empty dictionary.
+        """
         return {}
 
     def to_dict(self) -> dict[str, Any]:
-        """Kind, parameters and fit report, ready for JSON (see :mod:`hystcomp.io.models`)."""
+        """Kind, parameters and fit report, ready for JSON (see :mod:`hystcomp.io.models`).
+
+        Returns
+        -------
+        dict
+            ``{"kind": "dynamics", "hyperparameters": {}, "parameters": ...}``, and
+            ``"fit_report"`` for a fitted model.
+        """
         return model_document(self, hyperparameters={}, parameters=self.parameters())
 
     @classmethod
     def from_dict(cls, data: dict[str, Any]) -> LinearDynamics:
-        """Inverse of :meth:`to_dict`."""
+        """Inverse of :meth:`to_dict`.
+
+        Parameters
+        ----------
+        data : dict
+            A dictionary as :meth:`to_dict` writes it.
+
+        Returns
+        -------
+        LinearDynamics
+            The model, validated.
+        """
         check_document(cls, data, "parameters", dict)
         model = cls.from_parameters(**data["parameters"])
         read_fit_report(model, data)
@@ -550,13 +680,30 @@ def with_dynamics(
     inverse of the dynamics is scaled to unit gain there, ``D^-1 |D(1 Hz)|``, and adds only
     what the hysteresis model lacks, the creep slower than 1 Hz and the fast dynamics. It
     cannot remove the creep faster than 1 Hz that such a model holds, which the pair does
-    (on a Preisach stage with 3 % creep, MPI at 1 Hz: 0.020 µm as a pair, 0.112 µm with
-    the true dynamics matched this way, 0.057 µm without dynamics). Creep scales the
+    (Benchmarks, "Dynamics"). Creep scales the
     displacement from rest, so the scaling is about rest for a PI or MPI model whose loops
     close there (one that starts descended,
     :func:`hystcomp.identify.pi.initial_play_states`), and about the middle of the
     displacement range for other models, where the identification triangles have their
     mean.
+
+    Parameters
+    ----------
+    model : HysteresisModel
+        The hysteresis model the compensator inverts.
+    compensator : Compensator or PreisachCompensator
+        ``model.inverse()``.
+    dynamics : LinearDynamics
+        The linear dynamics to invert in series.
+    bandwidth_hz : float, optional
+        The band the inverse of the dynamics must follow, Hz (the model's default if None).
+    paired : bool, optional
+        Whether ``model`` and ``dynamics`` were identified as one pair.
+
+    Returns
+    -------
+    DynamicCompensator
+        The compensator in series with the inverse of the dynamics.
     """
     if not isinstance(dynamics, LinearDynamics):
         raise InvalidTypeError(

@@ -37,6 +37,20 @@ def one_column(values, name: str, owner: str):
     matrix of shape ``(n_samples, n_features)``; these models have one feature, the voltage.
     A sparse matrix, complex numbers, NaN or inf, or a matrix of another number of columns
     are refused with scikit-learn's wording of each problem beside the fix.
+
+    Parameters
+    ----------
+    values : array_like
+        A signal, or ``X`` / ``y`` as scikit-learn passes it.
+    name : str
+        The argument's name, for an error message.
+    owner : str
+        The class named in an error message.
+
+    Returns
+    -------
+    array_like
+        The one column of a matrix, else ``values`` as given.
     """
     if hasattr(values, "tocsr") and hasattr(values, "nnz"):  # scipy.sparse, not imported
         raise InvalidTypeError(
@@ -76,7 +90,20 @@ def one_column(values, name: str, owner: str):
 
 
 def check_target(x, owner: str):
-    """``x`` (``y``) for a fit: present, and one column if a matrix."""
+    """``x`` (``y``) for a fit: present, and one column if a matrix.
+
+    Parameters
+    ----------
+    x : array_like or None
+        The measured displacement, µm, as given to ``fit`` (``y`` in scikit-learn).
+    owner : str
+        The class named in an error message.
+
+    Returns
+    -------
+    array_like
+        ``x`` as a signal (a one-column matrix becomes its column), validated later.
+    """
     if x is None:
         raise InvalidSignalError(
             f"{owner} requires y to be passed, but the target y is None: give the measured "
@@ -89,7 +116,18 @@ def fit_signals(fit: Fit) -> Fit:
     """Decorate an estimator's ``fit(v, x)``: a one-column ``X`` (or ``y``) becomes a
     signal (:func:`one_column`), and the fit runs on one BLAS thread
     (:func:`hystcomp._blas.one_blas_thread`: its matrix products are small, and a threaded
-    BLAS on a busy machine made fits many times slower)."""
+    BLAS on a busy machine made fits many times slower).
+
+    Parameters
+    ----------
+    fit : callable
+        An estimator's ``fit(self, v, x, ...)``.
+
+    Returns
+    -------
+    callable
+        The wrapped ``fit``, with the same signature.
+    """
 
     @functools.wraps(fit)
     def wrapper(self, v, x):
@@ -353,6 +391,11 @@ class Estimator:
 
         Learned attributes stay as they are until the next :meth:`fit`.
 
+        Parameters
+        ----------
+        **params
+            Hyperparameters by name, each with its new value.
+
         Returns
         -------
         estimator
@@ -383,7 +426,18 @@ class Estimator:
         """The displacement (µm) predicted for the voltage ``v`` (V): :meth:`simulate`, under
         scikit-learn's name, so that its scorers, ``cross_val_predict`` and a pipeline's
         ``predict`` work on these models too. ``v`` may also be ``X`` of shape
-        ``(n_samples, 1)`` or a one-column DataFrame, as scikit-learn passes it."""
+        ``(n_samples, 1)`` or a one-column DataFrame, as scikit-learn passes it.
+
+        Parameters
+        ----------
+        v : array_like
+            The voltage, V: a 1-D signal, or ``X`` of shape ``(n_samples, 1)``.
+
+        Returns
+        -------
+        numpy.ndarray
+            The displacement, µm, one sample per voltage sample.
+        """
         owner = f"{type(self).__name__}.predict"
         self._check_fitted()
         return self.simulate(one_column(v, "v", owner))
@@ -417,7 +471,13 @@ class Estimator:
         return 1.0 - residual / total
 
     def parameters(self) -> dict[str, Any]:
-        """The learned parameters as plain Python values (lists and floats)."""
+        """The learned parameters as plain Python values (lists and floats).
+
+        Returns
+        -------
+        dict
+            The parameters by name, as :meth:`from_parameters` takes them.
+        """
         self._check_fitted()
         out = {}
         for name in self._learned:
@@ -426,7 +486,13 @@ class Estimator:
         return out
 
     def to_dict(self) -> dict[str, Any]:
-        """Kind, hyperparameters, parameters and fit report, ready for JSON."""
+        """Kind, hyperparameters, parameters and fit report, ready for JSON.
+
+        Returns
+        -------
+        dict
+            ``{"kind", "hyperparameters", "parameters", "fit_report"}``, JSON-ready.
+        """
         return model_document(self, hyperparameters=self.get_params(), parameters=self.parameters())
 
     @classmethod
@@ -434,6 +500,16 @@ class Estimator:
         """Inverse of :meth:`to_dict` (validates everything through ``from_parameters``).
 
         :func:`hystcomp.io.models.model_from_dict` checks a whole document (keys, JSON types) first.
+
+        Parameters
+        ----------
+        data : dict
+            A dictionary as :meth:`to_dict` writes it.
+
+        Returns
+        -------
+        Estimator
+            The model, of the class it is called on.
         """
         check_document(cls, data, "parameters", dict)
         model = cls.from_parameters(**data["parameters"])
@@ -587,5 +663,15 @@ def sklearn_expected_failed_checks(estimator=None) -> dict[str, str]:
     The checks feed tabular data: several columns of random numbers, an unrelated target,
     shuffled rows. A hysteresis model maps one signal, the voltage, to the displacement,
     and its output depends on the order of the samples; those checks cannot apply.
+
+    Parameters
+    ----------
+    estimator : Estimator, optional
+        The estimator to be checked (the list is the same for every model of the package).
+
+    Returns
+    -------
+    dict of str to str
+        The name of each check that does not apply, with the reason.
     """
     return dict(SKLEARN_EXPECTED_FAILED_CHECKS)

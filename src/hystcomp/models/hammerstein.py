@@ -12,8 +12,8 @@ consistent pair, a Hammerstein model:
   lag taken out, ``D^-1[x]`` (:meth:`LinearDynamics.remove`). A hysteresis model fitted
   on the raw 1 Hz record already holds the creep and lag of that record, and ``D^-1``
   would correct them a second time;
-* the two fits alternate until ``H`` no longer changes (:func:`fit_pair`; one or two
-  rounds on the panel of ``benchmarks/bench_dynamics_panel.py``).
+* the two fits alternate until ``H`` no longer changes (:func:`fit_pair`, at most
+  :data:`MAX_ROUNDS` rounds).
 
 The inverse of a pair inverts ``D`` with its unit steady-state gain; a hysteresis model and
 dynamics identified apart (``model.inverse(dynamics=dyn)``) are matched at 1 Hz instead
@@ -49,16 +49,16 @@ TOLERANCE = 1e-3
 class HammersteinModel:
     """A hysteresis model in series with linear dynamics, identified as one pair.
 
+    Building one from parts that were identified apart is the caller's statement that they
+    belong together; :func:`fit_pair` (``hystcomp identify DATA --model KIND
+    --dynamics-record DYN``) identifies them as a pair.
+
     Parameters
     ----------
     hysteresis : PrandtlIshlinskii, ModifiedPrandtlIshlinskii or Preisach
         The fitted hysteresis model ``H`` (voltage V -> µm, before the dynamics).
     dynamics : LinearDynamics
         The linear dynamics ``D`` (unit steady-state gain), identified behind ``H``.
-
-    Building one from parts that were identified apart is the caller's statement that they
-    belong together; :func:`fit_pair` (``hystcomp identify DATA --model KIND
-    --dynamics-record DYN``) identifies them as a pair.
 
     Attributes
     ----------
@@ -104,7 +104,18 @@ class HammersteinModel:
 
         At rest means where the compensator starts: ``H`` in its initial state and ``D``
         settled at the hysteresis model's output for the low end of its voltage range (a
-        first sample elsewhere is a step from there)."""
+        first sample elsewhere is a step from there).
+
+        Parameters
+        ----------
+        v : array_like
+            The voltage, V, at :attr:`sample_rate`.
+
+        Returns
+        -------
+        numpy.ndarray
+            The displacement, µm, one sample per voltage sample.
+        """
         v = as_signal(v, "v")
         lo = self.hysteresis.voltage_range_[0]
         rest = float(self.hysteresis.simulate(np.array([lo]))[0])
@@ -112,7 +123,18 @@ class HammersteinModel:
         return self.dynamics.simulate(u, initial=rest)
 
     def reachable_range(self, voltage_range=None) -> tuple[float, float]:
-        """The displacements (µm) the pair reaches at rest (those of the hysteresis model)."""
+        """The displacements (µm) the pair reaches at rest (those of the hysteresis model).
+
+        Parameters
+        ----------
+        voltage_range : tuple of (float, float), optional
+            A narrower voltage range, V (the model's own if None).
+
+        Returns
+        -------
+        tuple of (float, float)
+            The lowest and highest displacement reachable, µm.
+        """
         return self.hysteresis.reachable_range(voltage_range)
 
     def inverse(
@@ -153,7 +175,13 @@ class HammersteinModel:
     # -- files -----------------------------------------------------------------------------
 
     def to_dict(self) -> dict[str, Any]:
-        """Kind, both parts and the fit report, ready for JSON (:mod:`hystcomp.io.models`)."""
+        """Kind, both parts and the fit report, ready for JSON (:mod:`hystcomp.io.models`).
+
+        Returns
+        -------
+        dict
+            ``{"kind": "hammerstein", "hysteresis", "dynamics", "fit_report"}``, JSON-ready.
+        """
         return model_document(
             self, hysteresis=self.hysteresis.to_dict(), dynamics=self.dynamics.to_dict()
         )
@@ -161,7 +189,18 @@ class HammersteinModel:
     @classmethod
     def from_dict(cls, data: dict[str, Any]) -> HammersteinModel:
         """Inverse of :meth:`to_dict` (:func:`hystcomp.io.models.model_from_dict` checks
-        the document's shape first)."""
+        the document's shape first).
+
+        Parameters
+        ----------
+        data : dict
+            A dictionary as :meth:`to_dict` writes it.
+
+        Returns
+        -------
+        HammersteinModel
+            The pair, each part validated.
+        """
         parts = {c.kind: c for c in (PrandtlIshlinskii, ModifiedPrandtlIshlinskii, Preisach)}
         hysteresis = parts[data["hysteresis"]["kind"]].from_dict(data["hysteresis"])
         model = cls(hysteresis, LinearDynamics.from_dict(data["dynamics"]))

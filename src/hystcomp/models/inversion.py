@@ -28,6 +28,13 @@ def check_invertible(weights: np.ndarray, what: str) -> None:
     Also refuses partial sums so close to zero that the inverse weights of eq. (25) would
     exceed :data:`MAX_INVERSE_WEIGHT` (or overflow): such an inverse is not computable.
 
+    Parameters
+    ----------
+    weights : numpy.ndarray
+        Weights of a superposition (play operators or dead-zones), in order of threshold.
+    what : str
+        What they belong to, for the error message.
+
     Examples
     --------
     >>> check_invertible(np.array([1.0, -0.5, 0.2]), "the model")
@@ -81,6 +88,17 @@ def check_rising_everett(table: np.ndarray, voltages: np.ndarray, what: str, *, 
 
     ``cells`` says how the message names a node: ``"table"`` as ``table[i, j]`` (the
     model file's entry), else as its voltages.
+
+    Parameters
+    ----------
+    table : numpy.ndarray
+        The Everett function on the grid, µm, ``table[i, j] = X(voltages[i], voltages[j])``.
+    voltages : numpy.ndarray
+        The grid's voltages, V, rising.
+    what : str
+        What the table belongs to, for the error message.
+    cells : str
+        How the message names a cell of the table (``"table"`` or ``"grid"``).
 
     Examples
     --------
@@ -159,6 +177,20 @@ def invert_superposition(
     ``r'_i = sum_{j<=i} w_j (r_i - r_j)`` and ``w'_0 = 1/w_0``,
     ``w'_i = -w_i / ((w_0+...+w_i)(w_0+...+w_{i-1}))``. The caller checks invertibility.
 
+    Parameters
+    ----------
+    thresholds : numpy.ndarray
+        The forward thresholds ``r_i``, rising from 0.
+    weights : numpy.ndarray
+        The forward weights ``w_i``.
+
+    Returns
+    -------
+    thresholds : numpy.ndarray
+        The inverse thresholds ``r'_i``.
+    weights : numpy.ndarray
+        The inverse weights ``w'_i``.
+
     Examples
     --------
     >>> r, w = np.array([0.0, 1.0]), np.array([2.0, -1.0])
@@ -179,6 +211,18 @@ def inverse_initial_state(weights: np.ndarray, initial_state: np.ndarray) -> np.
 
     ``z_i = (w_0+...+w_i) y_i + sum_{j>i} w_j y_j``, which makes the inverse start exactly
     where the forward model starts.
+
+    Parameters
+    ----------
+    weights : numpy.ndarray
+        The forward play weights ``w_i``.
+    initial_state : numpy.ndarray
+        The forward plays' initial states ``y_i``, V.
+
+    Returns
+    -------
+    numpy.ndarray
+        The inverse plays' initial states ``z_i``, µm.
     """
     partial = np.cumsum(weights)
     weighted = weights * initial_state

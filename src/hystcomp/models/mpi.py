@@ -203,7 +203,32 @@ class ModifiedPrandtlIshlinskii(PrandtlIshlinskii):
         input_offset=0.0,
         output_offset=0.0,
     ) -> Self:
-        """A model with the given parameters (V, µm/V, µm, unitless); all validated."""
+        """A model with the given parameters (V, µm/V, µm, unitless); all validated.
+
+        Parameters
+        ----------
+        thresholds : array_like
+            The play thresholds ``r_i``, V, rising from 0.
+        weights : array_like
+            The play weights ``w_i``, unitless (µm per µm of the dead-zones' input).
+        deadzone_thresholds : array_like
+            The dead-zone thresholds ``r_S``, rising from 0.
+        deadzone_weights : array_like
+            The dead-zone weights ``w_S``.
+        initial_state : array_like, optional
+            The plays' initial states, V (zeros if None, eq. 18).
+        voltage_range : tuple of (float, float), optional
+            The amplifier's range, V.
+        input_offset : float, optional
+            The voltage subtracted before the plays, V.
+        output_offset : float, optional
+            The displacement added after the dead-zones, µm.
+
+        Returns
+        -------
+        ModifiedPrandtlIshlinskii
+            The model, as if fitted.
+        """
         owner = cls.__name__
         rs = check_thresholds(deadzone_thresholds, "deadzone_thresholds", owner)
         model = cls(n_operators=np.size(thresholds), n_deadzones=rs.size, voltage_range=None)
@@ -234,6 +259,20 @@ class ModifiedPrandtlIshlinskii(PrandtlIshlinskii):
         """Forward dead-zones ``(r_S, w_S)`` from the identified inverse ones ``(r'_S, w'_S)``.
 
         The paper's remark after eq. (19): the same transform as eqs. (24)-(25).
+
+        Parameters
+        ----------
+        inverse_thresholds : array_like
+            The identified inverse dead-zone thresholds ``r'_S``.
+        inverse_weights : array_like
+            The identified inverse dead-zone weights ``w'_S``.
+
+        Returns
+        -------
+        thresholds : numpy.ndarray
+            The forward thresholds ``r_S``.
+        weights : numpy.ndarray
+            The forward weights ``w_S``.
         """
         r = check_thresholds(inverse_thresholds, "inverse_thresholds", "forward_deadzones")
         w = as_vector(inverse_weights, "inverse_weights", "forward_deadzones", length=r.size)

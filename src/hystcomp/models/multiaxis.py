@@ -86,6 +86,26 @@ def as_axes(
 
     A 1-D array is one sample of N axes when ``n_axes`` is given and equals its length. A
     float64 C-contiguous array is returned as it is (a view): callers do not write into it.
+
+    Parameters
+    ----------
+    value : array_like
+        The samples of N axes.
+    name : str
+        The argument's name, for an error message.
+    owner : str
+        The class named in an error message.
+    n_axes : int, optional
+        The number of axes expected (any if None).
+    finite : bool, optional
+        Whether to refuse NaN and inf.
+    max_columns : int, optional
+        The largest number of axes accepted.
+
+    Returns
+    -------
+    numpy.ndarray
+        A C-contiguous float64 array of shape ``(n, N)``.
     """
     try:
         arr = np.ascontiguousarray(value, dtype=np.float64)  # no copy of a float64 array
@@ -344,7 +364,20 @@ class MultiAxisModel(Estimator):
 
     @classmethod
     def from_parameters(cls, *, axes, coupling=None) -> Self:
-        """A model of fitted axis models and a coupling matrix (unit diagonal; I if None)."""
+        """A model of fitted axis models and a coupling matrix (unit diagonal; I if None).
+
+        Parameters
+        ----------
+        axes : sequence of HysteresisModel
+            The fitted model of each axis, in axis order.
+        coupling : array_like, optional
+            The coupling matrix ``M``, shape ``(N, N)``, unit diagonal (identity if None).
+
+        Returns
+        -------
+        MultiAxisModel
+            The model, as if fitted.
+        """
         owner = cls.__name__
         axes = tuple(axes)
         if not 1 <= len(axes) <= MAX_AXES:
@@ -399,18 +432,53 @@ class MultiAxisModel(Estimator):
 
     def simulate(self, V) -> np.ndarray:
         """Displacements (µm, shape (n, N)) for the voltages ``V`` (V, shape (n, N)), from the
-        initial state; the model is not changed."""
+        initial state; the model is not changed.
+
+        Parameters
+        ----------
+        V : array_like
+            The voltages, V, shape ``(n, N)``.
+
+        Returns
+        -------
+        numpy.ndarray
+            The displacements, µm, shape ``(n, N)``.
+        """
         self._check_fitted()
         V = as_axes(V, "V", f"{type(self).__name__}.simulate", n_axes=self.n_axes)
         H = np.column_stack([axis.simulate(V[:, i]) for i, axis in enumerate(self.axes_)])
         return _mix(np.asarray(self.coupling_), np.ascontiguousarray(H))
 
     def predict(self, V) -> np.ndarray:
-        """:meth:`simulate`, under scikit-learn's name."""
+        """:meth:`simulate`, under scikit-learn's name.
+
+        Parameters
+        ----------
+        V : array_like
+            The voltages, V, shape ``(n, N)``.
+
+        Returns
+        -------
+        numpy.ndarray
+            The displacements, µm, shape ``(n, N)``.
+        """
         return self.simulate(V)
 
     def score(self, V, X) -> float:
-        """R² of the predicted displacements over all axes (each axis about its own mean)."""
+        """R² of the predicted displacements over all axes (each axis about its own mean).
+
+        Parameters
+        ----------
+        V : array_like
+            The voltages, V, shape ``(n, N)``.
+        X : array_like
+            The measured displacements, µm, shape ``(n, N)``.
+
+        Returns
+        -------
+        float
+            The coefficient of determination R² (1 is perfect).
+        """
         owner = f"{type(self).__name__}.score"
         X = as_axes(X, "X", owner, n_axes=self.n_axes)
         residual = float(np.sum((X - self.simulate(V)) ** 2))
@@ -420,12 +488,24 @@ class MultiAxisModel(Estimator):
         return 1.0 - residual / total
 
     def stepper(self) -> MultiAxisStepper:
-        """A streaming model: ``step(v_row) -> x_row``, bit for bit as :meth:`simulate`."""
+        """A streaming model: ``step(v_row) -> x_row``, bit for bit as :meth:`simulate`.
+
+        Returns
+        -------
+        MultiAxisStepper
+            A stepper in the axes' initial states.
+        """
         self._check_fitted()
         return MultiAxisStepper([a.stepper() for a in self.axes_], post=self.coupling_)
 
     def reachable_range(self) -> tuple[tuple[float, float], ...]:
-        """Each axis's reachable own displacement ``h_i`` (µm) inside its voltage range."""
+        """Each axis's reachable own displacement ``h_i`` (µm) inside its voltage range.
+
+        Returns
+        -------
+        tuple of (float, float)
+            One ``(low, high)`` pair per axis, µm.
+        """
         self._check_fitted()
         return tuple(axis.reachable_range() for axis in self.axes_)
 
@@ -479,7 +559,13 @@ class MultiAxisModel(Estimator):
         }
 
     def to_dict(self) -> dict[str, Any]:
-        """Kind, hyperparameters, each axis's own model dictionary and ``M``, for JSON."""
+        """Kind, hyperparameters, each axis's own model dictionary and ``M``, for JSON.
+
+        Returns
+        -------
+        dict
+            ``{"kind": "multiaxis", ...}``, JSON-ready.
+        """
         params = self.get_params()
         if not isinstance(params["family"], str):
             params["family"] = params["family"].kind
@@ -487,7 +573,18 @@ class MultiAxisModel(Estimator):
 
     @classmethod
     def from_dict(cls, data: dict[str, Any]) -> Self:
-        """Inverse of :meth:`to_dict`; every axis through its own ``from_dict``."""
+        """Inverse of :meth:`to_dict`; every axis through its own ``from_dict``.
+
+        Parameters
+        ----------
+        data : dict
+            A dictionary as :meth:`to_dict` writes it.
+
+        Returns
+        -------
+        MultiAxisModel
+            The model, each axis validated.
+        """
         check_document(cls, data, "axes", list)
         axes = []
         for i, doc in enumerate(data["axes"]):
@@ -551,6 +648,15 @@ class MultiAxisStepper:
     ``pre`` mixes the input row before the axes (a compensator's ``M^-1``), ``post`` their
     outputs (a model's ``M``). Each axis keeps its own stepper; a non-finite input holds the
     outputs of the axes it reaches.
+
+    Parameters
+    ----------
+    steppers : sequence
+        Each axis's own stepper, in axis order.
+    pre : array_like, optional
+        The matrix that mixes the input row before the axes (``M^-1``), shape ``(N, N)``.
+    post : array_like, optional
+        The matrix that mixes the axes' outputs (``M``), shape ``(N, N)``.
     """
 
     def __init__(self, steppers, *, pre=None, post=None):
@@ -569,7 +675,18 @@ class MultiAxisStepper:
         return self._n
 
     def step(self, u) -> np.ndarray:
-        """Advance one sample: ``u`` has one value per axis; returns one value per axis."""
+        """Advance one sample: ``u`` has one value per axis; returns one value per axis.
+
+        Parameters
+        ----------
+        u : array_like
+            One input sample per axis (V for a model, µm for a compensator).
+
+        Returns
+        -------
+        numpy.ndarray
+            One output sample per axis.
+        """
         row = self._row
         try:
             row[0, :] = u
@@ -592,7 +709,18 @@ class MultiAxisStepper:
         return out[0]
 
     def step_block(self, U) -> np.ndarray:
-        """Advance over a block of rows (n, N); returns the outputs (n, N)."""
+        """Advance over a block of rows (n, N); returns the outputs (n, N).
+
+        Parameters
+        ----------
+        U : array_like
+            Input samples, shape ``(n, N)``.
+
+        Returns
+        -------
+        numpy.ndarray
+            The outputs, shape ``(n, N)``.
+        """
         U = as_axes(U, "U", "MultiAxisStepper.step_block", n_axes=self._n, finite=False)
         mid = U if self._pre is None else _mix(self._pre, U)
         out = np.column_stack([s.step_block(mid[:, i]) for i, s in enumerate(self._steppers)])
@@ -604,7 +732,13 @@ class MultiAxisStepper:
             s.reset()
 
     def copy(self) -> MultiAxisStepper:
-        """An independent stepper in the same state."""
+        """An independent stepper in the same state.
+
+        Returns
+        -------
+        MultiAxisStepper
+            A new stepper in this one's state.
+        """
         return type(self)([s.copy() for s in self._steppers], pre=self._pre, post=self._post)
 
     @property
@@ -643,6 +777,13 @@ class MultiAxisCompensator:
     ``h_ref = M^-1 x_ref``, then each axis's own compensator ``v_i = H_i^-1[h_ref_i]``,
     clamped to that axis's voltage range. Built by :meth:`MultiAxisModel.inverse`.
 
+    Parameters
+    ----------
+    compensators : sequence
+        Each axis's own compensator, in axis order.
+    decoupling : array_like
+        ``M^-1``, shape ``(N, N)``.
+
     Attributes
     ----------
     kind : str
@@ -676,18 +817,46 @@ class MultiAxisCompensator:
         return len(self.compensators)
 
     def stepper(self) -> MultiAxisStepper:
-        """A streaming compensator: ``step(x_ref_row) -> v_row``."""
+        """A streaming compensator: ``step(x_ref_row) -> v_row``.
+
+        Returns
+        -------
+        MultiAxisStepper
+            A stepper in the compensators' initial states.
+        """
         return MultiAxisStepper([c.stepper() for c in self.compensators], pre=self.decoupling)
 
     def run(self, X_ref) -> MultiAxisRun:
-        """The voltages for references ``X_ref`` (µm, (n, N), finite), with the clamp counts."""
+        """The voltages for references ``X_ref`` (µm, (n, N), finite), with the clamp counts.
+
+        Parameters
+        ----------
+        X_ref : array_like
+            The references, µm, shape ``(n, N)``, finite.
+
+        Returns
+        -------
+        MultiAxisRun
+            The voltages (V, ``(n, N)``) and, per axis, the count of clamped samples.
+        """
         X = as_axes(X_ref, "X_ref", "MultiAxisCompensator.run", n_axes=self.n_axes)
         s = self.stepper()
         v = s.step_block(X)
         return MultiAxisRun(v, s.clamped_count, max(s.nonfinite_count))
 
     def simulate(self, X_ref) -> np.ndarray:
-        """The voltages (V, (n, N)) for references ``X_ref`` (µm, (n, N)), from the start."""
+        """The voltages (V, (n, N)) for references ``X_ref`` (µm, (n, N)), from the start.
+
+        Parameters
+        ----------
+        X_ref : array_like
+            The references, µm, shape ``(n, N)``.
+
+        Returns
+        -------
+        numpy.ndarray
+            The voltages, V, shape ``(n, N)``.
+        """
         return self.run(X_ref).v
 
     def __repr__(self) -> str:

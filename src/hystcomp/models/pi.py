@@ -262,7 +262,28 @@ class PrandtlIshlinskii(HysteresisModel):
         input_offset=0.0,
         output_offset=0.0,
     ) -> Self:
-        """A model with the given parameters (V, µm/V, µm); every value is validated."""
+        """A model with the given parameters (V, µm/V, µm); every value is validated.
+
+        Parameters
+        ----------
+        thresholds : array_like
+            The play thresholds ``r_i``, V, rising from 0.
+        weights : array_like
+            The play weights ``w_i``, µm/V.
+        initial_state : array_like, optional
+            The plays' initial states, V (zeros if None, eq. 18).
+        voltage_range : tuple of (float, float), optional
+            The amplifier's range, V.
+        input_offset : float, optional
+            The voltage subtracted before the plays, V.
+        output_offset : float, optional
+            The displacement added after them, µm.
+
+        Returns
+        -------
+        PrandtlIshlinskii
+            The model, as if fitted.
+        """
         owner = cls.__name__
         model = cls(n_operators=np.size(thresholds), voltage_range=None)
         model._set_learned(
@@ -311,6 +332,11 @@ class PrandtlIshlinskii(HysteresisModel):
         -------
         Compensator or DynamicCompensator
             The compensator, clamped to the voltage range.
+
+        Returns
+        -------
+        Compensator or DynamicCompensator
+            The compensator; with ``dynamics``, in series with their inverse.
 
         Raises
         ------

@@ -66,6 +66,11 @@ class PreisachStepper(Stepper):
     input sample holds the last output (before the first sample: ``x_0`` for a model,
     ``v_min`` clamped to the output range for a compensator) and is counted in
     :attr:`nonfinite_count`.
+
+    Parameters
+    ----------
+    packed : numpy.ndarray
+        The packed Preisach system (parameters and initial state).
     """
 
     kernels = pk.PREISACH_KERNELS
@@ -101,37 +106,12 @@ class Preisach(HysteresisModel):
     ``Preisach(fit_method="reversal-curves", everett="polynomial", zero_diagonal=False)``.
     ``hystcomp compare`` runs it for Table I with ``zero_diagonal=True``, ``X(v, v) = 0`` as
     eq. (2) implies: fitted free on the twin, the cubic's ``X(v, v)`` reaches 0.55 µm, a step
-    of the output at each reversal (its report gives both fits' tracking). The defaults were chosen by the measured tracking of a 1 Hz
-    triangle on the panel of ``benchmarks/bench_accuracy.py`` (5 actuators of none of the
-    model families x 4 excitations; rms error over the uncompensated one, worst / median
-    cell; ``python benchmarks/bench_accuracy.py --preisach``):
-
-    ==========================================  ============  ============
-    fit                                         worst         median
-    ==========================================  ============  ============
-    paper: reversal curves, cubic (sinusoids)   0.51          0.16
-    reversal curves, 25 x 25 table (sinusoids)  0.48          0.11
-    least squares, cubic                        0.31          0.16
-    least squares, 13 x 13 table                0.14          0.081
-    least squares, 17 x 17 table                0.14          0.080
-    least squares, 25 x 25 table (default)      0.16          0.074
-    least squares, 33 x 33 table                0.27          0.069
-    ==========================================  ============  ============
-
-    The reversal-curve fits have the sinusoids' 5 cells only, the others all 20. Since
-    those figures were measured, a model whose branch turns back has no compensator
-    (:meth:`inverse` refuses it, whatever the method): both reversal-curve fits have one
-    on the Preisach and Krasnosel'skii-Pokrovskii stages (by 0.03 to 0.23 µm, near a
-    reversal or an end of the range), where the exact inverse jumped 5 to 26 V in one
-    sample of a slow ramp (0.02 V with the twin's fits) and eq. (10) missed the model's
-    own output by up to 0.9 to 3.4 µm on a sinusoid (0.4 to 0.5 µm), so ``fit`` refuses
-    them there and the benchmark leaves those cells out. Least
-    squares with a table tracks at least as well as the cubic in every cell (better in 19 of
-    20: a cubic cannot follow a density that is not polynomial) and better than the paper's
-    fit on the paper's own record on every actuator (0.01 to 0.16x against 0.13 to 0.51x).
-    Of the grids, 25 nodes per axis has the best median; 13 and 17 have a slightly lower
-    worst cell (the Duhem stage from the sinusoids, 0.14x against 0.16x), and 33 over-fits
-    there (0.27x).
+    of the output at each reversal (its report gives both fits' tracking). The defaults were
+    chosen by the measured tracking of a 1 Hz triangle on the panel of
+    ``benchmarks/bench_accuracy.py`` (Benchmarks, "The Preisach fit"): least squares with a
+    table tracks at least as well as the cubic (a cubic cannot follow a density that is not
+    polynomial), and 25 nodes per axis has the best median. A model whose branch turns back
+    has no compensator (:meth:`inverse` refuses it, whatever the method).
 
     Parameters
     ----------
@@ -238,6 +218,25 @@ class Preisach(HysteresisModel):
         ``theta`` has ``d (d + 3) / 2`` entries for degree ``d`` (9 for eq. 5). ``table`` is
         a square array of ``X(alpha_i, beta_j)`` on ``n`` equally spaced voltages over
         ``voltage_range``; only its lower triangle (diagonal included) is read.
+
+        Parameters
+        ----------
+        theta : array_like, optional
+            The coefficients of the polynomial Everett function, eq. (5) order, µm/V^k.
+        table : array_like, optional
+            The Everett function on an equally spaced grid, µm (square; its lower triangle is
+            read).
+        voltage_range : tuple of (float, float), optional
+            The amplifier's range, V.
+        output_offset : float, optional
+            The displacement at the start state, µm.
+        max_extrema : int, optional
+            The bound on the memory of dominant extrema.
+
+        Returns
+        -------
+        Preisach
+            The model, as if fitted.
         """
         owner = cls.__name__
         if (theta is None) == (table is None):
@@ -276,6 +275,16 @@ class Preisach(HysteresisModel):
         Evaluation takes the degree of X and the memory bound from the hyperparameters, so
         a document whose ``theta`` has the size of another degree, or whose ``max_extrema``
         is not an int >= 3, is refused here rather than failing later.
+
+        Parameters
+        ----------
+        data : dict
+            A dictionary as :meth:`to_dict` writes it.
+
+        Returns
+        -------
+        Preisach
+            The model, validated.
         """
         model = super().from_dict(data)  # every hyperparameter checked, max_extrema too
         if model.theta_ is not None:
@@ -347,7 +356,14 @@ class Preisach(HysteresisModel):
         return {"everett": "table", "grid_size": int(self.table_.shape[0])}
 
     def parameters(self) -> dict:
-        """The learned parameters as plain Python values (``theta`` or ``table``)."""
+        """The learned parameters as plain Python values (``theta`` or ``table``).
+
+        Returns
+        -------
+        dict
+            ``theta`` or ``table`` (the one the model has), ``voltage_range`` and
+            ``output_offset``, as :meth:`from_parameters` takes them.
+        """
         out = super().parameters()
         return {name: value for name, value in out.items() if value is not None}
 
@@ -388,7 +404,20 @@ class Preisach(HysteresisModel):
         check_rising_everett(grid, nodes, what, cells="voltages")
 
     def everett_function(self, alpha, beta) -> np.ndarray:
-        """``X(alpha, beta)`` in µm (eq. 2) at voltages clamped to the plane (broadcast)."""
+        """``X(alpha, beta)`` in µm (eq. 2) at voltages clamped to the plane (broadcast).
+
+        Parameters
+        ----------
+        alpha : array_like
+            Upper switching voltages, V.
+        beta : array_like
+            Lower switching voltages, V.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``X(alpha, beta)``, µm, broadcast over the two.
+        """
         lo, hi = self.voltage_range_
         a, b = np.broadcast_arrays(np.asarray(alpha, float), np.asarray(beta, float))
         a_flat = np.ascontiguousarray(np.clip(a, lo, hi)).ravel()
@@ -410,18 +439,16 @@ class Preisach(HysteresisModel):
         (which bound every branch's slope when the density is non-negative) exceeds
         :data:`RHO_STEEPEST` (2) times the chord, ``rho`` is that slope over
         :data:`RHO_STEEPEST`, so that the factor stays within -1 and the recursion never
-        amplifies an error. With the chord, a fit to a stage whose descending branch is
-        2.5x the chord steep (the Coleman-Hodgdon stage of ``benchmarks/panel.py``) made the
-        voltage move against the reference on 583 of 60001 samples of its 1 Hz triangles
-        (3 with this ``rho``), and its tracking error moved by 10 % with the last bits of
-        the model (0.161 to 0.176 of the uncompensated error, by CPU; 0.146 now). The price
-        is more lag where H is flat: +14 % rms on a random cubic model whose steepest
-        slope, near a reversal, is 2.2x the chord.
+        amplifies an error; the price is more lag where H is flat (Benchmarks, "The gain
+        rho").
 
         It is a property of the model, so any model file (or preset) has it; on the paper's
-        model (steepest slope 1.32x the chord) it is the chord, within 4 % of the
-        least-squares slope of x against v over the identification records (0.306 against
-        0.310 and 0.319 µm/V).
+        model, whose branches are nowhere twice as steep as the chord, it is the chord.
+
+        Returns
+        -------
+        float
+            The gain ``rho``, µm/V.
         """
         self._check_fitted()
         lo, hi = self.voltage_range_
@@ -453,9 +480,8 @@ class Preisach(HysteresisModel):
             By default ``"multiplicative"``, the paper's compensator, alone; ``"exact"``
             with ``dynamics`` (unless ``rho`` is given). In series with the inverse of the
             dynamics, eq. (10)'s one-sample lag overshoots the voltage on the fast rises that
-            inverse asks for, and the hysteresis memory keeps the overshoot: after a step the
-            error left from 20 ms to 3 s is 0.46-0.51x of the error without the dynamics with
-            eq. (10), 0.09-0.15x with the exact inverse (``benchmarks/bench_dynamics.py``).
+            inverse asks for, and the hysteresis memory keeps the overshoot, which the exact
+            inverse does not (Benchmarks, "Dynamics").
             ``"multiplicative"``: the paper's approximate inverse multiplicative structure,
             eq. (10): ``v[k] = (x_ref[k] - Gamma(v[k-1])) / rho`` with
             ``Gamma(v) = H(v) - rho v`` and H's memory advanced by each applied ``v[k]``.
@@ -473,7 +499,7 @@ class Preisach(HysteresisModel):
         Returns
         -------
         PreisachCompensator or DynamicCompensator
-            The compensator, clamped to the voltage range.
+            The compensator; with ``dynamics``, in series with their inverse.
         """
         if method is None:
             method = "exact" if dynamics is not None and rho is None else "multiplicative"
@@ -517,6 +543,19 @@ class PreisachCompensator(Compensator):
     Built by :meth:`Preisach.inverse`; the output is always inside ``voltage_range``, and
     before the first sample it is ``v_min`` (the model's start state) clamped to it. Batch
     ``simulate`` and the stepper run the same kernel, bit for bit.
+
+    Parameters
+    ----------
+    model : Preisach
+        The forward model it inverts.
+    method : str
+        ``"multiplicative"`` (eq. 10) or ``"exact"``.
+    rho : float or None
+        The gain of eq. (10), µm/V (None for the exact inverse).
+    max_step : float
+        Largest output change per sample, V.
+    clamp : tuple of (float, float)
+        The output clamp, V.
 
     Attributes
     ----------

@@ -51,6 +51,19 @@ def check_packed_chain(packed, owner: str) -> np.ndarray:
 
     The kernels read the array without bounds checks, so an array of another layout would
     make them read or write outside it. Raises InvalidTypeError or InvalidParameterError.
+
+    Parameters
+    ----------
+    packed : array_like
+        A packed chain: counts, thresholds, weights and states, as :mod:`hystcomp._kernels.chain`
+        lays them out.
+    owner : str
+        The class named in an error message.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``packed`` as float64.
     """
     fix = "build it with model.inverse() (or take the .packed of one)"
     try:
@@ -96,7 +109,20 @@ def check_packed_chain(packed, owner: str) -> np.ndarray:
 
 def block(u, owner: str) -> np.ndarray:
     """A block of samples for a block kernel: 1-D, contiguous, writeable float64, or raise
-    (text, booleans, objects, more than one dimension)."""
+    (text, booleans, objects, more than one dimension).
+
+    Parameters
+    ----------
+    u : array_like
+        A block of input samples.
+    owner : str
+        The class named in an error message.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``u`` as a 1-D, contiguous, writeable float64 array.
+    """
     try:
         arr = np.asarray(u)
     except (TypeError, ValueError):  # ragged nesting
@@ -124,7 +150,22 @@ _UNIT_STRIDE = (8,)
 
 def output_block(out, u: np.ndarray, owner: str) -> np.ndarray:
     """``out`` if a block kernel can write the outputs of ``u`` into it, else raise: a
-    writeable, C-contiguous float64 array as long as ``u`` that does not overlap it."""
+    writeable, C-contiguous float64 array as long as ``u`` that does not overlap it.
+
+    Parameters
+    ----------
+    out : numpy.ndarray or None
+        Where the caller wants the outputs written (a new array if None).
+    u : numpy.ndarray
+        The block of inputs.
+    owner : str
+        The class named in an error message.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``out``, checked, or a new array as long as ``u``.
+    """
     if not (isinstance(out, np.ndarray) and out.dtype == np.float64):
         raise InvalidTypeError(
             f"The 'out' parameter of {owner} must be a float64 NumPy array. Got "
@@ -148,7 +189,7 @@ def output_block(out, u: np.ndarray, owner: str) -> np.ndarray:
     return out
 
 
-class BoundStep(Protocol):
+class _BoundStep(Protocol):
     """A stepper's fast ``step(u)``: a plain function that also names, as
     :func:`functools.partial` does, what it calls (``func``) and on what (``state``)."""
 
@@ -158,18 +199,31 @@ class BoundStep(Protocol):
     def __call__(self, u: float) -> float: ...
 
 
-def _named(step: Callable[[float], float], kernel, state) -> BoundStep:
-    """``step`` with the attributes of :class:`BoundStep`."""
-    bound = cast(BoundStep, step)
+def _named(step: Callable[[float], float], kernel, state) -> _BoundStep:
+    """``step`` with the attributes of :class:`_BoundStep`."""
+    bound = cast(_BoundStep, step)
     bound.func = kernel
     bound.state = state
     return bound
 
 
-def checked_step(kernel, p) -> BoundStep:
+def checked_step(kernel, p) -> _BoundStep:
     """``step(u) = kernel(p, u)`` for a float ``u`` (the fast path: one type test), and
     for any other real number after conversion; text, bools and arrays are refused (the
-    compiled kernel alone would parse a string)."""
+    compiled kernel alone would parse a string).
+
+    Parameters
+    ----------
+    kernel : callable
+        A compiled step kernel, ``kernel(p, u)``.
+    p : numpy.ndarray
+        The packed system (its state advances).
+
+    Returns
+    -------
+    callable
+        ``step(u) -> float``.
+    """
 
     def step(u):
         if u.__class__ is float:
@@ -179,8 +233,23 @@ def checked_step(kernel, p) -> BoundStep:
     return _named(step, kernel, p)
 
 
-def checked_pair_step(kernel, p, q) -> BoundStep:
-    """:func:`checked_step` for a kernel over two packed systems: ``step(u) = kernel(p, q, u)``."""
+def checked_pair_step(kernel, p, q) -> _BoundStep:
+    """:func:`checked_step` for a kernel over two packed systems: ``step(u) = kernel(p, q, u)``.
+
+    Parameters
+    ----------
+    kernel : callable
+        A compiled step kernel over two packed systems, ``kernel(p, q, u)``.
+    p : numpy.ndarray
+        The first packed system (its state advances).
+    q : numpy.ndarray
+        The second packed system.
+
+    Returns
+    -------
+    callable
+        ``step(u) -> float``.
+    """
 
     def step(u):
         if u.__class__ is float:
@@ -200,6 +269,22 @@ def fast_block(kernel, p, work, checked):
     a few type tests in Python and one compiled call, which checks the lengths and the
     overlap itself (status 0: done). Anything else goes to ``checked(u, out)``, which
     converts or refuses it with a message.
+
+    Parameters
+    ----------
+    kernel : callable
+        A block kernel.
+    p : numpy.ndarray
+        The packed system (its state advances).
+    work : numpy.ndarray
+        Scratch space for the kernel.
+    checked : callable
+        The slow path, ``checked(u, out)``, that converts or refuses other inputs.
+
+    Returns
+    -------
+    callable
+        ``step_block(u, out=None) -> numpy.ndarray``.
     """
     compiled = None  # a stepper that never takes this path compiles nothing for it
 
@@ -284,11 +369,9 @@ class Stepper(Rebound):
     is counted in :attr:`nonfinite_count`; nothing is raised inside a real-time loop.
 
     For speed, each stepper binds :meth:`step` to the compiled step kernel and its own state
-    when it is made (no method lookup, no dispatch on argument types): a call from Python
-    costs about a quarter of a microsecond, 0.5 % of a 20 kHz period, for the play chains
-    and for the Preisach model and its multiplicative inverse; the exact Preisach inverse
-    adds its root search per sample (``python benchmarks/run.py realtime`` and ``...
-    preisach``). One test that the sample is a float guards it (the compiled kernel alone
+    when it is made (no method lookup, no dispatch on argument types; the cost of a call is
+    in the documentation, Benchmarks, "Speed"); the exact Preisach inverse adds its root
+    search per sample. One test that the sample is a float guards it (the compiled kernel alone
     would parse the text ``"1.0"``); that small Python frame is the only cost above the
     bare kernel (the ``realtime`` benchmark gives the ratio). A loop that has its samples
     in blocks can use :meth:`step_block`, faster per sample.
@@ -298,6 +381,11 @@ class Stepper(Rebound):
     its state lies; it is the play chain's here, the Preisach system's in
     :class:`~hystcomp.models.preisach.PreisachStepper` and the simulated axis's in
     :class:`~hystcomp.plant.twin.TwinStepper`.
+
+    Parameters
+    ----------
+    packed : numpy.ndarray
+        The packed system (parameters and initial state); the stepper works on a copy.
     """
 
     kernels = chain.CHAIN_KERNELS
@@ -356,8 +444,8 @@ class Stepper(Rebound):
             Where to write the outputs: a writeable, contiguous float64 array as long as
             ``u``, not overlapping it, allocated once and passed on every call. With ``u`` a
             contiguous float64 array too, the call takes the fast path: a few type tests and
-            one compiled call (about a third of the time of a call that allocates; ``python
-            benchmarks/run.py realtime``). Anything else is checked and converted as without
+            one compiled call, faster than a call that allocates (Benchmarks, "Speed").
+            Anything else is checked and converted as without
             ``out``.
 
         Returns
@@ -397,8 +485,7 @@ class Stepper(Rebound):
         Returns
         -------
         Stepper
-            A stepper of the same class and system, whose state is a copy of this one's:
-            stepping one leaves the other as it is.
+            A new stepper in this one's state; stepping either leaves the other as it is.
         """
         twin = type(self)(self._initial)
         twin._p[:] = self._p
@@ -492,5 +579,11 @@ class PackedSystem(ABC):
         return out
 
     def stepper(self) -> Stepper:
-        """A :class:`Stepper` (of ``stepper_class``) starting from the initial state."""
+        """A :class:`Stepper` (of ``stepper_class``) starting from the initial state.
+
+        Returns
+        -------
+        Stepper
+            A stepper in the initial state.
+        """
         return self.stepper_class(self._packed())

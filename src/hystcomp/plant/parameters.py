@@ -175,11 +175,28 @@ class TwinParameters:
         return 1.0 / float(self.sample_rate)
 
     def replace(self, **changes) -> TwinParameters:
-        """A copy with some parameters changed (validated again)."""
+        """A copy with some parameters changed (validated again).
+
+        Parameters
+        ----------
+        **changes
+            New values by parameter name.
+
+        Returns
+        -------
+        TwinParameters
+            The copy.
+        """
         return dataclasses.replace(self, **changes)
 
     def as_dict(self) -> dict:
-        """Plain values, e.g. for a report."""
+        """Plain values, e.g. for a report.
+
+        Returns
+        -------
+        dict
+            Each parameter by name.
+        """
         return {k: (list(v) if isinstance(v, tuple) else v) for k, v in vars(self).items()}
 
 
@@ -190,6 +207,18 @@ def dynamics_matrices(params: TwinParameters) -> tuple[np.ndarray, np.ndarray]:
     gain is 1. In closed form (:func:`hystcomp._lti.zoh_matrices`, the discretisation that
     the identification fits), which agrees with ``scipy.linalg.expm`` of the augmented
     matrix to 1e-15 and spares ``hystcomp compare`` SciPy's import (0.2 s).
+
+    Parameters
+    ----------
+    params : TwinParameters
+        The twin's parameters (resonance, damping, sample rate).
+
+    Returns
+    -------
+    Ad : numpy.ndarray
+        The state matrix, shape ``(2, 2)``.
+    Bd : numpy.ndarray
+        The input matrix, shape ``(2,)``.
     """
     return zoh_matrices(params.resonance_hz, params.damping_ratio, float(params.sample_rate))
 
@@ -203,5 +232,15 @@ def creep_twin(**changes) -> TwinParameters:
 
     >>> creep_twin().creep_gain
     0.03
+
+    Parameters
+    ----------
+    **changes
+        Further parameters to change by name.
+
+    Returns
+    -------
+    TwinParameters
+        The parameters of the twin with creep.
     """
     return TwinParameters(**{"creep_gain": CREEP_GAIN, **changes})

@@ -192,7 +192,18 @@ class Scanner:
 
     def hysteresis(self, V) -> np.ndarray:
         """Each axis's quasi-static displacement ``H_i[v_i]`` (µm, (n, N)): no mode, no
-        coupling, no noise."""
+        coupling, no noise.
+
+        Parameters
+        ----------
+        V : array_like
+            The voltages, V, shape ``(n, N)``.
+
+        Returns
+        -------
+        numpy.ndarray
+            The displacements, µm, shape ``(n, N)``.
+        """
         U = self._normalised(V)
         H = np.empty_like(U)
         for i, axis in enumerate(self.axes):
@@ -202,7 +213,18 @@ class Scanner:
         return H
 
     def run_noiseless(self, V) -> np.ndarray:
-        """The axes' true positions as the sensors see them, without noise (µm, (n, N))."""
+        """The axes' true positions as the sensors see them, without noise (µm, (n, N)).
+
+        Parameters
+        ----------
+        V : array_like
+            The voltages, V, shape ``(n, N)``.
+
+        Returns
+        -------
+        numpy.ndarray
+            The positions, µm, shape ``(n, N)``.
+        """
         H = self.hysteresis(V)
         Y = np.empty_like(H)
         for i, axis in enumerate(self.axes):
@@ -214,13 +236,36 @@ class Scanner:
         """The sensors' readings (µm, (n, N)) for the voltages ``V`` (V, (n, N)), from rest.
 
         The noise is drawn from ``seed`` (default: the scanner's), so a run is reproducible.
+
+        Parameters
+        ----------
+        V : array_like
+            The voltages, V, shape ``(n, N)``.
+        seed : int, optional
+            The seed of the sensor noise (the scanner's if None).
+
+        Returns
+        -------
+        numpy.ndarray
+            The readings, µm, shape ``(n, N)``.
         """
         X = self.run_noiseless(V)
         rng = np.random.default_rng(self.seed if seed is None else seed)
         return X + self.noise_um * rng.standard_normal(X.shape)
 
     def time(self, n_samples: int) -> np.ndarray:
-        """Times of ``n_samples`` samples from 0, s."""
+        """Times of ``n_samples`` samples from 0, s.
+
+        Parameters
+        ----------
+        n_samples : int
+            The number of samples.
+
+        Returns
+        -------
+        numpy.ndarray
+            The times, s.
+        """
         return np.arange(int(n_samples)) / self.sample_rate
 
 

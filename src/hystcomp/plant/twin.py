@@ -93,12 +93,34 @@ class Twin:
         return self.params.voltage_range
 
     def time(self, n_samples: int) -> np.ndarray:
-        """Time of ``n_samples`` samples from 0, in s."""
+        """Time of ``n_samples`` samples from 0, in s.
+
+        Parameters
+        ----------
+        n_samples : int
+            The number of samples.
+
+        Returns
+        -------
+        numpy.ndarray
+            The times, s, at the twin's sample rate.
+        """
         n = check_int(n_samples, "n_samples", "Twin.time", minimum=0)
         return np.arange(n) / self.sample_rate
 
     def run_noiseless(self, v) -> np.ndarray:
-        """Displacement in µm for the command ``v`` in V, from rest, without sensor noise."""
+        """Displacement in µm for the command ``v`` in V, from rest, without sensor noise.
+
+        Parameters
+        ----------
+        v : array_like
+            The command, V, at the twin's sample rate.
+
+        Returns
+        -------
+        numpy.ndarray
+            The displacement, µm.
+        """
         u = as_signal(v, "v")
         out = np.empty_like(u)
         k.twin_run(self._packed.copy(), u, out)
@@ -108,12 +130,33 @@ class Twin:
         """Measured displacement in µm for the command ``v`` in V (from rest, with noise).
 
         The sensor reads ``G_cap x + n`` volts and the acquisition divides by ``G_cap``.
+
+        Parameters
+        ----------
+        v : array_like
+            The command, V, at the twin's sample rate.
+
+        Returns
+        -------
+        numpy.ndarray
+            The measured displacement, µm.
         """
         x = self.run_noiseless(v)
         return x + self._noise(x.size)
 
     def hysteresis(self, v) -> np.ndarray:
-        """The quasi-static displacement ``H[v]`` in µm (no creep, no dynamics, no noise)."""
+        """The quasi-static displacement ``H[v]`` in µm (no creep, no dynamics, no noise).
+
+        Parameters
+        ----------
+        v : array_like
+            The command, V.
+
+        Returns
+        -------
+        numpy.ndarray
+            The quasi-static displacement, µm.
+        """
         u = as_signal(v, "v")
         out = np.empty_like(u)
         k.hysteresis_run(self._packed.copy(), u, out)
@@ -132,6 +175,7 @@ class Twin:
         Returns
         -------
         TwinStepper
+            A stepper at rest.
         """
         return TwinStepper(self._packed, self.params, self._rng.spawn(1)[0] if noise else None)
 
@@ -152,6 +196,15 @@ class TwinStepper(Stepper):
     Use it in a loop with a compensator's stepper: ``x_k = twin.step(comp.step(x_ref_k))``.
     Unlike a compensator's stepper it refuses a non-finite command (a simulation has no
     reason to send one), so :attr:`nonfinite_count` and :attr:`clamped_count` stay 0.
+
+    Parameters
+    ----------
+    packed : numpy.ndarray
+        The twin's packed system (parameters and state at rest).
+    params : TwinParameters
+        The twin's parameters (sensor offset and noise).
+    rng : numpy.random.Generator
+        The noise generator; the stepper owns it.
     """
 
     kernels = k.TWIN_KERNELS
@@ -175,14 +228,38 @@ class TwinStepper(Stepper):
         self.__dict__.pop("step_block", None)
 
     def step(self, v: float) -> float:
-        """Apply one command sample (V) and return the measured displacement (µm)."""
+        """Apply one command sample (V) and return the measured displacement (µm).
+
+        Parameters
+        ----------
+        v : float
+            The command, V.
+
+        Returns
+        -------
+        float
+            The measured displacement, µm.
+        """
         v = check_real(v, "v", "TwinStepper.step")
         x = self._kernel(self._p, v) + self._offset
         return x if self._rng is None else x + self._sigma * self._rng.normal()
 
     def step_block(self, v, out=None) -> np.ndarray:
         """Apply a block of command samples and return the measured displacements (into
-        ``out`` if given, as :meth:`Stepper.step_block <hystcomp.models.system.Stepper.step_block>`)."""
+        ``out`` if given, as :meth:`Stepper.step_block <hystcomp.models.system.Stepper.step_block>`).
+
+        Parameters
+        ----------
+        v : array_like
+            Command samples, V.
+        out : numpy.ndarray, optional
+            Where to write the displacements (a new array if None).
+
+        Returns
+        -------
+        numpy.ndarray
+            The measured displacements, µm.
+        """
         u = as_signal(v, "v")
         x = super().step_block(u, out)
         if self._rng is None:
@@ -193,7 +270,13 @@ class TwinStepper(Stepper):
 
     def copy(self) -> TwinStepper:
         """An independent stepper in the same state, with a noise generator spawned from this
-        one's."""
+        one's.
+
+        Returns
+        -------
+        TwinStepper
+            A new stepper in this one's state.
+        """
         rng = None if self._rng is None else self._rng.spawn(1)[0]
         twin = type(self)(self._initial, self._params, rng)
         twin._p[:] = self._p
