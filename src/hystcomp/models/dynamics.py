@@ -69,13 +69,7 @@ from hystcomp.models.dynamic_compensator import (
     DynamicStepper,
     inverse_fir,
 )
-from hystcomp.models.estimator import (
-    check_document,
-    learned_values,
-    model_document,
-    read_fit_report,
-    set_learned,
-)
+from hystcomp.models.estimator import ModelFile, learned_values, set_learned
 
 __all__ = [
     "MATCH_HZ",
@@ -96,7 +90,7 @@ MIN_RESONANCE = 1e-6
 DAMPING_RANGE = (1e-6, 1e3)
 
 
-class LinearDynamics:
+class LinearDynamics(ModelFile):
     """Creep modes and the first resonance (and a second) of an actuator, unit steady-state gain.
 
     Build it with :meth:`from_parameters`, identify it with :meth:`fit`
@@ -584,35 +578,12 @@ class LinearDynamics:
         """
         return {}
 
-    def to_dict(self) -> dict[str, Any]:
-        """Kind, parameters and fit report, ready for JSON (see :mod:`hystcomp.io.models`).
-
-        Returns
-        -------
-        dict
-            ``{"kind": "dynamics", "hyperparameters": {}, "parameters": ...}``, and
-            ``"fit_report"`` for a fitted model.
-        """
-        return model_document(self, hyperparameters={}, parameters=self.parameters())
+    def _document_parts(self) -> dict[str, Any]:
+        return {"hyperparameters": {}, "parameters": self.parameters()}
 
     @classmethod
-    def from_dict(cls, data: dict[str, Any]) -> LinearDynamics:
-        """Inverse of :meth:`to_dict`.
-
-        Parameters
-        ----------
-        data : dict
-            A dictionary as :meth:`to_dict` writes it.
-
-        Returns
-        -------
-        LinearDynamics
-            The model, validated.
-        """
-        check_document(cls, data, "parameters", dict)
-        model = cls.from_parameters(**data["parameters"])
-        read_fit_report(model, data)
-        return model
+    def _from_document(cls, data: dict[str, Any]) -> LinearDynamics:
+        return cls.from_parameters(**data["parameters"])
 
     def __repr__(self) -> str:
         if not hasattr(self, "resonance_hz_"):

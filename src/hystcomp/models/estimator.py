@@ -261,7 +261,73 @@ def read_fit_report(model: Any, data: dict[str, Any]) -> None:
         model.fit_report_ = dict(data["fit_report"])
 
 
-class Estimator:
+class ModelFile:
+    """What a model file holds, written and read the same way for every kind of model.
+
+    :meth:`to_dict` writes the model's ``kind``, its parts (:meth:`_document_parts`) and
+    its fit report; :meth:`from_dict` checks the document's main entry
+    (``_document_entry``), builds the model from it (:meth:`_from_document`, which
+    validates everything) and gives it the fit report back. :mod:`hystcomp.io.models`
+    writes the dictionary as JSON, with a format and a version.
+    """
+
+    kind: ClassVar[str]
+    #: The entry that :meth:`from_dict` checks first, and its type (None: the document's
+    #: shape is checked by :func:`hystcomp.io.models.model_from_dict`).
+    _document_entry: ClassVar[tuple[str, type] | None] = ("parameters", dict)
+
+    def _document_parts(self) -> dict[str, Any]:
+        """The document's entries after ``kind``, in their order."""
+        raise NotImplementedError
+
+    @classmethod
+    def _from_document(cls, data: dict[str, Any]) -> Self:
+        """The model a checked document describes, every value validated."""
+        raise NotImplementedError
+
+    def to_dict(self) -> dict[str, Any]:
+        """The model file's dictionary: kind, parts and fit report, ready for JSON.
+
+        Returns
+        -------
+        dict
+            ``{"kind": ..., <the model's parts>, "fit_report": ...}``: for an estimator its
+            ``hyperparameters`` and ``parameters``, for a pair its ``hysteresis`` and
+            ``dynamics``, for many axes each axis's own dictionary; ``fit_report`` only for
+            a fitted model.
+        """
+        return model_document(self, **self._document_parts())
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> Self:
+        """Inverse of :meth:`to_dict`: the model that a dictionary describes, validated.
+
+        :func:`hystcomp.io.models.model_from_dict` checks a whole document (keys, JSON
+        types) first.
+
+        Parameters
+        ----------
+        data : dict
+            A dictionary as :meth:`to_dict` writes it.
+
+        Returns
+        -------
+        object
+            The model, of the class it is called on.
+
+        Raises
+        ------
+        InvalidParameterError
+            If the document does not describe a valid model of this kind.
+        """
+        if cls._document_entry is not None:
+            check_document(cls, data, *cls._document_entry)
+        model = cls._from_document(data)
+        read_fit_report(model, data)
+        return model
+
+
+class Estimator(ModelFile):
     """Base of the fitted models: voltage (V) in, displacement (µm) out, learned from data.
 
     Subclasses list their learned parameters in ``_learned`` (names without the trailing
@@ -485,33 +551,13 @@ class Estimator:
             out[name] = value.tolist() if isinstance(value, np.ndarray) else value
         return out
 
-    def to_dict(self) -> dict[str, Any]:
-        """Kind, hyperparameters, parameters and fit report, ready for JSON.
-
-        Returns
-        -------
-        dict
-            ``{"kind", "hyperparameters", "parameters", "fit_report"}``, JSON-ready.
-        """
-        return model_document(self, hyperparameters=self.get_params(), parameters=self.parameters())
+    def _document_parts(self) -> dict[str, Any]:
+        return {"hyperparameters": self.get_params(), "parameters": self.parameters()}
 
     @classmethod
-    def from_dict(cls, data: dict[str, Any]) -> Self:
-        """Inverse of :meth:`to_dict` (validates everything through ``from_parameters``).
-
-        :func:`hystcomp.io.models.model_from_dict` checks a whole document (keys, JSON types) first.
-
-        Parameters
-        ----------
-        data : dict
-            A dictionary as :meth:`to_dict` writes it.
-
-        Returns
-        -------
-        Estimator
-            The model, of the class it is called on.
-        """
-        check_document(cls, data, "parameters", dict)
+    def _from_document(cls, data: dict[str, Any]) -> Self:
+        """``from_parameters`` validates the parameters; a hyperparameter the parameters
+        determine must agree with them, and every hyperparameter keeps its constraint."""
         model = cls.from_parameters(**data["parameters"])
         derived = model._derived_hyperparameters()
         for name, value in data.get("hyperparameters", {}).items():
@@ -529,7 +575,6 @@ class Estimator:
                 )
             setattr(model, name, value)
         model._check_hyperparameters()  # every value, as fit() would check it
-        read_fit_report(model, data)
         return model
 
     _estimator_type = "regressor"  # what scikit-learn < 1.6 reads

@@ -32,7 +32,7 @@ from hystcomp.identify.scoring import transient_end
 from hystcomp.models.base import HysteresisModel
 from hystcomp.models.dynamic_compensator import DynamicCompensator
 from hystcomp.models.dynamics import LinearDynamics, with_dynamics
-from hystcomp.models.estimator import model_document, read_fit_report
+from hystcomp.models.estimator import ModelFile
 from hystcomp.models.mpi import ModifiedPrandtlIshlinskii
 from hystcomp.models.pi import PrandtlIshlinskii
 from hystcomp.models.preisach import Preisach
@@ -46,7 +46,7 @@ MAX_ROUNDS = 4
 TOLERANCE = 1e-3
 
 
-class HammersteinModel:
+class HammersteinModel(ModelFile):
     """A hysteresis model in series with linear dynamics, identified as one pair.
 
     Building one from parts that were identified apart is the caller's statement that they
@@ -174,38 +174,16 @@ class HammersteinModel:
 
     # -- files -----------------------------------------------------------------------------
 
-    def to_dict(self) -> dict[str, Any]:
-        """Kind, both parts and the fit report, ready for JSON (:mod:`hystcomp.io.models`).
+    _document_entry = None  # model_from_dict checks the two parts first
 
-        Returns
-        -------
-        dict
-            ``{"kind": "hammerstein", "hysteresis", "dynamics", "fit_report"}``, JSON-ready.
-        """
-        return model_document(
-            self, hysteresis=self.hysteresis.to_dict(), dynamics=self.dynamics.to_dict()
-        )
+    def _document_parts(self) -> dict[str, Any]:
+        return {"hysteresis": self.hysteresis.to_dict(), "dynamics": self.dynamics.to_dict()}
 
     @classmethod
-    def from_dict(cls, data: dict[str, Any]) -> HammersteinModel:
-        """Inverse of :meth:`to_dict` (:func:`hystcomp.io.models.model_from_dict` checks
-        the document's shape first).
-
-        Parameters
-        ----------
-        data : dict
-            A dictionary as :meth:`to_dict` writes it.
-
-        Returns
-        -------
-        HammersteinModel
-            The pair, each part validated.
-        """
+    def _from_document(cls, data: dict[str, Any]) -> HammersteinModel:
         parts = {c.kind: c for c in (PrandtlIshlinskii, ModifiedPrandtlIshlinskii, Preisach)}
         hysteresis = parts[data["hysteresis"]["kind"]].from_dict(data["hysteresis"])
-        model = cls(hysteresis, LinearDynamics.from_dict(data["dynamics"]))
-        read_fit_report(model, data)
-        return model
+        return cls(hysteresis, LinearDynamics.from_dict(data["dynamics"]))
 
     def __repr__(self) -> str:
         return f"HammersteinModel({self.hysteresis!r}, {self.dynamics!r})"

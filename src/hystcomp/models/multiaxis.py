@@ -44,12 +44,7 @@ from hystcomp.identify.compensation import tracking_estimate
 from hystcomp.identify.coupling import fit_coupling, refine_coupling
 from hystcomp.identify.scoring import transient_end
 from hystcomp.models.base import HysteresisModel
-from hystcomp.models.estimator import (
-    Estimator,
-    check_document,
-    model_document,
-    read_fit_report,
-)
+from hystcomp.models.estimator import Estimator
 from hystcomp.models.mpi import ModifiedPrandtlIshlinskii
 from hystcomp.models.pi import PrandtlIshlinskii
 from hystcomp.models.preisach import Preisach
@@ -558,34 +553,18 @@ class MultiAxisModel(Estimator):
             "coupling": np.asarray(self.coupling_).tolist(),
         }
 
-    def to_dict(self) -> dict[str, Any]:
-        """Kind, hyperparameters, each axis's own model dictionary and ``M``, for JSON.
+    _document_entry = ("axes", list)
 
-        Returns
-        -------
-        dict
-            ``{"kind": "multiaxis", ...}``, JSON-ready.
-        """
+    def _document_parts(self) -> dict[str, Any]:
         params = self.get_params()
         if not isinstance(params["family"], str):
             params["family"] = params["family"].kind
-        return model_document(self, hyperparameters=params, **self.parameters())
+        return {"hyperparameters": params, **self.parameters()}
 
     @classmethod
-    def from_dict(cls, data: dict[str, Any]) -> Self:
-        """Inverse of :meth:`to_dict`; every axis through its own ``from_dict``.
-
-        Parameters
-        ----------
-        data : dict
-            A dictionary as :meth:`to_dict` writes it.
-
-        Returns
-        -------
-        MultiAxisModel
-            The model, each axis validated.
-        """
-        check_document(cls, data, "axes", list)
+    def _from_document(cls, data: dict[str, Any]) -> Self:
+        """Every axis through its own ``from_dict``, then the coupling and the
+        hyperparameters."""
         axes = []
         for i, doc in enumerate(data["axes"]):
             kind = doc.get("kind") if isinstance(doc, dict) else None
@@ -601,7 +580,6 @@ class MultiAxisModel(Estimator):
             if name in hyper:
                 setattr(model, name, hyper[name])
         model._check_hyperparameters()
-        read_fit_report(model, data)
         return model
 
     def __sklearn_tags__(self):  # pragma: no cover - read by scikit-learn only

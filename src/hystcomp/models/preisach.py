@@ -268,36 +268,6 @@ class Preisach(HysteresisModel):
         model.voltage_range = None
         return model
 
-    @classmethod
-    def from_dict(cls, data) -> Preisach:
-        """Inverse of :meth:`to_dict`; a ``degree`` hyperparameter must match ``theta``.
-
-        Evaluation takes the degree of X and the memory bound from the hyperparameters, so
-        a document whose ``theta`` has the size of another degree, or whose ``max_extrema``
-        is not an int >= 3, is refused here rather than failing later.
-
-        Parameters
-        ----------
-        data : dict
-            A dictionary as :meth:`to_dict` writes it.
-
-        Returns
-        -------
-        Preisach
-            The model, validated.
-        """
-        model = super().from_dict(data)  # every hyperparameter checked, max_extrema too
-        if model.theta_ is not None:
-            sizes = {pk.n_monomials(d): d for d in range(1, MAX_DEGREE + 1)}
-            degree = sizes[model.theta_.size]
-            if type(model.degree) is not int or model.degree != degree:  # not 3.0 nor True
-                raise InvalidParameterError(
-                    f"The 'degree' hyperparameter of {cls.__name__} must match 'theta', whose "
-                    f"{model.theta_.size} entries are those of degree {degree}. Got "
-                    f"{model.degree!r} instead; correct or drop it."
-                )
-        return model
-
     @fit_signals
     def fit(self, v, x) -> Preisach:
         """Identify the model from a record (Section III-A); see
