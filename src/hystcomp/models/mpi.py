@@ -207,22 +207,17 @@ class ModifiedPrandtlIshlinskii(PrandtlIshlinskii):
 
         Parameters
         ----------
-        thresholds : array_like
-            The play thresholds ``r_i``, V, rising from 0.
-        weights : array_like
-            The play weights ``w_i``, unitless (µm per µm of the dead-zones' input).
+        thresholds, weights, initial_state
+            The plays of ``H``, as in :meth:`PrandtlIshlinskii.from_parameters
+            <hystcomp.models.pi.PrandtlIshlinskii.from_parameters>`: thresholds (V, rising
+            from 0), weights (µm/V) and initial states (V; zeros if None, eq. 18).
         deadzone_thresholds : array_like
-            The dead-zone thresholds ``r_S``, rising from 0.
+            The dead-zone thresholds ``r_S`` of ``S``, µm of ``H``'s output, rising from 0.
         deadzone_weights : array_like
-            The dead-zone weights ``w_S``.
-        initial_state : array_like, optional
-            The plays' initial states, V (zeros if None, eq. 18).
-        voltage_range : tuple of (float, float), optional
-            The amplifier's range, V.
-        input_offset : float, optional
-            The voltage subtracted before the plays, V.
-        output_offset : float, optional
-            The displacement added after the dead-zones, µm.
+            The dead-zone weights ``w_S``, unitless.
+        voltage_range, input_offset, output_offset
+            The amplifier's range (V), the voltage subtracted before the plays (V) and the
+            displacement added after the dead-zones (µm).
 
         Returns
         -------
