@@ -14,13 +14,15 @@ from __future__ import annotations
 import contextlib
 import importlib
 import os
+import re
 import signal
 import sys
 
 import click
 
 from hystcomp import _signals
-from hystcomp.errors import HystcompError
+from hystcomp._notice import worded
+from hystcomp.errors import HystcompError, InvalidParameterError
 
 EXIT_BAD_INPUT = 2
 EXIT_INTERNAL = 1
@@ -46,43 +48,90 @@ def _one_line(text: str) -> str:
 #: shell completion load neither numba nor SciPy (tests/cli/test_cli_lazy.py checks that this
 #: table matches the commands).
 COMMANDS = {
-    "calibrate": (
-        "hystcomp.cli.calibrate",
-        "Print how the simulated axis (the twin) compares with the paper's figures.",
-    ),
-    "compare": (
-        "hystcomp.cli.compare",
-        "Identify the Preisach, PI and MPI models on the twin and compare the four methods.",
-    ),
-    "compensate": (
-        "hystcomp.cli.compensate",
-        "Voltage that makes the actuator of MODEL.json follow REFERENCE (columns t, x).",
-    ),
-    "evaluate": (
-        "hystcomp.cli.evaluate",
-        "How well MEASURED (columns t, x; v too if there) tracked REFERENCE (columns t, x).",
-    ),
-    "excite": (
-        "hystcomp.cli.excite",
-        "Write the identification input for MODEL: pi, mpi, preisach, rich, dynamics, multiaxis.",
-    ),
-    "export-c": (
-        "hystcomp.cli.export_c",
-        "Write MODEL_FILE's compensator as C99 code: NAME.h and NAME.c in folder -o.",
-    ),
-    "identify": (
-        "hystcomp.cli.identify",
-        "Identify a hysteresis model from DATA (columns t, v, x) and write it as JSON.",
-    ),
-    "raster": (
-        "hystcomp.cli.raster",
-        "An AFM raster on the simulated scanner: uncompensated, per-axis, coupled.",
-    ),
-    "simulate": (
-        "hystcomp.cli.simulate",
-        "Run the model in MODEL.json on the voltage in INPUT (columns t, v).",
-    ),
+    name: (f"hystcomp.cli.{name.replace('-', '_')}", text)
+    for name, text in {
+        "calibrate": "Print how the simulated axis (the twin) compares with the paper's figures.",
+        "compare": "Identify the Preisach, PI and MPI models on the twin and compare the four "
+        "methods.",
+        "compensate": "Voltage that makes the actuator of MODEL.json follow REFERENCE (columns "
+        "t, x).",
+        "evaluate": "How well MEASURED (columns t, x; v too if there) tracked REFERENCE "
+        "(columns t, x).",
+        "excite": "Write the identification input for MODEL: pi, mpi, preisach, rich, "
+        "dynamics, multiaxis.",
+        "export-c": "Write MODEL_FILE's compensator as C99 code: NAME.h and NAME.c in folder -o.",
+        "identify": "Identify a hysteresis model from DATA (columns t, v, x) and write it as JSON.",
+        "raster": "An AFM raster on the simulated scanner: uncompensated, per-axis, coupled.",
+        "simulate": "Run the model in MODEL.json on the voltage in INPUT (columns t, v).",
+    }.items()
 }
+
+#: The remedies that the library's sentences name (:class:`hystcomp._notice.Notice`), in the
+#: command's words.
+WORDS = {
+    "excite_rich": "hystcomp excite rich",
+    "excite_mpi": "hystcomp excite mpi",
+    "excite_dynamics": "hystcomp excite dynamics",
+    "transient": "--transient",
+    "model": "--model {others}",
+    "initial_memory": "--initial-memory",
+    "allow_extrapolation": "--allow-extrapolation",
+    "strict": "Nothing written (--strict)",
+    "drop_strict": "drop --strict",
+    "method_exact": "--method exact",
+    "drop_method": "Drop --method",
+    "narrow": "narrow the output with --voltage-range {lo} {hi}",
+    "drop_dynamics": "Drop --dynamics",
+    "dynamics_option": "--dynamics",
+    "identify_dynamics": "the file written by 'hystcomp identify DATA --model dynamics'",
+    "pair_alone": "the hysteresis model alone (hystcomp identify without --dynamics-record)",
+    "identify_pair": "hystcomp identify DATA --model KIND --dynamics-record DYN.csv",
+    "slew": "--slew-rate",
+    "give_fs": "give --fs",
+}
+#: A library parameter's option where its name is not the option's.
+OPTIONS = {"sample_rate": "--fs", "out_dir": "--out"}
+#: "The 'name' parameter of owner rest": a refused parameter, said as its option's value.
+_PARAMETER = re.compile(
+    r"The '(?P<name>\w+)' (?:parameter|argument) of [\w.]+,? (?P<rest>[a-z0-9'].*)"
+)
+
+
+def say(text) -> str:
+    """A library sentence (a :class:`~hystcomp._notice.Notice` or text) in the command's words."""
+    return _one_line(worded(text, WORDS))
+
+
+def report(*results, lines: bool = True, warnings: bool = True) -> None:
+    """Print the workflow results' report lines, then their warnings on standard error."""
+    for result in results if lines else ():
+        for line in getattr(result, "lines", ()):
+            click.echo(worded(line, WORDS))
+    for result in results if warnings else ():
+        for warning in getattr(result, "warnings", ()):
+            click.echo(f"hystcomp: warning: {say(warning)}", err=True)
+
+
+def refuse(given: dict, why: str) -> None:
+    """Refuse, in the command's words, the first option given that ``why`` does not take."""
+    for option, value in given.items():
+        if value is not None and value is not False:
+            raise click.UsageError(f"{option} does not apply to {why}.")
+
+
+class _Command(click.Command):
+    """A subcommand: a library parameter refused is said as the value of its option."""
+
+    def invoke(self, ctx):
+        try:
+            return super().invoke(ctx)
+        except InvalidParameterError as exc:
+            found = _PARAMETER.fullmatch(say(exc.args[0] if len(exc.args) == 1 else exc))
+            name = found and OPTIONS.get(found["name"], "--" + found["name"].replace("_", "-"))
+            option = next((p for p in self.params if name in p.opts), None) if name else None
+            if option is not None and ctx.params.get(option.name) is not None:  # given
+                raise click.BadParameter(found["rest"], ctx, param_hint=f"'{name}'") from None
+            raise
 
 
 class _Group(click.Group):
@@ -91,6 +140,8 @@ class _Group(click.Group):
     Its subcommands are imported lazily from :data:`COMMANDS`; each module registers its
     command on :data:`main` when imported.
     """
+
+    command_class = _Command
 
     def list_commands(self, ctx):
         return sorted({*COMMANDS, *self.commands})
@@ -151,7 +202,9 @@ class _Group(click.Group):
             click.echo(f"hystcomp: error: {_one_line(exc.format_message())}", err=True)
             sys.exit(exc.exit_code)
         except HystcompError as exc:
-            click.echo(f"hystcomp: error: {_one_line(exc)}", err=True)
+            click.echo(
+                f"hystcomp: error: {say(exc.args[0] if len(exc.args) == 1 else exc)}", err=True
+            )
             sys.exit(EXIT_BAD_INPUT)
         except MemoryError:
             click.echo(

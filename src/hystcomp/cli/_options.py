@@ -14,7 +14,9 @@ from hystcomp._hyperparameters import MAX_OPERATORS
 from hystcomp._progress import Progress
 from hystcomp._validation import MAX_MAGNITUDE
 from hystcomp.errors import InvalidParameterError
-from hystcomp.io.records import X_UNITS  # light: the readers load compiled code only on use
+
+# light: the readers load compiled code only on use
+from hystcomp.io.records import X_UNITS, format_csv
 
 # hystcomp.io.records, hystcomp.io.models and the models are imported where used: a command that
 # needs no kernel (``excite``) then loads neither numba nor SciPy's sparse solvers.
@@ -100,22 +102,6 @@ narrow_range_option = click.option(
 )
 
 
-def narrowed(model, narrow_range) -> dict:
-    """``{"voltage_range": narrow_range}`` for ``model.inverse``, or ``{}`` if not given;
-    a range reaching beyond the model's is refused as the option's error."""
-    if narrow_range is None:
-        return {}
-    (lo, hi), (low, high) = model.voltage_range_, narrow_range
-    if low < lo or high > hi:
-        raise click.BadParameter(
-            f"may only narrow the model's voltage range {lo:g} .. {hi:g} V: the model was "
-            f"identified inside it and would command voltages it never saw. Got {low:g} "
-            f"{high:g}; choose limits within it, or identify over a wider range.",
-            param_hint="'--voltage-range'",
-        )
-    return {"voltage_range": narrow_range}
-
-
 def columns(ctx, param, value):
     """A callback: a column mapping such as ``v=1,x=5`` (see :func:`parse_columns`)."""
     from hystcomp.io.records import parse_columns
@@ -190,17 +176,18 @@ def read_options(
     quiet: bool = False,
     path="",
     *,
-    reads: tuple[str, ...] = ("v", "x"),
+    reads: tuple[str, ...] | None = ("v", "x"),
 ) -> dict:
     """Keyword arguments for :func:`hystcomp.io.records.read_table` from the shared options.
 
     ``reads`` are the columns the command reads besides t: a ``--columns`` entry for
     another one is refused (it would be ignored, and was most likely meant for one read).
+    None (an N-axis file) checks nothing.
     """
     from hystcomp.io.records import MEANINGS
 
     named = columns or {}
-    unused = [key for key in named if key not in ("t", *reads)]
+    unused = [key for key in named if reads is not None and key not in ("t", *reads)]
     if unused:
         key, spec = unused[0], named[unused[0]]
         meant = next((k for k in reads if k not in named), reads[0])
@@ -254,41 +241,55 @@ def __getattr__(name: str):
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
-def method_options(model, model_file, method) -> dict:
-    """``model.inverse``'s ``method`` for ``--method``, refused for a model without one."""
-    if method is None:
-        return {}
-    if model.kind != "preisach":
-        raise click.BadParameter(
-            f"applies to Preisach models only; the model in {model_file} is "
-            f"{model.kind.upper()}, whose inverse is analytic (eqs. 23-26). Drop --method.",
-            param_hint="'--method'",
-        )
-    return {"method": method}
+def check_plot(plot, *, inputs=(), output=None) -> None:
+    """Refuse, before any work, a figure path of an unknown format, or one that would
+    overwrite an input or the command's other output."""
+    from pathlib import Path
+
+    from hystcomp.experiment.fig_identification import FORMATS  # matplotlib only when drawn
+    from hystcomp.io.atomic import check_output_path
+
+    if Path(plot).suffix.lower() not in FORMATS:
+        raise click.BadParameter(f"must end in {', '.join(FORMATS)}.", param_hint="--plot")
+    check_output_path(plot, inputs=inputs, what="figure")
+    if output is not None and Path(plot).resolve() == Path(output).resolve():
+        raise click.BadParameter("names the same file as -o.", param_hint="--plot")
 
 
-#: A step of the reference's time column shorter than this share of its median step is a
-#: fault of the column, not jitter: at its rate the slew-rate limit would all but hold the
-#: voltage still on every sample.
-SHORTEST_STEP = 1e-3
+def write_model(model, output, plot=None, draw=None) -> None:
+    """Write ``model`` to ``output`` and, with ``plot``, the figure ``draw(path)`` makes; all
+    at once (a failure writes none of them), then say so."""
+    from hystcomp.io.atomic import atomic_paths
+    from hystcomp.io.models import model_text
+
+    text = model_text(model)
+    outputs = [output] if plot is None else [output, plot]
+    with atomic_paths(*outputs) as (tmp_model, *tmp_plot):
+        tmp_model.write_text(text, encoding="utf-8")
+        if plot is not None:
+            draw(tmp_plot[0])
+    for path in outputs[::-1]:
+        click.echo(f"  wrote {path}")
 
 
-def slew_sample_rate(t, path) -> float:
-    """The rate (Hz) of the shortest step of ``t``, at which the slew-rate limit holds on
-    every step; refused, naming the row, if that step is a fault of the time column."""
-    import numpy as np
+def write_signal(table: dict, output, quiet: bool, summary: str) -> None:
+    """Write ``table`` to ``output`` (``summary`` after it), or as CSV on standard output."""
+    import sys
 
-    from hystcomp.errors import InvalidSignalError
+    from hystcomp.errors import OutputPathError
+    from hystcomp.io.records import write_table
 
-    steps = np.diff(t)
-    k = int(np.argmin(steps))
-    shortest, median = float(steps[k]), float(np.median(steps))
-    if not shortest >= SHORTEST_STEP * median or not 1.0 / shortest <= MAX_MAGNITUDE:
-        raise InvalidSignalError(
-            f"--slew-rate limits the voltage's change per sample at the reference's shortest "
-            f"time step, but the time column 't' of {str(path)!r} steps by only "
-            f"{shortest:.3g} s from t = {float(t[k])!r} to {float(t[k + 1])!r} s (data row "
-            f"{k + 2}), against a median step of {median:.3g} s: the limit would hold the "
-            "voltage nearly still. Correct the time column there, or drop it and give --fs."
-        )
-    return 1.0 / shortest
+    if output is not None:
+        write_table(output, table, progress=progress(f"writing {output}", quiet))
+        click.echo(f"wrote {output}: {summary}")
+        return
+    try:
+        click.echo(format_csv(table), nl=False)
+        sys.stdout.flush()
+    except BrokenPipeError:
+        raise  # the reader went away (| head): not an error
+    except OSError as exc:
+        raise OutputPathError(
+            f"Cannot write the signal to standard output: {exc.strerror or exc}. Give a "
+            "file with -o, or check where standard output goes."
+        ) from None

@@ -3,12 +3,12 @@
 from __future__ import annotations
 
 import json
-from pathlib import Path
 
 import click
 
-from hystcomp.cli import main
+from hystcomp.cli import main, report
 from hystcomp.cli._options import (
+    check_plot,
     columns_option,
     fs_option,
     nonnegative,
@@ -17,7 +17,6 @@ from hystcomp.cli._options import (
     warn_x_unit,
     x_unit_option,
 )
-from hystcomp.io.atomic import check_output_path
 
 
 @main.command("evaluate")
@@ -50,15 +49,10 @@ def evaluate(reference, measured, as_json, plot, skip, columns, sample_rate, x_u
     x_ref in % of the range (whole loop and top quarter, as the paper's Table I and Fig. 9)
     and the error over time in ten spans. --columns, --fs and --x-unit apply to MEASURED.
     """
-    from hystcomp.workflows.evaluate import OUTSIDE_WARNING
     from hystcomp.workflows.evaluate import evaluate as run_evaluation
 
     if plot is not None:
-        from hystcomp.experiment.fig_identification import FORMATS
-
-        if Path(plot).suffix.lower() not in FORMATS:
-            raise click.BadParameter(f"must end in {', '.join(FORMATS)}.", param_hint="--plot")
-        check_output_path(plot, inputs=(reference, measured), what="figure")
+        check_plot(plot, inputs=(reference, measured))
     result = run_evaluation(
         reference,
         measured,
@@ -66,58 +60,15 @@ def evaluate(reference, measured, as_json, plot, skip, columns, sample_rate, x_u
         **read_options(columns, sample_rate, x_unit, quiet, measured, reads=("v", "x")),
     )
     warn_x_unit(result.x, measured, quiet, x_unit)
-    if result.outside_share > OUTSIDE_WARNING:
-        click.echo(
-            f"hystcomp: warning: {result.outside} samples ({100 * result.outside_share:.3g} %) "
-            f"of {measured} lie outside the time span of {reference} and are left out; check "
-            "that the two belong together and that their time columns start alike.",
-            err=True,
-        )
+    report(result, lines=False)
     if plot is not None:
         from hystcomp.experiment.fig_evaluate import plot_evaluation
 
         plot_evaluation(result, plot)
     if as_json:
         out = result.to_dict()
-        if plot is not None:
-            out["plot"] = str(plot)
-        click.echo(json.dumps(out))
+        click.echo(json.dumps(out if plot is None else {**out, "plot": str(plot)}))
         return
-    for line in describe(result):
-        click.echo(line)
+    report(result, warnings=False)
     if plot is not None:
         click.echo(f"  wrote {plot}")
-
-
-def describe(result) -> list[str]:
-    """The lines that word an :class:`~hystcomp.workflows.evaluate.Evaluation`."""
-    span = result.range_um
-    share = f" ({100 * result.rms_um / span:.3g} % of the {span:.4g} µm range)" if span else ""
-    matched = (
-        "interpolated at the measured instants" if result.interpolated else "the same instants"
-    )
-    lines = [
-        f"tracking of {result.measured} against {result.reference}",
-        f"  matched:    {result.samples} samples, t {result.t[0]:.6g} .. {result.t[-1]:.6g} s "
-        f"(reference {matched}"
-        + (f"; the first {result.skip_s:g} s left out" if result.skip_s else "")
-        + (f"; {result.outside} outside the reference's time span" if result.outside else "")
-        + ")",
-        (
-            f"  error:      rms {result.rms_um:.4g} µm{share}, max {result.max_um:.4g} µm, "
-            f"mean {result.mean_um:.4g} µm"
-        ),
-    ]
-    if result.hysteresis_pct is None:
-        lines.append("  hysteresis: - (the reference does not rise and fall)")
-    else:
-        lines.append(
-            f"  hysteresis: {result.hysteresis_pct:.3g} % of the range (top quarter, the "
-            f"saturation zone: {result.saturation_zone_pct:.3g} %)"
-        )
-    lines.append("  error over time:")
-    lines.append(f"    {'t (s)':>21}  {'rms (µm)':>9}  {'max (µm)':>9}")
-    for part in result.spans:
-        when = f"{part.t_start:.4g} .. {part.t_end:.4g}"
-        lines.append(f"    {when:>21}  {part.rms_um:9.4g}  {part.max_um:9.4g}")
-    return lines

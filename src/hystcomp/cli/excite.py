@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import sys
-
 import click
 
 from hystcomp import paper
@@ -12,13 +10,11 @@ from hystcomp.cli._options import (
     check_data_output,
     output_option,
     positive,
-    progress,
     quiet_option,
     voltage_range,
+    write_signal,
 )
-from hystcomp.errors import OutputPathError
 from hystcomp.identify.excitation import DEFAULT_SAMPLE_RATE, SIGNAL_KINDS, excitation_signal
-from hystcomp.io.records import format_csv, write_table
 
 
 @main.command("excite")
@@ -80,27 +76,16 @@ def excite(model, output, sample_rate, voltage_range, frequency, axes, quiet):
         raise click.UsageError(
             "--axes N goes with 'excite multiaxis' (and only with it): give both or neither."
         )
-    if model == "multiaxis":
-        from hystcomp.cli._multiaxis import excite_multiaxis
-
-        excite_multiaxis(axes, output, sample_rate, voltage_range, frequency, quiet)
-        return
     if output is not None:
         check_data_output(output, what="signal file")
-    t, v = excitation_signal(
-        model, sample_rate=sample_rate, voltage_range=voltage_range, frequency=frequency
-    )
-    if output is None:
-        try:
-            click.echo(format_csv({"t": t, "v": v}), nl=False)
-            sys.stdout.flush()
-        except BrokenPipeError:
-            raise  # the reader went away (| head): not an error
-        except OSError as exc:
-            raise OutputPathError(
-                f"Cannot write the signal to standard output: {exc.strerror or exc}. Give a "
-                "file with -o, or check where standard output goes."
-            ) from None
+    signal = {"sample_rate": sample_rate, "voltage_range": voltage_range, "frequency": frequency}
+    if model == "multiaxis":
+        from hystcomp.identify.multiaxis_excitation import multiaxis_sequence
+
+        t, V = multiaxis_sequence(axes, **signal)
+        table = {"t": t, **{f"v{i + 1}": V[:, i] for i in range(axes)}}
+        what = f"{t.size} samples of {axes} axes at {sample_rate:g} Hz ({t[-1]:g} s)"
     else:
-        write_table(output, {"t": t, "v": v}, progress=progress(f"writing {output}", quiet))
-        click.echo(f"wrote {output}: {t.size} samples at {sample_rate:g} Hz ({t[-1]:g} s)")
+        t, v = excitation_signal(model, **signal)
+        table, what = {"t": t, "v": v}, f"{t.size} samples at {sample_rate:g} Hz ({t[-1]:g} s)"
+    write_signal(table, output, quiet, what)

@@ -2,27 +2,21 @@
 
 from __future__ import annotations
 
-import warnings
 from pathlib import Path
 
 import click
 
 from hystcomp import paper
-from hystcomp.cli import main
-from hystcomp.cli._dynamics import load_dynamics, refuse_dynamics_as_model
-from hystcomp.cli._options import (
-    method_option,
-    method_options,
-    narrow_range_option,
-    narrowed,
-    positive,
-)
-from hystcomp.codegen import DEFAULT_PREFIX, check_prefix, export_c
-from hystcomp.errors import HystcompWarning, ModelFileError
+from hystcomp.cli import main, report
+from hystcomp.cli._options import method_option, narrow_range_option, positive
+from hystcomp.codegen import DEFAULT_PREFIX, check_prefix
 from hystcomp.io.atomic import check_output_path
 from hystcomp.io.models import load_model
-from hystcomp.models.dynamics import APART
-from hystcomp.models.hammerstein import HammersteinModel
+from hystcomp.workflows.compensate import (
+    export_compensator,
+    load_dynamics,
+    refuse_dynamics_as_model,
+)
 
 
 @main.command("export-c")
@@ -87,43 +81,19 @@ def export_c_command(
     for suffix in (".h", ".c") if directory.is_dir() else ():  # never overwrite the model
         check_output_path(directory / f"{prefix}{suffix}", inputs=(model_file,))
     model = load_model(model_file)
-    if getattr(model, "kind", None) == "multiaxis":  # one state struct for all axes
-        from hystcomp.cli._multiaxis import export_multiaxis, refuse
-
-        refuse("--dynamics", dynamics_file, "a multi-axis model")
-        export_multiaxis(model, model_file, directory, prefix, slew_rate, sample_rate, method)
-        return
     refuse_dynamics_as_model(model, model_file)
-    options = {"slew_rate": slew_rate, "sample_rate": sample_rate, **narrowed(model, narrow_range)}
-    pair = isinstance(model, HammersteinModel)
-    if pair and dynamics_file is not None:
-        raise ModelFileError(
-            f"{str(model_file)!r} holds a hysteresis model and its dynamics, identified as "
-            "one pair; its inverse inverts both. Drop --dynamics."
-        )
-    dynamics = model.dynamics if pair else None
-    if dynamics_file is not None:
-        dynamics = options["dynamics"] = load_dynamics(dynamics_file)
-    if dynamics is not None and abs(dynamics.sample_rate_ - sample_rate) > 1e-6 * sample_rate:
-        raise click.BadParameter(
-            f"is {sample_rate:g} Hz but {dynamics_file or model_file} was identified at "
-            f"{dynamics.sample_rate_:g} Hz; the code must run at the dynamics' rate.",
-            param_hint="'--fs'",
-        )
-    chosen = method_options(model.hysteresis if pair else model, model_file, method)
-    if pair:
-        options.pop("sample_rate")  # the pair's own
-    elif dynamics_file is not None:
-        click.echo(f"hystcomp: warning: {APART}", err=True)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", HystcompWarning)  # said above, in the command's words
-        compensator = model.inverse(**options, **chosen)
-    header, source = export_c(
-        compensator,
+    result = export_compensator(
+        model,
         directory,
         prefix=prefix,
         source=str(model_file),
         sample_rate=sample_rate,
+        slew_rate=slew_rate,
+        voltage_range=narrow_range,
+        method=method,
+        dynamics=None if dynamics_file is None else load_dynamics(dynamics_file),
         inputs=(model_file,),
     )
-    click.echo(f"wrote {header} and {source}")
+    report(result)
+    paths = [str(p) for p in result.paths]
+    click.echo(f"wrote {' and '.join(paths) if len(paths) == 2 else ', '.join(paths)}")

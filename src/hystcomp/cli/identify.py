@@ -1,19 +1,19 @@
 """``hystcomp identify``: a model from a measured record, with an optional hold-out test.
 
-The work is :func:`hystcomp.identify.workflow.identify_record`; this module parses the
-options, prints the result and writes the files.
+The work is :mod:`hystcomp.workflows` (:func:`~hystcomp.workflows.identify.identify_record`,
+``auto``, ``pair``, ``multiaxis``); this module parses the options, prints the result and
+writes the files.
 """
 
 from __future__ import annotations
-
-from pathlib import Path
 
 import click
 
 from hystcomp._hyperparameters import EVERETT_KINDS, MAX_DEGREE
 from hystcomp._validation import MAX_MAGNITUDE
-from hystcomp.cli import main
+from hystcomp.cli import main, refuse, report
 from hystcomp.cli._options import (
+    check_plot,
     columns_option,
     count,
     fraction,
@@ -24,33 +24,22 @@ from hystcomp.cli._options import (
     read_options,
     voltage_range,
     warn_x_unit,
+    write_model,
     x_unit_option,
 )
-from hystcomp.errors import IdentificationError
 from hystcomp.identify.preisach import FIT_METHODS
 from hystcomp.identify.preisach_lsq import MAX_LSQ_GRID
-from hystcomp.identify.workflow import (
-    LABELS,
-    SIZE_OPTIONS,
-    build_estimator,
-    extrapolation_error,
-    fit_samples,
-    identify_record,
-)
-from hystcomp.io.atomic import atomic_paths, check_output_path
-from hystcomp.io.models import model_text
+from hystcomp.io.atomic import check_output_path
+from hystcomp.io.multiaxis import is_multiaxis
 from hystcomp.io.records import read_record
-
-#: Largest --grid (the least-squares table fit has about grid^2 / 2 unknowns).
-MAX_GRID = MAX_LSQ_GRID
+from hystcomp.workflows.identify import LABELS, SIZE_OPTIONS, build_estimator, identify_record
 
 
 def _check_options(kind: str, given: dict) -> None:
     """Refuse, in the command's words, an option that --model (or --everett) does not take."""
     for name, value in given.items():
         if value is not None and kind != "auto" and name not in SIZE_OPTIONS[kind]:
-            option = name.replace("_", "-")
-            raise click.UsageError(f"--{option} does not apply to --model {kind}.")
+            raise click.UsageError(f"--{name.replace('_', '-')} does not apply to --model {kind}.")
     if given["everett"] == "table" and given["degree"] is not None:
         raise click.UsageError("--degree applies to --everett polynomial; a table has --grid.")
     if given["grid"] is not None and given["everett"] == "polynomial":
@@ -127,7 +116,7 @@ def _regularization(ctx, param, value):
 )
 @click.option(
     "--grid",
-    type=click.IntRange(2, MAX_GRID),
+    type=click.IntRange(2, MAX_LSQ_GRID),
     default=None,
     help="Nodes per axis of a preisach --everett table [25].",
 )
@@ -267,93 +256,61 @@ def identify(
     """
     inputs = (data,) if dynamics_record is None else (data, dynamics_record)
     check_output_path(output, inputs=inputs, what="model file")
-    from hystcomp.io.multiaxis import is_multiaxis
-
-    if is_multiaxis(data, columns):  # t, v1..vN, x1..xN: N coupled axes
-        from hystcomp.cli._multiaxis import identify_multiaxis, refuse
-
-        why = "an N-axis record"
-        refuse("--model dynamics", kind == "dynamics" or None, why)
-        for name, value in (("--holdout", holdout), ("--dynamics-record", dynamics_record)):
-            refuse(name, value, why)
-        refuse("--plot", plot, why)
-        options = {"operators": operators, "deadzones": deadzones, "degree": degree}
-        options.update(fit=fit, everett=everett, grid=grid, regularization=regularization)
-        options.update(constraints=constraints, initial_memory=initial_memory)
-        _check_options(kind, options)
-        identify_multiaxis(
-            data,
-            output,
-            kind=kind,
-            options=options,
-            columns=columns,
-            sample_rate=sample_rate,
-            x_unit=x_unit,
-            quiet=quiet,
-            transient=transient,
-            voltage_range=voltage_range,
-            allow_extrapolation=allow_extrapolation,
-            n_jobs=n_jobs,
+    options = {"operators": operators, "deadzones": deadzones, "regularization": regularization}
+    options.update(degree=degree, fit=fit, everett=everett, grid=grid, constraints=constraints)
+    options["initial_memory"] = initial_memory
+    multi = is_multiaxis(data, columns)
+    if multi:  # N coupled axes: each axis's model and the coupling
+        given = {"--model dynamics": kind == "dynamics" or None, "--holdout": holdout}
+        refuse({**given, "--dynamics-record": dynamics_record, "--plot": plot}, "an N-axis record")
+    elif kind == "dynamics":  # linear dynamics: a record of 'hystcomp excite dynamics'
+        given = {f"--{k.replace('_', '-')}": v for k, v in options.items()}
+        given.update({"--transient": transient, "--voltage-range": voltage_range})
+        refuse(
+            {**given, "--holdout": holdout, "--dynamics-record": dynamics_record},
+            "--model dynamics",
         )
-        return
-    if n_jobs is not None:
+    elif n_jobs is not None:
         raise click.UsageError("--jobs applies to N-axis records (columns v1..vN, x1..xN).")
-    if plot is not None:  # matplotlib is imported only when a figure is asked for
-        from hystcomp.experiment.fig_identification import FORMATS, plot_identification_result
-
-        if Path(plot).suffix.lower() not in FORMATS:
-            raise click.BadParameter(f"must end in {', '.join(FORMATS)}.", param_hint="--plot")
-        check_output_path(plot, inputs=inputs, what="figure")
-        if Path(plot).resolve() == Path(output).resolve():
-            raise click.BadParameter("names the same file as -o.", param_hint="--plot")
-    if kind == "dynamics":  # linear dynamics: a record of 'hystcomp excite dynamics'
-        from hystcomp.cli._dynamics import identify_dynamics
-
-        given = {"--operators": operators, "--deadzones": deadzones, "--degree": degree}
-        given.update({"--regularization": regularization, "--transient": transient})
-        given.update({"--voltage-range": voltage_range, "--holdout": holdout})
-        given["--initial-memory"] = initial_memory
-        given["--dynamics-record"] = dynamics_record
-        for name, value in given.items():
-            if value is not None:
-                raise click.UsageError(f"{name} does not apply to --model dynamics.")
-        identify_dynamics(read_record(data, **read_options(columns, sample_rate)), output, plot)
-        return
-    options = {"operators": operators, "deadzones": deadzones}
-    options.update(regularization=regularization, degree=degree, fit=fit, everett=everett)
-    options.update(grid=grid, constraints=constraints, initial_memory=initial_memory)
-    _check_options(kind, options)
-    if kind != "auto":
-        model = build_estimator(kind, voltage_range=voltage_range, **options)
-    rec = read_record(data, **read_options(columns, sample_rate, x_unit, quiet, data))
-    warn_x_unit(rec.x, data, quiet, x_unit)
-    n = len(rec)
-    n_fit = fit_samples(n, holdout)
-    if holdout is not None and not 2 <= n_fit < n:
-        raise IdentificationError(
-            f"--holdout {holdout} leaves {n_fit} of {n} samples to fit on; choose a fraction "
-            "that keeps samples on both sides."
-        )
-    why = None if voltage_range is None else extrapolation_error(voltage_range, rec.v[:n_fit])
-    if why is not None and not allow_extrapolation:
-        raise click.BadParameter(
-            f"{why}: the compensator would command voltages the model never saw. Give a "
-            "range within the record, record over the whole range, or pass "
-            "--allow-extrapolation.",
-            param_hint="'--voltage-range'",
-        )
-    fitting = {
-        "allow_extrapolation": allow_extrapolation,
-        "transient": transient,
-        "unit_check": False,  # checked above, before the fit, and silenced by --quiet
-    }
     if dynamics_record is not None and holdout is not None:
         raise click.UsageError(
             "--holdout does not apply with --dynamics-record: the pair's tracking is "
             "estimated on the dynamics record's triangles. Hold out without it."
         )
-    lines: list[str] = []
-    fitted = None  # the hysteresis model's identification, where auto made it
+    _check_options(kind, options)
+    if plot is not None:
+        check_plot(plot, inputs=inputs, output=output)
+    given = {k: v for k, v in options.items() if v is not None}
+    fitting = {"allow_extrapolation": allow_extrapolation, "transient": transient}
+    fitting["unit_check"] = False  # checked here before the fit, and silenced by --quiet
+    reading = read_options(columns, sample_rate, x_unit, quiet, data, reads=None)
+    if multi:
+        from hystcomp.io.multiaxis import read_axes
+        from hystcomp.workflows.multiaxis import identify_axes
+
+        table = read_axes(data, ("v", "x"), **reading)
+        with progress(f"identifying {table['v'].shape[1]} axes", quiet).ticking():
+            axes = identify_axes(
+                *(table[k] for k in "tvx"),
+                kind=kind,
+                n_jobs=n_jobs,
+                source=str(data),
+                voltage_range=voltage_range,
+                **fitting,
+                **given,
+            )
+        report(axes)
+        return write_model(axes.model, output)
+    if kind == "dynamics":
+        from hystcomp.experiment.fig_dynamics import plot_bode
+        from hystcomp.workflows.pair import identify_dynamics_record
+
+        found = identify_dynamics_record(read_record(data, **read_options(columns, sample_rate)))
+        report(found)
+        return write_model(found.model, output, plot, lambda path: plot_bode(found.model, path))
+    model = kind if kind == "auto" else build_estimator(kind, voltage_range=voltage_range, **given)
+    rec = read_record(data, **reading)
+    warn_x_unit(rec.x, data, quiet, x_unit)
     if kind == "auto":
         from hystcomp.workflows.auto import identify_best
 
@@ -362,38 +319,32 @@ def identify(
             voltage_range=voltage_range,
             holdout=holdout,
             progress=lambda k: progress(f"identifying the {LABELS[k]} model", quiet).ticking(),
-            **{k: v for k, v in options.items() if v is not None},
+            **given,
             **fitting,
         )
-        lines += chosen.lines
-        fitted = chosen.best
+        said, result = [chosen], chosen.best  # the results whose report is printed, in order
     else:
         fitting["progress"] = progress(f"identifying the {LABELS[kind]} model", quiet).ticking()
+        said, result = [], None
     if dynamics_record is None:
-        result = fitted or identify_record(rec, model, holdout=holdout, **fitting)
-        lines, warnings, written = lines + result.lines, result.warnings, result.model
+        result = result or identify_record(rec, model, holdout=holdout, **fitting)
+        said.append(result)
+        written = result.model
     else:
         from hystcomp.workflows.pair import identify_pair_record
 
         dyn = read_record(dynamics_record, **read_options(columns, sample_rate))
-        if fitted is not None:
-            paired = identify_pair_record(rec, dyn, fitted.model, hysteresis=fitted)
-        else:
+        if result is None:
             paired = identify_pair_record(rec, dyn, model, **fitting)
-        result = paired.hysteresis
-        lines = lines + result.lines + paired.lines
-        warnings = result.warnings + paired.warnings
-        written = paired.model
-    for line in lines:
-        click.echo(line)
-    for warning in warnings:
-        click.echo(f"hystcomp: warning: {warning}", err=True)
-    # Everything is computed; now write all outputs at once (a failure writes none of them).
-    text = model_text(written)
-    outputs = [output] if plot is None else [output, plot]
-    with atomic_paths(*outputs) as (tmp_model, *tmp_plot):
-        tmp_model.write_text(text, encoding="utf-8")
-        if plot is not None:  # the fitted part, and the hold-out as the model predicts it
-            plot_identification_result(rec, result, tmp_plot[0])
-    for path in outputs[::-1]:
-        click.echo(f"  wrote {path}")
+        else:  # the model auto fitted, not fitted again
+            paired = identify_pair_record(rec, dyn, result.model, hysteresis=result)
+        result, written = paired.hysteresis, paired.model
+        said += [result, paired]
+    report(*said)
+
+    def draw(path):  # the fitted part, and the hold-out as the model predicts it
+        from hystcomp.experiment.fig_identification import plot_identification_result
+
+        plot_identification_result(rec, result, path)
+
+    write_model(written, output, plot, draw)

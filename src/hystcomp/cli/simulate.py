@@ -1,12 +1,13 @@
-"""``hystcomp simulate``: a model's displacement for a voltage input."""
+"""``hystcomp simulate``: a model's displacement for a voltage input.
+
+The work is :func:`hystcomp.workflows.simulate.simulate_voltage`.
+"""
 
 from __future__ import annotations
 
 import click
-import numpy as np
 
-from hystcomp.cli import main
-from hystcomp.cli._dynamics import dynamics_for
+from hystcomp.cli import main, report
 from hystcomp.cli._options import (
     check_data_output,
     columns_option,
@@ -18,10 +19,11 @@ from hystcomp.cli._options import (
     warn_x_unit,
     x_unit_option,
 )
-from hystcomp.errors import ModelFileError
 from hystcomp.io.models import load_model
+from hystcomp.io.multiaxis import read_axes
 from hystcomp.io.records import read_table, write_table
-from hystcomp.models.hammerstein import HammersteinModel
+from hystcomp.models.multiaxis import MultiAxisModel
+from hystcomp.workflows.simulate import simulate_voltage
 
 
 @main.command("simulate")
@@ -43,68 +45,35 @@ def simulate(model_file, input_file, output, columns, sample_rate, x_unit, quiet
     """
     check_data_output(output, inputs=(model_file, input_file), what="result file")
     model = load_model(model_file)
-    if getattr(model, "kind", None) == "multiaxis":  # N coupled axes: t, v1..vN -> x1..xN
-        from hystcomp.cli._multiaxis import simulate_multiaxis
-
-        simulate_multiaxis(
-            model,
-            model_file,
-            input_file,
-            output,
-            columns=columns,
-            sample_rate=sample_rate,
-            x_unit=x_unit,
-            quiet=quiet,
-        )
-        return
-    if getattr(model, "kind", None) == "dynamics":
-        raise ModelFileError(
-            f"{str(model_file)!r} holds linear dynamics, not a hysteresis model; simulate "
-            "runs a PI, MPI or Preisach model file on a voltage (the dynamics act on a "
-            "displacement: LinearDynamics.simulate in Python)."
-        )
-    table = read_table(
-        input_file,
-        ("v",),
-        optional=("x",),
-        **read_options(columns, sample_rate, x_unit, quiet, input_file, reads=("v", "x")),
-    )
-    if "x" in table:  # a measured displacement to validate against: in µm, like the model
-        warn_x_unit(table["x"], input_file, quiet, x_unit)
-    if isinstance(model, HammersteinModel):  # discrete-time dynamics: at their rate only
-        dynamics_for(model.dynamics, table)
+    multi = isinstance(model, MultiAxisModel)  # N coupled axes: t, v1..vN -> x1..xN
+    reading = read_options(columns, sample_rate, x_unit, quiet, input_file, reads=None)
+    if multi:
+        table = read_axes(input_file, ("v",), **reading)
+    else:
+        reading = read_options(columns, sample_rate, x_unit, quiet, input_file)
+        table = read_table(input_file, ("v",), optional=("x",), **reading)
+        if "x" in table:  # a measured displacement to validate against: in µm, like the model
+            warn_x_unit(table["x"], input_file, quiet, x_unit)
     v = table["v"]
-    lo, hi = getattr(model, "voltage_range_", (-float("inf"), float("inf")))
-    if v.min() < lo or v.max() > hi:
-        click.echo(
-            f"hystcomp: warning: the input ({v.min():.4g} .. {v.max():.4g} V) leaves the "
-            f"model's voltage range ({lo:.4g} .. {hi:.4g} V); the model extrapolates there.",
-            err=True,
-        )
-    with progress("simulating", quiet).ticking():
-        x = model.simulate(v)
-    written = progress(f"writing {output}", quiet)
-    write_table(output, {"t": table["t"], "v": v, "x": x}, progress=written)
-    click.echo(f"wrote {output}: {x.size} samples, x from {x.min():.4g} to {x.max():.4g} µm")
-    if "x" in table:
-        click.echo(_validation(v, table["x"], x, input_file))
-
-
-def _validation(v, measured, x, source) -> str:
-    """One line: the model's error against the measured displacement of ``source``, after
-    its start-up transient (where the model's memory and the stage's may differ), beside
-    a straight line fitted to that record."""
-    from hystcomp.identify.scoring import error_report, straight_line, transient_end
-
-    start = transient_end(v)
-    if v.size - start < max(10, v.size // 10):  # too little left after it: score it all
-        start = 0
-    model = error_report(measured, x, start)
-    a, b = straight_line(v[start:], measured[start:])
-    line = float(np.sqrt(np.mean((a * v[start:] + b - measured[start:]) ** 2)))
-    after = f" from sample {start + 1} (after the start-up transient)" if start else ""
-    return (
-        f"  against the measured x of {source}{after}: model rms {model['rms_error_um']:.4g} "
-        f"µm, max {model['max_error_um']:.4g} µm; a straight line fitted to it: rms "
-        f"{line:.4g} µm"
+    result = simulate_voltage(
+        model,
+        table["t"],
+        v,
+        measured=table.get("x"),
+        source=str(model_file),
+        data=str(input_file),
+        progress=progress("simulating", quiet).ticking(),
     )
+    report(result, lines=False)
+    x = result.x
+    out = {"t": table["t"]}
+    if multi:
+        out.update({f"v{i + 1}": v[:, i] for i in range(model.n_axes)})
+        out.update({f"x{i + 1}": x[:, i] for i in range(model.n_axes)})
+        summary = f"{x.shape[0]} samples of {model.n_axes} axes"
+    else:
+        out.update(v=v, x=x)
+        summary = f"{x.size} samples, x from {x.min():.4g} to {x.max():.4g} µm"
+    write_table(output, out, progress=progress(f"writing {output}", quiet))
+    click.echo(f"wrote {output}: {summary}")
+    report(result, warnings=False)
