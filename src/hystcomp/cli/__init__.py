@@ -24,7 +24,6 @@ import click
 
 from hystcomp import _signals
 from hystcomp._notice import worded
-from hystcomp._program import command_line as run  # noqa: F401  (the program's end)
 from hystcomp.errors import HystcompError, InvalidParameterError
 
 EXIT_BAD_INPUT, EXIT_INTERNAL = 2, 1

@@ -210,18 +210,6 @@ def write_model(model, output, plot=None, draw=None) -> None:
     write_files(writers if plot is None else {**writers, plot: draw}, reverse=True)
 
 
-def table_of(t, **signals) -> dict:
-    """``t`` and each signal as the columns of a data file: ``v``, or ``v1..vN`` for a
-    signal with one column per axis (``x_ref``: ``x1_ref..xN_ref``)."""
-    out = {"t": t}
-    for name, s in signals.items():
-        if s.ndim == 1:
-            out[name] = s
-        else:
-            out.update({f"{name[0]}{i + 1}{name[1:]}": s[:, i] for i in range(s.shape[1])})
-    return out
-
-
 def write_signal(table: dict, output, quiet: bool, summary: str) -> None:
     """Write ``table`` to ``output`` and say ``summary``, or print it as CSV without one."""
     from hystcomp.io.records import write_table

@@ -14,8 +14,8 @@ from hystcomp.cli import _options as opts
 from hystcomp.cli import command, report
 from hystcomp.cli import option as cli_option
 from hystcomp.io.models import load_model
-from hystcomp.io.multiaxis import read_axes
-from hystcomp.io.records import read_table, write_table
+from hystcomp.io.multiaxis import axis_table, read_axes
+from hystcomp.io.records import read_table
 from hystcomp.models.multiaxis import MultiAxisModel
 from hystcomp.workflows.compensate import (
     compensate_reference,
@@ -43,11 +43,8 @@ def compensate(model_file, reference_file, output, dynamics_file, **o):
     model = load_model(model_file)
     refuse_dynamics_as_model(model, model_file)
     multi = isinstance(model, MultiAxisModel)  # t, x1..xN -> t, v1..vN, x1_ref..xN_ref
-    if multi and dynamics_file is not None:
-        raise click.UsageError("--dynamics does not apply to a multi-axis model.")
     dynamics = None if dynamics_file is None else load_dynamics(dynamics_file)
-    reads = None if multi else ("x",)
-    options = opts.read_options(o, reference_file, reads=reads)
+    options = opts.read_options(o, reference_file, reads=None if multi else ("x",))
     table = (read_axes if multi else read_table)(reference_file, ("x",), **options)
     if not multi:
         opts.warn_x_unit(table["x"], reference_file, o)
@@ -62,14 +59,10 @@ def compensate(model_file, reference_file, output, dynamics_file, **o):
         slew_rate=o["slew_rate"],
         dynamics=dynamics,
         strict=o["strict"],
-        progress=opts.progress(
-            f"computing the voltage{'s' if multi else ''}", o["quiet"]
-        ).ticking(),
+        progress=opts.progress("computing the voltage" + "s" * multi, o["quiet"]).ticking(),
     )
     report(result)
     v, x = result.v, table["x"]
-    out = opts.table_of(table["t"], v=v, x_ref=x)
-    write_table(output, out, progress=opts.progress(f"writing {output}", o["quiet"]))
     if multi:
         ranges = ", ".join(f"v{i + 1} {c.min():.4g} .. {c.max():.4g} V" for i, c in enumerate(v.T))
         summary = f"{len(v)} samples of {v.shape[1]} axes ({ranges}; {sum(result.clamped)} clamped)"
@@ -79,7 +72,7 @@ def compensate(model_file, reference_file, output, dynamics_file, **o):
             f"{v.size} samples, v from {v.min():.4g} to {v.max():.4g} V (range {lo:.4g} .. "
             f"{hi:.4g} V, {result.clamped} clamped)"
         )
-    click.echo(f"wrote {output}: {summary}")
+    opts.write_signal(axis_table(table["t"], v=v, x_ref=x), output, o["quiet"], summary)
     if result.preview is not None:
         click.echo(
             f"  with the inverse of the dynamics of {dynamics_file or model_file}: "

@@ -11,6 +11,7 @@ from hystcomp.cli import _options as opts
 from hystcomp.cli import command
 from hystcomp.cli import option as cli_option
 from hystcomp.identify.excitation import DEFAULT_SAMPLE_RATE, SIGNAL_KINDS, excitation_signal
+from hystcomp.io.multiaxis import axis_table
 
 option = functools.partial(cli_option, "excite")
 
@@ -62,4 +63,4 @@ def excite(model, output, axes, quiet, **signal):
         t, v = excitation_signal(model, **signal)
     each = f" of {axes} axes" if axes else ""
     what = f"{t.size} samples{each} at {signal['sample_rate']:g} Hz ({t[-1]:g} s)"
-    opts.write_signal(opts.table_of(t, v=v), output, quiet, what)
+    opts.write_signal(axis_table(t, v=v), output, quiet, what)

@@ -21,7 +21,8 @@ from hystcomp.identify.preisach_lsq import MAX_LSQ_GRID
 from hystcomp.io.atomic import check_output_path
 from hystcomp.io.multiaxis import is_multiaxis
 from hystcomp.io.records import read_record
-from hystcomp.workflows.identify import LABELS, SIZE_OPTIONS, build_estimator, identify_record
+from hystcomp.workflows.identify import LABELS, SIZE_OPTIONS
+from hystcomp.workflows.record import identify_model
 
 option = functools.partial(cli_option, "identify")
 #: The options that size or shape the hysteresis model (:data:`SIZE_OPTIONS`).
@@ -95,11 +96,6 @@ def identify(data, kind, output, plot, dynamics_record, holdout, voltage_range, 
         refuse(given, "--model dynamics")
     elif o["n_jobs"] is not None:
         raise click.UsageError("--jobs applies to N-axis records (columns v1..vN, x1..xN).")
-    if dynamics_record is not None and holdout is not None:
-        raise click.UsageError(
-            "--holdout does not apply with --dynamics-record: the pair's tracking is "
-            "estimated on the dynamics record's triangles. Hold out without it."
-        )
     _check_options(kind, options)
     if plot is not None:
         opts.check_plot(plot, inputs=inputs, output=output)
@@ -129,46 +125,26 @@ def identify(data, kind, output, plot, dynamics_record, holdout, voltage_range, 
         report(axes)
         return opts.write_model(axes.model, output)
     plain = opts.read_options({**o, "x_unit": None, "quiet": True})  # a dynamics record
-    if kind == "dynamics":
+    rec = read_record(data, **(plain if kind == "dynamics" else reading))
+    if kind != "dynamics":
+        opts.warn_x_unit(rec.x, data, o)
+    dyn = None if dynamics_record is None else read_record(dynamics_record, **plain)
+    found = identify_model(
+        rec,
+        kind,
+        dynamics_record=dyn,
+        holdout=holdout,
+        progress=lambda k: ticking(f"the {LABELS[k]} model"),
+        **({} if kind == "dynamics" else {"voltage_range": voltage_range, **fitting, **given}),
+    )
+    report(found)
+
+    def draw(path):  # the fitted part and the hold-out as the model predicts it, or a Bode plot
         from hystcomp.experiment.fig_dynamics import plot_bode
-        from hystcomp.workflows.pair import identify_dynamics_record
-
-        found = identify_dynamics_record(read_record(data, **plain))
-        report(found)
-        return opts.write_model(found.model, output, plot, lambda to: plot_bode(found.model, to))
-    model = kind if kind == "auto" else build_estimator(kind, voltage_range=voltage_range, **given)
-    rec = read_record(data, **reading)
-    opts.warn_x_unit(rec.x, data, o)
-    said, result = [], None  # the results whose report is printed, in order
-    if kind == "auto":
-        from hystcomp.workflows.auto import identify_best
-
-        progress = {"progress": lambda k: ticking(f"the {LABELS[k]} model")}
-        chosen = identify_best(
-            rec, voltage_range=voltage_range, holdout=holdout, **progress, **given, **fitting
-        )
-        said, result = [chosen], chosen.best
-    else:
-        fitting["progress"] = ticking(f"the {LABELS[kind]} model")
-    if dynamics_record is None:
-        result = result or identify_record(rec, model, holdout=holdout, **fitting)
-        said.append(result)
-        written = result.model
-    else:
-        from hystcomp.workflows.pair import identify_pair_record
-
-        dyn = read_record(dynamics_record, **plain)
-        if result is None:
-            paired = identify_pair_record(rec, dyn, model, **fitting)
-        else:  # the model auto fitted, not fitted again
-            paired = identify_pair_record(rec, dyn, result.model, hysteresis=result)
-        result, written = paired.hysteresis, paired.model
-        said += [result, paired]
-    report(*said)
-
-    def draw(path):  # the fitted part, and the hold-out as the model predicts it
         from hystcomp.experiment.fig_identification import plot_identification_result
 
-        plot_identification_result(rec, result, path)
+        if found.hysteresis is None:
+            return plot_bode(found.model, path)
+        plot_identification_result(rec, found.hysteresis, path)
 
-    opts.write_model(written, output, plot, draw)
+    opts.write_model(found.model, output, plot, draw)

@@ -10,8 +10,8 @@ import click
 from hystcomp.cli import _options as opts
 from hystcomp.cli import command, option, report
 from hystcomp.io.models import load_model
-from hystcomp.io.multiaxis import read_axes
-from hystcomp.io.records import read_table, write_table
+from hystcomp.io.multiaxis import axis_table, read_axes
+from hystcomp.io.records import read_table
 from hystcomp.models.multiaxis import MultiAxisModel
 from hystcomp.workflows.simulate import simulate_voltage
 
@@ -44,10 +44,9 @@ def simulate(model_file, input_file, output, **o):
     )
     report(result, lines=False)
     x = result.x
-    out = opts.table_of(table["t"], v=table["v"], x=x)
-    write_table(output, out, progress=opts.progress(f"writing {output}", o["quiet"]))
     if multi:
-        click.echo(f"wrote {output}: {x.shape[0]} samples of {x.shape[1]} axes")
+        summary = f"{x.shape[0]} samples of {x.shape[1]} axes"
     else:
-        click.echo(f"wrote {output}: {x.size} samples, x from {x.min():.4g} to {x.max():.4g} µm")
+        summary = f"{x.size} samples, x from {x.min():.4g} to {x.max():.4g} µm"
+    opts.write_signal(axis_table(table["t"], v=table["v"], x=x), output, o["quiet"], summary)
     report(result, warnings=False)

@@ -231,15 +231,7 @@ def inverse_for(
         ``model.inverse(...)``, its warnings left to the caller (see :data:`APART`).
     """
     pair = isinstance(model, HammersteinModel)
-    if dynamics is not None and (pair or isinstance(model, MultiAxisModel)):
-        what = (
-            "a hysteresis model and its dynamics, identified as one pair; its inverse inverts both"
-            if pair
-            else "a multi-axis model, whose inverse takes no dynamics"
-        )
-        raise ModelFileError(
-            Notice("{path} holds {what}. {drop_dynamics}.", path=repr(source), what=what)
-        )
+    _no_dynamics(model, dynamics, source)
     options: dict[str, Any] = {"slew_rate": slew_rate, "voltage_range": voltage_range}
     if not pair:  # the pair runs at its own rate
         options["sample_rate"] = sample_rate
@@ -261,6 +253,20 @@ def inverse_for(
     with _warnings.catch_warnings():
         _warnings.simplefilter("ignore", HystcompWarning)  # the caller says them as it words
         return model.inverse(**options)
+
+
+def _no_dynamics(model, dynamics, source: str) -> None:
+    """Refuse dynamics given apart for a pair (which has its own) or an N-axis model."""
+    pair = isinstance(model, HammersteinModel)
+    if dynamics is not None and (pair or isinstance(model, MultiAxisModel)):
+        what = (
+            "a hysteresis model and its dynamics, identified as one pair; its inverse inverts both"
+            if pair
+            else "a multi-axis model, whose inverse takes no dynamics"
+        )
+        raise ModelFileError(
+            Notice("{path} holds {what}. {drop_dynamics}.", path=repr(source), what=what)
+        )
 
 
 def compensate_reference(
@@ -318,6 +324,7 @@ def compensate_reference(
             f"{reference!r} holds references for {k} axes (x1..x{k}), but {source} is a "
             f"model of {n} axes: give one column per axis, x1..x{n}."
         )
+    _no_dynamics(model, dynamics, source)
     told: list[str] = []
     rate = None if slew_rate is None else slew_sample_rate(t, reference)
     if pair:
