@@ -37,8 +37,8 @@ import numpy as np
 
 import hystcomp
 from hystcomp.codegen import export_c
-from hystcomp.workflows.identify import identify_record
 from hystcomp.io.records import parse_columns
+from hystcomp.workflows.identify import identify_record
 
 RECORD = Path(__file__).resolve().parents[1] / "tests/data/piezo-micromanipulator/Model_Vi_Do.dat"
 FLAGS = ["-std=c99", "-O2", "-Wall", "-Wextra", "-Werror", "-pedantic"]
