@@ -100,8 +100,10 @@ class _Command(click.Command):
             return super().invoke(ctx)
         except InvalidParameterError as exc:
             found = _PARAMETER.fullmatch(say(exc.args[0] if len(exc.args) == 1 else exc))
-            name = found and OPTIONS.get(found["name"], "--" + found["name"].replace("_", "-"))
-            option = next((p for p in self.params if name in p.opts), None) if name else None
+            if found is None:
+                raise
+            name = OPTIONS.get(found["name"], "--" + found["name"].replace("_", "-"))
+            option = next((p for p in self.params if name in p.opts), None)
             if option is not None and ctx.params.get(option.name) is not None:  # given
                 raise click.BadParameter(found["rest"], ctx, param_hint=f"'{name}'") from None
             raise

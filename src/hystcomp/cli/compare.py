@@ -6,6 +6,7 @@ The work is :func:`hystcomp.workflows.compare.compare_on_twin`.
 from __future__ import annotations
 
 import time
+from typing import Any
 
 import click
 
@@ -25,7 +26,9 @@ def compare(out_dir: str, seed: int, periods: int | None, quick: bool, quiet: bo
     from hystcomp.workflows.compare import compare_on_twin
 
     start = time.perf_counter()
-    changes = {"seed": seed} if periods is None else {"seed": seed, "periods": periods}
+    changes: dict[str, Any] = {"seed": seed}
+    if periods is not None:
+        changes["periods"] = periods
     config = CompareConfig.quick(**changes) if quick else CompareConfig(**changes)
 
     def progress(line: str) -> None:

@@ -25,9 +25,8 @@ from hystcomp.workflows.identify import LABELS, SIZE_OPTIONS
 from hystcomp.workflows.record import identify_model
 
 option = functools.partial(cli_option, "identify")
-#: The options that size or shape the hysteresis model (:data:`SIZE_OPTIONS`).
-FAMILY = ("operators", "deadzones", "regularization", "degree", "fit", "everett", "grid")
-FAMILY += ("constraints", "initial_memory")
+#: The options that size or shape the hysteresis model, of every family.
+FAMILY = list(dict.fromkeys(name for names in SIZE_OPTIONS.values() for name in names))
 
 
 def _check_options(kind: str, given: dict) -> None:
@@ -114,7 +113,9 @@ def identify(data, kind, output, plot, dynamics_record, holdout, voltage_range, 
         table = read_axes(data, ("v", "x"), **reading)
         with ticking(f"{table['v'].shape[1]} axes"):
             axes = identify_axes(
-                *(table[k] for k in "tvx"),
+                table["t"],
+                table["v"],
+                table["x"],
                 kind=kind,
                 n_jobs=o["n_jobs"],
                 source=str(data),

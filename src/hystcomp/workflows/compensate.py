@@ -414,7 +414,7 @@ def _refused(what: str, strict: bool, remedy: str, accept: str = "") -> Notice:
 def _clamped_axes(model, compensator, run, X, strict: bool) -> list[str]:
     """A warning per axis of an N-axis run that clamped samples (the first refused if strict)."""
     H = X @ np.asarray(compensator.decoupling).T
-    told = []
+    told: list[str] = []
     for i, clamped in enumerate(run.clamped):
         if not clamped:
             continue
