@@ -550,11 +550,8 @@ def export_compensator(
     prefix: str,
     source: str = "the model",
     sample_rate: float,
-    slew_rate=None,
-    voltage_range=None,
-    method=None,
-    dynamics=None,
     inputs=(),
+    **inverse,
 ) -> ExportResult:
     """Write the compensator of ``model`` as C99 code (:mod:`hystcomp.codegen`).
 
@@ -571,10 +568,10 @@ def export_compensator(
     sample_rate : float
         The rate in Hz at which the step function is called; a pair's dynamics, or
         ``dynamics``, must have been identified at it.
-    slew_rate, voltage_range, method, dynamics
-        As :func:`inverse_for`.
     inputs : sequence of path-like, optional
         Files the outputs must not overwrite.
+    **inverse
+        ``slew_rate``, ``voltage_range``, ``method``, ``dynamics``: as :func:`inverse_for`.
 
     Returns
     -------
@@ -584,6 +581,7 @@ def export_compensator(
     from hystcomp.codegen.multiaxis import export_multiaxis_c
 
     own = model.dynamics if isinstance(model, HammersteinModel) else None
+    dynamics = inverse.get("dynamics")
     for dyn in (d for d in (own, dynamics) if d is not None):
         if abs(dyn.sample_rate_ - sample_rate) > 1e-6 * sample_rate:
             raise InvalidParameterError(
@@ -591,15 +589,7 @@ def export_compensator(
                 f"the dynamics were identified at {dyn.sample_rate_:g} Hz; the code must run "
                 "at the dynamics' rate."
             )
-    compensator = inverse_for(
-        model,
-        source=source,
-        voltage_range=voltage_range,
-        method=method,
-        slew_rate=slew_rate,
-        sample_rate=sample_rate,
-        dynamics=dynamics,
-    )
+    compensator = inverse_for(model, source=source, sample_rate=sample_rate, **inverse)
     write = export_multiaxis_c if isinstance(model, MultiAxisModel) else export_c
     options = {"prefix": prefix, "source": source, "sample_rate": sample_rate, "inputs": inputs}
     paths = list(write(compensator, directory, **options))

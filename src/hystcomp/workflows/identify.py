@@ -160,50 +160,36 @@ def build_estimator(
                 f"The {name!r} option of build_estimator does not apply to kind {kind!r}, "
                 f"which takes {', '.join(SIZE_OPTIONS[kind])}; got {name}={value!r}. Leave it out."
             )
-    params = {"voltage_range": voltage_range}
-    if "operators" in SIZE_OPTIONS[kind]:
-        params["n_operators"] = DEFAULT_OPERATORS if operators is None else operators
-    if "deadzones" in SIZE_OPTIONS[kind]:
-        params["n_deadzones"] = DEFAULT_OPERATORS if deadzones is None else deadzones
-    if regularization is not None:
-        params["regularization"] = regularization
-    if initial_memory is not None:
-        params["initial_memory"] = initial_memory
-    if degree is not None:
-        params["degree"] = degree
-    if kind == "preisach":
-        params.update(_everett_params(fit, everett, degree, grid))
-        if constraints is not None:
-            params["zero_diagonal"] = (
-                check_constraints(constraints, "build_estimator") == "physical"
+    for name, value, wants, other in (
+        ("degree", degree, "polynomial", "table"),
+        ("grid", grid, "table", "polynomial"),
+    ):
+        if value is not None and everett == other:
+            raise InvalidParameterError(
+                f"The {name!r} option of build_estimator applies to everett={wants!r}; got "
+                f"{name}={value!r} with everett={other!r}. A {other} takes "
+                f"{'grid' if name == 'degree' else 'degree'!r}."
             )
-    elif constraints is not None:
-        params["constraints"] = constraints
+    if degree is not None and everett is None:
+        given["everett"] = "polynomial"  # a degree names eq. 5's polynomial, not the table
+    params = {"voltage_range": voltage_range}
+    for name in ("operators", "deadzones"):
+        if name in SIZE_OPTIONS[kind]:
+            params[f"n_{name}"] = DEFAULT_OPERATORS if given[name] is None else given[name]
+    params.update({_HYPERPARAMETERS.get(k, k): v for k, v in given.items() if v is not None})
+    if kind == "preisach" and constraints is not None:
+        check_constraints(constraints, "build_estimator")
+        params["zero_diagonal"] = params.pop("constraints") == "physical"
     return cls(**params)
 
 
-def _everett_params(fit, everett, degree, grid) -> dict:
-    """The Preisach estimator's ``fit_method``, ``everett`` and ``grid_size`` from the options."""
-    if everett == "table" and degree is not None:
-        raise InvalidParameterError(
-            f"The 'degree' option of build_estimator applies to everett='polynomial'; got "
-            f"degree={degree!r} with everett='table'. A table takes 'grid'."
-        )
-    if grid is not None and everett == "polynomial":
-        raise InvalidParameterError(
-            f"The 'grid' option of build_estimator applies to everett='table'; got "
-            f"grid={grid!r} with everett='polynomial'. A polynomial takes 'degree'."
-        )
-    if degree is not None and everett is None:
-        everett = "polynomial"  # a degree names the polynomial of eq. 5, not the default table
-    params = {}
-    if fit is not None:
-        params["fit_method"] = fit
-    if everett is not None:
-        params["everett"] = everett
-    if grid is not None:
-        params["grid_size"] = grid
-    return params
+#: The estimator's name of an option where it is not the option's.
+_HYPERPARAMETERS = {
+    "operators": "n_operators",
+    "deadzones": "n_deadzones",
+    "fit": "fit_method",
+    "grid": "grid_size",
+}
 
 
 def fit_samples(n: int, holdout: float | None) -> int:
