@@ -425,9 +425,13 @@ def identify_record(
         why = extrapolation_error(chosen_range, v)
         if why is not None:
             raise InvalidParameterError(
-                f"The 'voltage_range' of {_OWNER}, {why}: the compensator would command "
-                "voltages the model never saw. Give a range within the record, record over "
-                "the whole range, or pass allow_extrapolation=True."
+                Notice(
+                    f"The 'voltage_range' argument of {_OWNER}, "
+                    "{why}: the compensator would command voltages the model never saw. Give "
+                    "a range within the record, record over the whole range, or pass "
+                    "{allow_extrapolation}.",
+                    why=why,
+                )
             )
     if transient is None:
         start = transient_end(v)
