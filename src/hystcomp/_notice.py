@@ -48,7 +48,7 @@ def _keys(template: str) -> set[str]:
 
 
 def _fill(template: str, words: Mapping[str, str], data: Mapping[str, Any]) -> str:
-    names = {k: words[k].format(**data) for k in _keys(template) if k in words}
+    names = {k: words[k].format(**data) for k in _keys(template) if k in words and k not in data}
     return template.format(**data, **names)
 
 
@@ -59,7 +59,8 @@ class Notice(str):
     ----------
     template : str
         The sentence, with ``{key}`` where a remedy is named (a key of :data:`PYTHON`) and
-        ``{name}`` for a value of ``data``; no other braces.
+        ``{name}`` for a value of ``data`` (which a remedy of the same key gives way to);
+        no other braces.
     kind : str, optional
         What it is about (``'line'``, ``'coverage'``, ...), for a caller that sorts them.
     **data

@@ -15,7 +15,7 @@ from hystcomp.cli import command, report
 from hystcomp.cli import option as cli_option
 from hystcomp.io.models import load_model
 from hystcomp.io.multiaxis import axis_table, read_axes
-from hystcomp.io.records import read_table
+from hystcomp.io.records import read_table, write_table
 from hystcomp.models.multiaxis import MultiAxisModel
 from hystcomp.workflows.compensate import (
     compensate_reference,
@@ -72,7 +72,9 @@ def compensate(model_file, reference_file, output, dynamics_file, **o):
             f"{v.size} samples, v from {v.min():.4g} to {v.max():.4g} V (range {lo:.4g} .. "
             f"{hi:.4g} V, {result.clamped} clamped)"
         )
-    opts.write_signal(axis_table(table["t"], v=v, x_ref=x), output, o["quiet"], summary)
+    written = opts.progress(f"writing {output}", o["quiet"])
+    write_table(output, axis_table(table["t"], v=v, x_ref=x), progress=written)
+    click.echo(f"wrote {output}: {summary}")
     if result.preview is not None:
         click.echo(
             f"  with the inverse of the dynamics of {dynamics_file or model_file}: "

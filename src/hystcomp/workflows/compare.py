@@ -73,9 +73,9 @@ def compare_on_twin(
     parent = os.path.dirname(os.path.abspath(out_dir)) if out_dir else "."
     if not os.path.isdir(parent):  # as every output refuses a file's missing folder
         raise InvalidParameterError(
-            f"The 'out_dir' argument of compare_on_twin, the folder {out_dir!r}, cannot be "
-            f"made: its parent folder {parent!r} does not exist. Create it first or choose "
-            "another folder."
+            f"The 'out_dir' argument of compare_on_twin names the folder {out_dir!r}, which "
+            f"cannot be made: its parent folder {parent!r} does not exist. Create it first or "
+            "choose another folder."
         )
 
     def step(line: str) -> None:

@@ -342,11 +342,11 @@ def compensate_reference(
         if strict:
             raise ModelFileError(
                 Notice(
-                    "{model} and the dynamics were identified apart, so whether their "
+                    "{source} and the dynamics were identified apart, so whether their "
                     "inverse tracks better than the hysteresis model's alone cannot be "
                     "predicted. {strict}; identify them as one pair ({identify_pair}), or "
                     "{drop_strict}.",
-                    model=source,
+                    source=source,
                 )
             )
         told.append(APART)
