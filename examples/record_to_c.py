@@ -4,7 +4,7 @@ A lab's path from its own measurement to firmware, in one script:
 
 1. read the record as it is (here the vendored micromanipulator record: no time column,
    200 Hz, a 0..3.6 V command, a sensor offset), naming its columns and sample rate;
-2. identify a model with :func:`hystcomp.identify.workflow.identify_record`, fitting the first
+2. identify a model with :func:`hystcomp.workflows.identify.identify_record`, fitting the first
    half and predicting the second, and print its report: the fit, the hold-out, and the
    compensator's estimated tracking beside a straight line's;
 3. save the model file and export its compensator as C99 (``NAME.h``, ``NAME.c``);
@@ -37,8 +37,8 @@ import numpy as np
 
 import hystcomp
 from hystcomp.codegen import export_c
-from hystcomp.identify.workflow import identify_record
 from hystcomp.io.records import parse_columns
+from hystcomp.workflows.identify import identify_record
 
 RECORD = Path(__file__).resolve().parents[1] / "tests/data/piezo-micromanipulator/Model_Vi_Do.dat"
 FLAGS = ["-std=c99", "-O2", "-Wall", "-Wextra", "-Werror", "-pedantic"]

@@ -21,9 +21,9 @@ from hystcomp.errors import (
     ModelFileError,
     NotFittedError,
 )
-from hystcomp.identify.workflow import _verdict
 from hystcomp.io.models import model_from_dict, model_to_dict
 from hystcomp.io.records import write_table
+from hystcomp.workflows.identify import _verdict
 
 
 def run(*args):

@@ -22,13 +22,13 @@ LAYERS = {
     "hystcomp._validation": 1,
     "hystcomp._blas": 1,
     "hystcomp._hyperparameters": 1,
+    "hystcomp._notice": 1,
     "hystcomp._progress": 1,
     "hystcomp._lti": 1,
     "hystcomp._kernels": 1,
     "hystcomp.io.atomic": 1,
     "hystcomp.identify": 2,  # the array-level fits the models delegate to
     "hystcomp.models": 3,
-    "hystcomp.identify.workflow": 4,  # builds models from a record
     "hystcomp.io": 4,  # model files name every model class
     "hystcomp.plant": 4,
     "hystcomp.presets": 4,
@@ -118,4 +118,17 @@ def test_the_import_graph_has_no_cycle():
 
 def test_the_graph_sees_deferred_imports():
     # identify_record builds the models: the edge must be seen, or the checks above prove little
-    assert "hystcomp.models.pi" in _graph()["hystcomp.identify.workflow"]
+    assert "hystcomp.models.pi" in _graph()["hystcomp.workflows.identify"]
+
+
+def test_the_fits_import_no_estimator():
+    # identify/ sits below the models: the estimators delegate to it, never the reverse
+    graph = _graph()
+    upward = {
+        f"{module} imports {target}"
+        for module, targets in graph.items()
+        if module.startswith("hystcomp.identify")
+        for target in targets
+        if target.startswith("hystcomp.models")
+    }
+    assert upward == set()

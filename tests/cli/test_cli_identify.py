@@ -352,12 +352,14 @@ def test_mpi_regularization_reaches_the_fit_and_the_model_file(tmp_path):
 def test_the_program_flushes_then_ends_with_the_commands_status(
     monkeypatch, tmp_path, capsys, argv, status
 ):
-    from hystcomp import cli
+    import os
+
+    from hystcomp import _program
 
     ended = []
-    monkeypatch.setattr(cli.os, "_exit", ended.append)  # the real one would end pytest
+    monkeypatch.setattr(os, "_exit", ended.append)  # the real one would end pytest
     monkeypatch.setattr(sys, "argv", ["hystcomp", *(a.format(tmp=tmp_path) for a in argv)])
-    cli.run()
+    _program.command_line()
     assert ended == [status]
     err = capsys.readouterr().err
     assert err.startswith("hystcomp: error:") if status else "Traceback" not in err

@@ -11,9 +11,9 @@ import pytest
 from hystcomp import presets
 from hystcomp.experiment import fig_dynamics, fig_identification, fig_preisach
 from hystcomp.identify.excitation import triangle_sequence
-from hystcomp.identify.workflow import identify_record
 from hystcomp.io.records import read_record
 from hystcomp.models.mpi import ModifiedPrandtlIshlinskii
+from hystcomp.workflows.identify import identify_record
 
 REAL_RECORD = Path(__file__).parents[1] / "data" / "piezo-micromanipulator" / "Model_Vi_Do.dat"
 

@@ -151,7 +151,7 @@ def _record(tmp_path, v, x):
 def test_identify_warns_when_no_better_than_a_line_is_predicted(tmp_path, monkeypatch):
     _, v = triangle_sequence(sample_rate=1000.0)
     path = _record(tmp_path, v, presets.paper_mpi().simulate(v))
-    from hystcomp.identify import workflow
+    from hystcomp.workflows import identify as workflow
 
     def pessimistic(model, v, x, *, start=0):
         return {

@@ -18,13 +18,13 @@ from hystcomp.identify.excitation import (
     triangle_sequence,
 )
 from hystcomp.identify.scoring import coverage_warning, transient_end
-from hystcomp.identify.workflow import (
+from hystcomp.io.records import Record
+from hystcomp.models.dynamics import LinearDynamics
+from hystcomp.workflows.identify import (
     IdentificationResult,
     build_estimator,
     identify_record,
 )
-from hystcomp.io.records import Record
-from hystcomp.models.dynamics import LinearDynamics
 from hystcomp.workflows.pair import identify_dynamics_record
 
 FS = 1000.0  # Hz
@@ -150,7 +150,7 @@ def test_a_compensator_predicted_near_the_straight_line_is_warned_about(monkeypa
     """Within 0.8x of a line, a reference unlike the record can lose the margin: said, with
     the other models to try (the record has turning points across the range: no advice to
     record another)."""
-    from hystcomp.identify import workflow
+    from hystcomp.workflows import identify as workflow
 
     def estimate(model, v, x, *, start=0):
         return {
@@ -168,8 +168,15 @@ def test_a_compensator_predicted_near_the_straight_line_is_warned_about(monkeypa
     else:
         assert len(warnings) == 1
         assert f"predicted to track {says}" in warnings[0]
-        assert warnings[0].endswith("try --model pi or preisach.")
-        assert "excite rich" not in warnings[0]
+        assert warnings[0].endswith("try the model pi or preisach.")
+        assert warnings[0].kind == "line"
+        assert (
+            warnings[0]
+            .worded({"model": "--model {others}"})
+            .endswith("try --model pi or preisach.")
+        )
+        assert "excitation_signal('rich')" not in warnings[0]
+        assert "--model" not in warnings[0]  # the library holds no command-line words
 
 
 def test_a_record_must_be_a_record():
@@ -267,9 +274,12 @@ def test_a_record_that_drifts_across_the_range_once_is_a_warning():
     rec = Record(np.arange(v.size) / FS, v, presets.paper_mpi().simulate(v))
     warning = identify_record(rec, "pi", operators=8).warnings[-1]
     assert warning.startswith("after its start-up transient the record never rises over more")
+    assert warning.kind == "coverage"
     assert (
-        "Record swings across the whole range in both directions (hystcomp excite rich" in warning
+        "Record swings across the whole range in both directions "
+        "(hystcomp.identify.excitation.excitation_signal('rich')" in warning
     )
+    assert "(hystcomp excite rich, " in warning.worded({"excite_rich": "hystcomp excite rich"})
     loop = np.r_[np.linspace(0.0, 120.0, 500), np.linspace(120.0, 0.0, 500)]
     once = Record(np.arange(loop.size) / FS, loop, presets.paper_mpi().simulate(loop))
     warning = identify_record(once, "pi", operators=8).warnings[-1]

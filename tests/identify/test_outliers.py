@@ -19,8 +19,8 @@ from hystcomp.identify.excitation import (
 )
 from hystcomp.identify.outliers import bulk_range, isolated_samples
 from hystcomp.identify.scoring import transient_end
-from hystcomp.identify.workflow import identify_record
 from hystcomp.io.records import Record, read_table, write_table
+from hystcomp.workflows.identify import identify_record
 
 FS = 2000.0  # Hz: the paper's triangles, 8001 samples
 

@@ -14,20 +14,20 @@ from __future__ import annotations
 import contextlib
 import importlib
 import os
+import re
 import signal
 import sys
+import tomllib
+from pathlib import Path
 
 import click
 
 from hystcomp import _signals
-from hystcomp.errors import HystcompError
+from hystcomp._notice import worded
+from hystcomp.errors import HystcompError, InvalidParameterError
 
-EXIT_BAD_INPUT = 2
-EXIT_INTERNAL = 1
+EXIT_BAD_INPUT, EXIT_INTERNAL = 2, 1
 EXIT_BROKEN_PIPE = 141  # 128 + SIGPIPE, as a shell reports a command killed by it
-EXIT_SIGINT = 128 + signal.SIGINT  # 130
-EXIT_SIGTERM = 128 + signal.SIGTERM  # 143
-EXIT_SIGHUP = 129  # 128 + SIGHUP (POSIX)
 
 
 def remove_pending() -> None:
@@ -41,48 +41,72 @@ def _one_line(text: object) -> str:
     return " ".join(str(text).split())
 
 
+#: The command line's words (words.toml): each command's and option's help, and the remedies
+#: that the library's sentences name (:class:`hystcomp._notice.Notice`).
+TEXT = tomllib.loads((Path(__file__).parent / "words.toml").read_text(encoding="utf-8"))
 #: Subcommand -> (its module, the first line of its help). A module is imported only when its
 #: command runs or shows its own help, so that ``hystcomp --help``, a mistyped command and
 #: shell completion load neither numba nor SciPy (tests/cli/test_cli_lazy.py checks that this
 #: table matches the commands).
 COMMANDS = {
-    "calibrate": (
-        "hystcomp.cli.calibrate",
-        "Print how the simulated axis (the twin) compares with the paper's figures.",
-    ),
-    "compare": (
-        "hystcomp.cli.compare",
-        "Identify the Preisach, PI and MPI models on the twin and compare the four methods.",
-    ),
-    "compensate": (
-        "hystcomp.cli.compensate",
-        "Voltage that makes the actuator of MODEL.json follow REFERENCE (columns t, x).",
-    ),
-    "evaluate": (
-        "hystcomp.cli.evaluate",
-        "How well MEASURED (columns t, x; v too if there) tracked REFERENCE (columns t, x).",
-    ),
-    "excite": (
-        "hystcomp.cli.excite",
-        "Write the identification input for MODEL: pi, mpi, preisach, rich, dynamics, multiaxis.",
-    ),
-    "export-c": (
-        "hystcomp.cli.export_c",
-        "Write MODEL_FILE's compensator as C99 code: NAME.h and NAME.c in folder -o.",
-    ),
-    "identify": (
-        "hystcomp.cli.identify",
-        "Identify a hysteresis model from DATA (columns t, v, x) and write it as JSON.",
-    ),
-    "raster": (
-        "hystcomp.cli.raster",
-        "An AFM raster on the simulated scanner: uncompensated, per-axis, coupled.",
-    ),
-    "simulate": (
-        "hystcomp.cli.simulate",
-        "Run the model in MODEL.json on the voltage in INPUT (columns t, v).",
-    ),
+    name: (f"hystcomp.cli.{name.replace('-', '_')}", TEXT[name]["help"].split("\n")[0])
+    for name in TEXT
+    if name not in ("remedies", "options")
 }
+#: A library parameter's option where its name is not the option's.
+OPTIONS = {"sample_rate": "--fs", "out_dir": "--out"}
+#: "The 'name' parameter of owner rest": a refused parameter, said as its option's value.
+_PARAMETER = re.compile(
+    r"The '(?P<name>\w+)' (?:parameter|argument) of [\w.]+,? (?P<rest>[a-z0-9'].*)"
+)
+
+
+def command(name: str):
+    """``main.command(name)``, with its help from words.toml."""
+    return main.command(name, help=TEXT[name]["help"])
+
+
+def option(command: str, *decls: str, **attrs):
+    """``click.option``, with its help from words.toml: the command's own, else the shared."""
+    flag = next(d for d in decls if d.startswith("--"))[2:]
+    return click.option(*decls, help=TEXT[command].get(flag, TEXT["options"].get(flag)), **attrs)
+
+
+def say(text) -> str:
+    """A library sentence (a :class:`~hystcomp._notice.Notice` or text) in the command's words."""
+    return _one_line(worded(text, TEXT["remedies"]))
+
+
+def report(*results, lines: bool = True, warnings: bool = True) -> None:
+    """Print the workflow results' report lines, then their warnings on standard error."""
+    for line in (x for r in results if lines for x in getattr(r, "lines", ())):
+        click.echo(worded(line, TEXT["remedies"]))
+    for warning in (x for r in results if warnings for x in getattr(r, "warnings", ())):
+        click.echo(f"hystcomp: warning: {say(warning)}", err=True)
+
+
+def refuse(given: dict, why: str) -> None:
+    """Refuse, in the command's words, the first option given that ``why`` does not take."""
+    for option, value in given.items():
+        if value is not None and value is not False:
+            raise click.UsageError(f"{option} does not apply to {why}.")
+
+
+class _Command(click.Command):
+    """A subcommand: a library parameter refused is said as the value of its option."""
+
+    def invoke(self, ctx):
+        try:
+            return super().invoke(ctx)
+        except InvalidParameterError as exc:
+            found = _PARAMETER.fullmatch(say(exc.args[0] if len(exc.args) == 1 else exc))
+            if found is None:
+                raise
+            name = OPTIONS.get(found["name"], "--" + found["name"].replace("_", "-"))
+            option = next((p for p in self.params if name in p.opts), None)
+            if option is not None and ctx.params.get(option.name) is not None:  # given
+                raise click.BadParameter(found["rest"], ctx, param_hint=f"'{name}'") from None
+            raise
 
 
 class _Group(click.Group):
@@ -91,6 +115,8 @@ class _Group(click.Group):
     Its subcommands are imported lazily from :data:`COMMANDS`; each module registers its
     command on :data:`main` when imported.
     """
+
+    command_class = _Command
 
     def list_commands(self, ctx):
         return sorted({*COMMANDS, *self.commands})
@@ -132,87 +158,56 @@ class _Group(click.Group):
         try:
             with _signals.installed():  # signals recorded; the command stops at a safe point
                 return super().main(args, prog_name, complete_var, standalone_mode=False, **extra)
-        except _signals.Interrupted as exc:  # (its temporaries are removed by then)
-            sys.exit(_signals.finish(exc))
-        except click.exceptions.Abort as exc:
-            if isinstance(exc.__cause__, KeyboardInterrupt):  # click's wrapping of Ctrl-C
-                sys.exit(_signals.finish(_signals.Interrupted(signal.SIGINT)))
-            remove_pending()
-            click.echo("hystcomp: aborted", err=True)
-            sys.exit(EXIT_INTERNAL)
         except click.exceptions.NoArgsIsHelpError as exc:  # plain `hystcomp`: usage, commands
             click.echo(exc.ctx.get_help(), err=True)
             sys.exit(EXIT_BAD_INPUT)
-        except click.UsageError as exc:
-            hint = f" (see '{exc.ctx.command_path} --help')" if exc.ctx is not None else ""
-            click.echo(f"hystcomp: error: {_one_line(exc.format_message())}{hint}", err=True)
-            sys.exit(EXIT_BAD_INPUT)
-        except click.ClickException as exc:
-            click.echo(f"hystcomp: error: {_one_line(exc.format_message())}", err=True)
-            sys.exit(exc.exit_code)
-        except HystcompError as exc:
-            click.echo(f"hystcomp: error: {_one_line(exc)}", err=True)
-            sys.exit(EXIT_BAD_INPUT)
-        except MemoryError:
-            click.echo(
-                "hystcomp: error: not enough memory for this input; use a shorter record, "
-                "fewer operators or a lower sample rate.",
-                err=True,
-            )
-            sys.exit(EXIT_BAD_INPUT)
-        except BrokenPipeError:  # the reader of standard output went away (e.g. | head)
-            with contextlib.suppress(OSError, ValueError):  # no flush error at exit either
-                os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
-            sys.exit(EXIT_BROKEN_PIPE)
-        except KeyboardInterrupt:  # raised by code, or Python's handler before ours
-            sys.exit(_signals.finish(_signals.Interrupted(signal.SIGINT)))
-        except OSError as exc:  # the system refused a path or a write: bad input, not a fault
-            remove_pending()
-            where = f" {os.fsdecode(exc.filename)[:120]!r}" if exc.filename else ""
-            click.echo(
-                f"hystcomp: error: cannot use{where}: {exc.strerror or exc}. Check the path "
-                "(the length of its names, that its folders exist and are folders), its "
-                "permissions and the free space.",
-                err=True,
-            )
-            sys.exit(EXIT_BAD_INPUT)
-        except Exception as exc:  # noqa: BLE001 - an internal fault: say so, briefly
-            click.echo(
-                f"hystcomp: internal error: {type(exc).__name__}: {_one_line(exc)} "
-                "(please report it with the command you ran)",
-                err=True,
-            )
-            sys.exit(EXIT_INTERNAL)
+        except (Exception, KeyboardInterrupt, _signals.Interrupted) as exc:  # noqa: BLE001
+            status, message = _failure(exc)
+            if message:
+                click.echo(message, err=True)
+            sys.exit(status)
 
 
-def run() -> None:
-    """The ``hystcomp`` program: :data:`main`, then the process ends without tearing down.
-
-    The console script and ``python -m hystcomp`` call this (through
-    :mod:`hystcomp._program`, which installs the signal handling before anything else is
-    imported), never a test (which calls :data:`main`). Once a command has returned, its
-    outputs are written, closed and renamed into place, and standard output and error are
-    flushed here; what is left is the interpreter's teardown, which deallocates every
-    module and compiled kernel one by one: 0.4 to 0.6 s of a 4 s ``hystcomp compare``,
-    measured in alternated runs. So the process ends with :func:`os._exit` and the
-    command's exit status. If a flush fails (standard output closed early), the normal
-    exit path runs and reports it.
-    """
-    code: int | str | None
-    try:
-        result = main(prog_name="hystcomp")  # --help and --version return 0
-        code = result if isinstance(result, int) else 0
-    except SystemExit as exc:
-        code = exc.code
-    _signals.done()  # returned: in the program, a signal from now on changes nothing
-    if code is not None and not isinstance(code, int):
-        sys.exit(code)  # a message: printed and exit status 1, as Python does
-    try:
-        sys.stdout.flush()
-        sys.stderr.flush()
-    except (OSError, ValueError):
-        sys.exit(code)
-    os._exit(code or 0)
+def _failure(exc: BaseException) -> tuple[int, str | None]:
+    """The exit status of a command that raised ``exc``, and the line that says why."""
+    if isinstance(exc, _signals.Interrupted):  # its temporaries are removed by then
+        return _signals.finish(exc), None
+    abort = isinstance(exc, click.exceptions.Abort)
+    if isinstance(exc, KeyboardInterrupt) or (
+        abort and isinstance(exc.__cause__, KeyboardInterrupt)
+    ):
+        return _signals.finish(_signals.Interrupted(signal.SIGINT)), None  # Ctrl-C, or click's
+    if abort:
+        remove_pending()
+        return EXIT_INTERNAL, "hystcomp: aborted"
+    if isinstance(exc, click.UsageError):
+        hint = f" (see '{exc.ctx.command_path} --help')" if exc.ctx is not None else ""
+        return EXIT_BAD_INPUT, f"hystcomp: error: {_one_line(exc.format_message())}{hint}"
+    if isinstance(exc, click.ClickException):
+        return exc.exit_code, f"hystcomp: error: {_one_line(exc.format_message())}"
+    if isinstance(exc, HystcompError):
+        return EXIT_BAD_INPUT, f"hystcomp: error: {say(exc.args[0] if len(exc.args) == 1 else exc)}"
+    if isinstance(exc, MemoryError):
+        return EXIT_BAD_INPUT, (
+            "hystcomp: error: not enough memory for this input; use a shorter record, fewer "
+            "operators or a lower sample rate."
+        )
+    if isinstance(exc, BrokenPipeError):  # the reader of standard output went away (| head)
+        with contextlib.suppress(OSError, ValueError):  # no flush error at exit either
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return EXIT_BROKEN_PIPE, None
+    if isinstance(exc, OSError):  # the system refused a path or a write: bad input, no fault
+        remove_pending()
+        where = f" {os.fsdecode(exc.filename)[:120]!r}" if exc.filename else ""
+        return EXIT_BAD_INPUT, (
+            f"hystcomp: error: cannot use{where}: {exc.strerror or exc}. Check the path (the "
+            "length of its names, that its folders exist and are folders), its permissions "
+            "and the free space."
+        )
+    return EXIT_INTERNAL, (  # an internal fault: say so, briefly
+        f"hystcomp: internal error: {type(exc).__name__}: {_one_line(exc)} (please report it "
+        "with the command you ran)"
+    )
 
 
 @click.group(cls=_Group, context_settings={"help_option_names": ["-h", "--help"]})

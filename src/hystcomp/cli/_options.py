@@ -1,23 +1,26 @@
-"""Options shared by several subcommands, and the checks every option value goes through.
+"""Options shared by several subcommands, the checks every option value goes through, and the
+steps every command shares: read a file, show progress, write the outputs.
 
 Every value is checked when click parses it (a callback), so that a bad option is refused
 before any file is read or any work is done, with one line naming the option and the fix.
+hystcomp.io.records's readers, hystcomp.io.models and the models are imported where used: a
+command that needs no kernel (``excite``) then loads neither numba nor SciPy's sparse solvers.
 """
 
 from __future__ import annotations
 
 import math
+import sys
+from pathlib import Path
 
 import click
 
 from hystcomp._hyperparameters import MAX_OPERATORS
 from hystcomp._progress import Progress
 from hystcomp._validation import MAX_MAGNITUDE
-from hystcomp.errors import InvalidParameterError
-from hystcomp.io.records import X_UNITS  # light: the readers load compiled code only on use
-
-# hystcomp.io.records, hystcomp.io.models and the models are imported where used: a command that
-# needs no kernel (``excite``) then loads neither numba nor SciPy's sparse solvers.
+from hystcomp.cli import TEXT
+from hystcomp.errors import InvalidParameterError, OutputPathError
+from hystcomp.io.records import X_UNITS, format_csv  # light: no compiled code until used
 
 
 def _finite(value: float, param) -> float:
@@ -29,27 +32,16 @@ def _finite(value: float, param) -> float:
     return value
 
 
-def positive(unit: str):
-    """A callback: the value, if given, must be a finite number > 0 (in ``unit``)."""
+def positive(unit: str, strict: bool = True):
+    """A callback: the value, if given, must be a finite number > 0 (>= 0 unless ``strict``)
+    in ``unit``."""
 
     def check(ctx, param, value):
-        if value is None:
-            return None
-        if not (_finite(value, param) > 0):
-            raise click.BadParameter(f"must be a number > 0 ({unit}); got {value!r}.", param=param)
-        return value
-
-    return check
-
-
-def nonnegative(unit: str):
-    """A callback: the value, if given, must be a finite number >= 0 (in ``unit``)."""
-
-    def check(ctx, param, value):
-        if value is None:
-            return None
-        if not (_finite(value, param) >= 0):
-            raise click.BadParameter(f"must be a number >= 0 ({unit}); got {value!r}.", param=param)
+        if value is not None and not (_finite(value, param) > 0 or (not strict and value == 0)):
+            sign = ">" if strict else ">="
+            raise click.BadParameter(
+                f"must be a number {sign} 0 ({unit}); got {value!r}.", param=param
+            )
         return value
 
     return check
@@ -65,8 +57,7 @@ def fraction(ctx, param, value):
 
 
 def count(ctx, param, value):
-    """A callback: an operator count between 1 and
-    :data:`~hystcomp._hyperparameters.MAX_OPERATORS`."""
+    """A callback: an operator count between 1 and ``MAX_OPERATORS``."""
     if value is not None and not 1 <= value <= MAX_OPERATORS:
         raise click.BadParameter(
             f"must be between 1 and {MAX_OPERATORS} (the paper uses 16; the fit grows as the "
@@ -86,122 +77,66 @@ def voltage_range(ctx, param, value):
     return (lo, hi)
 
 
-#: ``--voltage-range LO HI`` of compensate and export-c: a clamp inside the model's range.
-narrow_range_option = click.option(
-    "--voltage-range",
-    "narrow_range",
-    nargs=2,
-    type=float,
-    default=None,
-    metavar="LO HI",
-    callback=voltage_range,
-    help="Clamp the output to this range in V, inside the model's range (it may only "
-    "narrow it) [the model's range].",
-)
-
-
-def narrowed(model, narrow_range) -> dict:
-    """``{"voltage_range": narrow_range}`` for ``model.inverse``, or ``{}`` if not given;
-    a range reaching beyond the model's is refused as the option's error."""
-    if narrow_range is None:
-        return {}
-    (lo, hi), (low, high) = model.voltage_range_, narrow_range
-    if low < lo or high > hi:
-        raise click.BadParameter(
-            f"may only narrow the model's voltage range {lo:g} .. {hi:g} V: the model was "
-            f"identified inside it and would command voltages it never saw. Got {low:g} "
-            f"{high:g}; choose limits within it, or identify over a wider range.",
-            param_hint="'--voltage-range'",
-        )
-    return {"voltage_range": narrow_range}
-
-
 def columns(ctx, param, value):
-    """A callback: a column mapping such as ``v=1,x=5`` (see :func:`parse_columns`)."""
+    """A callback: a column mapping such as ``v=1,x=5``, or ``v1=2,...`` of an N-axis file."""
+    from hystcomp.io.multiaxis import parse_axis_columns
     from hystcomp.io.records import parse_columns
 
     try:
         return parse_columns(value)
     except InvalidParameterError as exc:
-        if value is not None and any(c.isdigit() for c in value.split("=")[0]):
-            from hystcomp.io.multiaxis import parse_axis_columns  # an N-axis file: v1=2,...
-
-            try:
-                return parse_axis_columns(value)
-            except InvalidParameterError as axis_exc:
-                raise click.BadParameter(str(axis_exc), param=param) from None
-        raise click.BadParameter(str(exc), param=param) from None
+        try:
+            if value is None or not any(c.isdigit() for c in value.split("=")[0]):
+                raise exc from None
+            return parse_axis_columns(value)
+        except InvalidParameterError as error:
+            raise click.BadParameter(str(error), param=param) from None
 
 
-columns_option = click.option(
-    "--columns",
-    metavar="SPEC",
-    default=None,
-    callback=columns,
-    help=(
-        "Which file columns hold t, v, x: 1-based numbers for text tables or the one matrix "
-        "of a MAT/NPZ file (v=1,x=5), or names in any case (v=volts,x=disp). Default: "
-        "columns named t, v, x. N-axis files: v1=2,v2=3,x1=4,x2=5 (default: columns named "
-        "v1..vN, x1..xN)."
-    ),
-)
-fs_option = click.option(
-    "--fs",
-    "sample_rate",
-    type=float,
-    default=None,
-    metavar="HZ",
-    callback=positive("Hz"),
-    help="Sample rate in Hz, for files without a time column t.",
+def _shared(*decls: str, **attrs):
+    flag = next(d for d in decls if d.startswith("--"))[2:]
+    return click.option(*decls, help=TEXT["options"][flag], **attrs)
+
+
+#: ``--voltage-range LO HI`` of compensate and export-c: a clamp inside the model's range.
+narrow_range = _shared(
+    "--voltage-range", "narrow_range", nargs=2, type=float, metavar="LO HI", callback=voltage_range
 )
 
 
-def output_option(required: bool = True, what: str = "output"):
-    """The ``-o/--output FILE`` option (format by suffix: .csv, .npz, .mat)."""
-    return click.option(
-        "-o",
-        "--output",
-        required=required,
-        metavar="FILE",
-        help=f"Where to write the {what} (.csv, .npz or .mat).",
-    )
+def method_option(f):
+    """``--method``: the Preisach inverse's method (its choices from the Preisach model)."""
+    from hystcomp.models.preisach import INVERSE_METHODS
+
+    return _shared("--method", type=click.Choice(INVERSE_METHODS))(f)
 
 
-x_unit_option = click.option(
-    "--x-unit",
-    type=click.Choice(X_UNITS),
-    default=None,
-    help="Unit of the displacement in the file, converted to µm [the file's units row, else um].",
-)
-quiet_option = click.option(
-    "--quiet",
-    "-q",
-    is_flag=True,
-    help="No progress line and no unit-guess warning. Warnings about safety (clamping, "
-    "leaving the model's range) are always shown. Progress is shown only on a terminal, "
-    "for steps over 2 s.",
-)
+def reading(f):
+    """The options of a command that reads a data file: --columns, --fs, --x-unit, --quiet."""
+    for decorate in reversed(
+        [
+            _shared("--columns", metavar="SPEC", callback=columns),
+            _shared("--fs", "sample_rate", type=float, metavar="HZ", callback=positive("Hz")),
+            _shared("--x-unit", type=click.Choice(X_UNITS)),
+            _shared("--quiet", "-q", is_flag=True),
+        ]
+    ):
+        f = decorate(f)
+    return f
 
 
-def read_options(
-    columns: dict | None,
-    sample_rate: float | None,
-    x_unit=None,
-    quiet: bool = False,
-    path="",
-    *,
-    reads: tuple[str, ...] = ("v", "x"),
-) -> dict:
+def read_options(given: dict, path="", *, reads: tuple[str, ...] | None = ("v", "x")) -> dict:
     """Keyword arguments for :func:`hystcomp.io.records.read_table` from the shared options.
 
     ``reads`` are the columns the command reads besides t: a ``--columns`` entry for
     another one is refused (it would be ignored, and was most likely meant for one read).
+    None (an N-axis file) checks nothing.
     """
     from hystcomp.io.records import MEANINGS
 
-    named = columns or {}
-    unused = [key for key in named if key not in ("t", *reads)]
-    if unused:
+    named = given.get("columns") or {}
+    unused = [key for key in named if reads is not None and key not in ("t", *reads)]
+    if reads is not None and unused:
         key, spec = unused[0], named[unused[0]]
         meant = next((k for k in reads if k not in named), reads[0])
         raise click.BadParameter(
@@ -210,8 +145,8 @@ def read_options(
             f"of {MEANINGS[meant].split(' in ')[0]} instead, e.g. --columns {meant}={spec}.",
             param_hint="'--columns'",
         )
-    options = {"columns": columns, "sample_rate": sample_rate, "x_unit": x_unit}
-    if not quiet:
+    options = {k: given.get(k) for k in ("columns", "sample_rate", "x_unit")}
+    if not given.get("quiet"):
         options["progress"] = Progress(f"reading {click.format_filename(str(path))}")
     return options
 
@@ -221,12 +156,12 @@ def progress(label: str, quiet: bool):
     return Progress(label, enabled=False if quiet else None)
 
 
-def warn_x_unit(x, source, quiet: bool, x_unit: str | None = None) -> None:
+def warn_x_unit(x, source, given: dict) -> None:
     """The one-line warning of :func:`hystcomp.io.records.x_unit_warning`, unless --quiet."""
     from hystcomp.io.records import x_unit_warning
 
-    message = x_unit_warning(x, str(source), x_unit)
-    if message and not quiet:
+    message = x_unit_warning(x, str(source), given.get("x_unit"))
+    if message and not given.get("quiet"):
         click.echo(f"hystcomp: warning: {message}", err=True)
 
 
@@ -239,56 +174,56 @@ def check_data_output(path, *, inputs=(), what: str = "output"):
     return check_writable(path)
 
 
-def __getattr__(name: str):
-    if name == "method_option":  # built on first use: its choices come from the Preisach model
-        from hystcomp.models.preisach import INVERSE_METHODS
+def check_plot(plot, *, inputs=(), output=None) -> None:
+    """Refuse, before any work, a figure of an unknown format, or one that would overwrite
+    an input or the command's other output."""
+    from hystcomp.experiment.fig_identification import FORMATS  # no matplotlib yet
+    from hystcomp.io.atomic import check_output_path
 
-        return click.option(
-            "--method",
-            type=click.Choice(INVERSE_METHODS),
-            default=None,
-            help="Preisach models only: the inverse multiplicative structure (eq. 10) or the "
-            "exact inverse [multiplicative; exact with --dynamics, as eq. 10's one-sample lag "
-            "overshoots a fast rise, a minor loop that the dynamics cannot undo].",
-        )
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    if Path(plot).suffix.lower() not in FORMATS:
+        raise click.BadParameter(f"must end in {', '.join(FORMATS)}.", param_hint="--plot")
+    check_output_path(plot, inputs=inputs, what="figure")
+    if output is not None and Path(plot).resolve() == Path(output).resolve():
+        raise click.BadParameter("names the same file as -o.", param_hint="--plot")
 
 
-def method_options(model, model_file, method) -> dict:
-    """``model.inverse``'s ``method`` for ``--method``, refused for a model without one."""
-    if method is None:
-        return {}
-    if model.kind != "preisach":
-        raise click.BadParameter(
-            f"applies to Preisach models only; the model in {model_file} is "
-            f"{model.kind.upper()}, whose inverse is analytic (eqs. 23-26). Drop --method.",
-            param_hint="'--method'",
-        )
-    return {"method": method}
+def write_files(writers: dict, *, reverse: bool = False) -> None:
+    """Write every output at once (a failure writes none of them), then say so.
+
+    ``writers`` maps each path to a function that writes a temporary file given to it.
+    """
+    from hystcomp.io.atomic import atomic_paths
+
+    with atomic_paths(*writers) as temporaries:
+        for write, tmp in zip(writers.values(), temporaries, strict=True):
+            write(tmp)
+    for path in list(writers)[:: -1 if reverse else 1]:
+        click.echo(f"  wrote {path}")
 
 
-#: A step of the reference's time column shorter than this share of its median step is a
-#: fault of the column, not jitter: at its rate the slew-rate limit would all but hold the
-#: voltage still on every sample.
-SHORTEST_STEP = 1e-3
+def write_model(model, output, plot=None, draw=None) -> None:
+    """Write ``model`` to ``output`` and, with ``plot``, the figure ``draw(path)`` makes."""
+    from hystcomp.io.models import model_text
+
+    text = model_text(model)
+    writers = {output: lambda tmp: tmp.write_text(text, encoding="utf-8")}
+    write_files(writers if plot is None else {**writers, plot: draw}, reverse=True)
 
 
-def slew_sample_rate(t, path) -> float:
-    """The rate (Hz) of the shortest step of ``t``, at which the slew-rate limit holds on
-    every step; refused, naming the row, if that step is a fault of the time column."""
-    import numpy as np
+def write_signal(table: dict, output, quiet: bool, summary: str) -> None:
+    """Write ``table`` to ``output`` and say ``summary``, or print it as CSV without one."""
+    from hystcomp.io.records import write_table
 
-    from hystcomp.errors import InvalidSignalError
-
-    steps = np.diff(t)
-    k = int(np.argmin(steps))
-    shortest, median = float(steps[k]), float(np.median(steps))
-    if not shortest >= SHORTEST_STEP * median or not 1.0 / shortest <= MAX_MAGNITUDE:
-        raise InvalidSignalError(
-            f"--slew-rate limits the voltage's change per sample at the reference's shortest "
-            f"time step, but the time column 't' of {str(path)!r} steps by only "
-            f"{shortest:.3g} s from t = {float(t[k])!r} to {float(t[k + 1])!r} s (data row "
-            f"{k + 2}), against a median step of {median:.3g} s: the limit would hold the "
-            "voltage nearly still. Correct the time column there, or drop it and give --fs."
-        )
-    return 1.0 / shortest
+    if output is not None:
+        write_table(output, table, progress=progress(f"writing {output}", quiet))
+        return click.echo(f"wrote {output}: {summary}")
+    try:
+        click.echo(format_csv(table), nl=False)
+        sys.stdout.flush()
+    except BrokenPipeError:
+        raise  # the reader went away (| head): not an error
+    except OSError as exc:
+        raise OutputPathError(
+            f"Cannot write the signal to standard output: {exc.strerror or exc}. Give a "
+            "file with -o, or check where standard output goes."
+        ) from None

@@ -4,28 +4,16 @@ from __future__ import annotations
 
 import click
 
-from hystcomp.cli import main
+from hystcomp.cli import command, option
 
 
-@main.command("calibrate")
-@click.option(
-    "--refit",
-    is_flag=True,
-    help="Fit the twin's hysteresis parameters to the paper's Preisach loops again first "
-    "(a few seconds), print them, and report the refitted twin.",
-)
+@command("calibrate")
+@option("calibrate", "--refit", is_flag=True)
 def calibrate(refit: bool) -> None:
-    """Print how the simulated axis (the twin) compares with the paper's figures.
-
-    Stroke at 120 V, major-loop hysteresis (whole and in the saturation zone), the rms
-    difference to the loops of eq. 6 (Fig. 5), the resonance of D(s), and the
-    uncompensated tracking errors of Table I with several linear gains. Units: µm, V, Hz.
-    See hystcomp.experiment.calibration.
-    """
+    """``hystcomp calibrate``: the report of :mod:`hystcomp.experiment.calibration`."""
     from hystcomp.experiment.calibration import calibration_report, fit_twin_hysteresis
 
-    params = None
+    params = fit_twin_hysteresis() if refit else None
     if refit:
-        params = fit_twin_hysteresis()
         click.echo(params)
     click.echo(calibration_report(params))

@@ -246,7 +246,7 @@ def _excerpts(v, x, before, after, path, model_name, t, fit_end, turns, seconds)
 
 def plot_identification_result(record, result, path) -> None:
     """The figure of ``hystcomp identify --plot``: :func:`plot_identification` of what
-    :func:`~hystcomp.identify.workflow.identify_record` found, from the end of the
+    :func:`~hystcomp.workflows.identify.identify_record` found, from the end of the
     start-up transient to the end of the record, the hold-out (if any) predicted by the
     identified model.
 

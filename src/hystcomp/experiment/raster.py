@@ -138,6 +138,24 @@ class RasterResult:
         """The axes' summed rms, coupled over per-axis."""
         return float(self.rms_um["coupled"].sum() / self.rms_um["per-axis"].sum())
 
+    def csv_text(self) -> str:
+        """Each axis's rms per method and its ratio to the uncompensated, as CSV.
+
+        Returns
+        -------
+        str
+            A header ``axis,method,rms_um,ratio_to_uncompensated`` and a row per axis and
+            method (axes named x, y, z), the numbers in full precision.
+        """
+        rows = ["axis,method,rms_um,ratio_to_uncompensated"]
+        for i in range(self.X_ref.shape[1]):
+            for method in METHODS:
+                rms = self.rms_um[method][i]
+                rows.append(
+                    f"{'xyz'[i]},{method},{rms!r},{rms / self.rms_um['uncompensated'][i]!r}"
+                )
+        return "\n".join(rows) + "\n"
+
     def table(self) -> list[str]:
         """The table ``hystcomp raster`` prints.
 

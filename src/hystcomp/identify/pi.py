@@ -286,7 +286,7 @@ def prepare_record(
         raise IdentificationError(
             f"{owner}: the input 'v' is constant ({v0!r} V), so it shows no hysteresis to "
             "identify. Record the response to an input that sweeps the actuator's range, "
-            "such as 'hystcomp excite pi'."
+            "such as the paper's triangles of 30 to 120 V (excitation_signal('pi'))."
         )
     u_fit, x_fit = u[start:], x[start:]
     if np.ptp(u_fit) <= 0.0:

@@ -9,6 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from hystcomp._kernels.reversals import turning_points
+from hystcomp._notice import Notice
 from hystcomp._validation import as_signal, as_signal_pair, check_int
 from hystcomp.errors import IdentificationError
 from hystcomp.identify.outliers import bulk_range
@@ -101,9 +102,13 @@ def check_transient(transient, v: np.ndarray, owner: str, *, min_used: int) -> i
     )
     if v.size - start < min_used:
         raise IdentificationError(
-            f"{owner}: only {v.size - start} of {v.size} samples remain after the start-up "
-            f"transient (first sample used: {start}), fewer than the {min_used} needed. "
-            "Record longer, use fewer operators, or set a shorter transient (--transient)."
+            Notice(
+                "{owner}: only "
+                f"{v.size - start} of {v.size} samples remain after the start-up transient "
+                f"(first sample used: {start}), fewer than the {min_used} needed. Record "
+                "longer, use fewer operators, or set a shorter transient ({transient}).",
+                owner=owner,
+            )
         )
     return start
 
@@ -219,7 +224,7 @@ def largest_swings(levels) -> tuple[float, float]:
     return rise, fall
 
 
-def coverage_warning(v, start: int = 0) -> str | None:
+def coverage_warning(v, start: int = 0) -> Notice | None:
     """Why a record may not show what a compensator meets, or None.
 
     The tracking estimate of ``hystcomp identify`` is measured on the record itself, so it
@@ -247,6 +252,9 @@ def coverage_warning(v, start: int = 0) -> str | None:
     str or None
         The reason, or None if the record rises, falls and turns back inside its range.
 
+    The sentence is a :class:`~hystcomp._notice.Notice`: the signals it suggests recording
+    and the transient option are named as data, which the command line words as its own.
+
     Examples
     --------
     >>> def ramps(*levels):  # straight lines between turning points, 100 samples each
@@ -265,30 +273,32 @@ def coverage_warning(v, start: int = 0) -> str | None:
         return None
     idx, _ = turning_indices(v, END_ZONE * span)
     levels = v[idx]
-    what = "hystcomp excite rich, or the paper's triangles of hystcomp excite mpi"
+    what = "{excite_rich}, or the paper's triangles of {excite_mpi}"
     if start:
         what += (
             f"; the first {start} samples are left out as a start-up transient, until the "
-            "input first reaches an end of its range: --transient changes that"
+            "input first reaches an end of its range: {transient} changes that"
         )
     for swing, verb, noun in zip(
         largest_swings(levels), ("rises", "falls"), ("rising", "falling"), strict=True
     ):
         if swing < MIN_SWING * span:
-            return (
+            return Notice(
                 f"after its start-up transient the record never {verb} over more than "
                 f"{100 * swing / span:.0f} % of its input range: the model's {noun} branches "
                 "beyond that are fitted on nothing, and a reference that swings further may "
-                f"track far worse than estimated. Record swings across the whole range in "
-                f"both directions ({what})."
+                "track far worse than estimated. Record swings across the whole range in "
+                f"both directions ({what}).",
+                kind="coverage",
             )
     low, high = float(v.min()), float(v.max())
     inner = levels[1:-1]
     if not np.any((inner > low + END_ZONE * span) & (inner < high - END_ZONE * span)):
-        return (
+        return Notice(
             "the record turns back only at the ends of its input range; it shows no minor "
             "loop, and a reference that turns inside the range may track far worse than "
-            f"estimated. Record turning points inside the range ({what})."
+            f"estimated. Record turning points inside the range ({what}).",
+            kind="coverage",
         )
     return None
 

@@ -255,3 +255,34 @@ def read_axes(
     for arr in out.values():
         arr.setflags(write=False)
     return out
+
+
+def axis_table(t, **signals) -> dict:
+    """The columns of a data file: ``t`` and each signal, as ``v`` or, for a signal with one
+    column per axis, as ``v1..vN`` (``x_ref``: ``x1_ref..xN_ref``).
+
+    Parameters
+    ----------
+    t : ndarray
+        Time in s.
+    **signals : ndarray
+        Each signal by its column name: 1-D, or 2-D with one column per axis.
+
+    Returns
+    -------
+    dict
+        Column name to 1-D array, ``t`` first.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> list(axis_table(np.arange(2.0), v=np.ones((2, 2)), x_ref=np.zeros((2, 2))))
+    ['t', 'v1', 'v2', 'x1_ref', 'x2_ref']
+    """
+    out = {"t": t}
+    for name, s in signals.items():
+        if s.ndim == 1:
+            out[name] = s
+        else:
+            out.update({f"{name[0]}{i + 1}{name[1:]}": s[:, i] for i in range(s.shape[1])})
+    return out

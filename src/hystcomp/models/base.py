@@ -129,7 +129,7 @@ class HysteresisModel(PackedSystem, Estimator):
 
         ``voltage_range_`` is the amplifier's range, the compensator's clamp: the fitted
         record's by default, or one given wider (``allow_extrapolation`` of
-        :func:`~hystcomp.identify.workflow.identify_record`) or narrower. This is what the
+        :func:`~hystcomp.workflows.identify.identify_record`) or narrower. This is what the
         record really covered, from the fit report (``fit_report_["input_range_v"]``); a
         model built from parameters, or read from a file without it, returns None.
 

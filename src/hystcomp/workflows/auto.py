@@ -4,7 +4,7 @@ Which family tracks best changes from stage to stage (on the panel of
 ``benchmarks/bench_accuracy.py`` the Preisach model is best on Bouc-Wen and Duhem stages,
 MPI on a Maxwell-slip stage and on one with narrow minor loops, and PI never), and the fit
 error cannot tell: every family fits its record to R^2 = 0.998 or so. :func:`identify_best`
-fits every family the record determines (:func:`~hystcomp.identify.workflow.identify_record`
+fits every family the record determines (:func:`~hystcomp.workflows.identify.identify_record`
 for each) and keeps the one whose compensator is predicted to track a reference over the
 range best (:func:`~hystcomp.identify.compensation.tracking_estimate`). The ranking, each
 family's estimate and its error on held-out reversal branches (references that turn inside
@@ -16,8 +16,14 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
+from hystcomp._notice import Notice
 from hystcomp.errors import IdentificationError
-from hystcomp.identify.workflow import LABELS, SIZE_OPTIONS, IdentificationResult, identify_record
+from hystcomp.workflows.identify import (
+    LABELS,
+    SIZE_OPTIONS,
+    IdentificationResult,
+    identify_record,
+)
 
 __all__ = ["FAMILIES", "AutoResult", "identify_best"]
 
@@ -78,7 +84,7 @@ def identify_best(record, *, families=FAMILIES, progress=None, **options) -> Aut
         ``progress(kind)`` returns the context manager entered around that family's fit
         (``hystcomp identify`` shows one status line per family).
     **options
-        Those of :func:`~hystcomp.identify.workflow.identify_record` (``voltage_range``,
+        Those of :func:`~hystcomp.workflows.identify.identify_record` (``voltage_range``,
         ``transient``, ``holdout``, ...); a family option (``operators``, ``grid``, ...)
         goes to the families that take it.
 
@@ -134,9 +140,13 @@ def identify_best(record, *, families=FAMILIES, progress=None, **options) -> Aut
     if inside is not None:
         kind, held, winner_held = inside
         lines.append(
-            f"  for references that turn inside the range the {LABELS[kind]} model is "
-            f"predicted better (cross-validated {held:.3g} µm against {winner_held:.3g} µm): "
-            f"--model {kind}"
+            Notice(
+                f"  for references that turn inside the range the {LABELS[kind]} model is "
+                f"predicted better (cross-validated {held:.3g} µm against {winner_held:.3g} "
+                "µm): {model}",
+                kind="line",
+                others=kind,
+            )
         )
     return AutoResult(best, ranking, skipped, results, lines)
 

@@ -121,6 +121,55 @@ class Evaluation:
         total = self.outside + self.samples
         return self.outside / total if total else 0.0
 
+    @property
+    def warnings(self) -> list[str]:
+        """A warning when more than :data:`OUTSIDE_WARNING` of the measured samples lie
+        outside the reference's time span (the two may not belong together)."""
+        if not self.outside_share > OUTSIDE_WARNING:
+            return []
+        return [
+            (
+                f"{self.outside} samples ({100 * self.outside_share:.3g} %) of {self.measured} lie "
+                f"outside the time span of {self.reference} and are left out; check that the two "
+                "belong together and that their time columns start alike."
+            )
+        ]
+
+    @property
+    def lines(self) -> list[str]:
+        """The figures as a report, one line each: the match, the error, the hysteresis and
+        the error over time."""
+        span = self.range_um
+        share = f" ({100 * self.rms_um / span:.3g} % of the {span:.4g} µm range)" if span else ""
+        matched = (
+            "interpolated at the measured instants" if self.interpolated else "the same instants"
+        )
+        lines = [
+            f"tracking of {self.measured} against {self.reference}",
+            f"  matched:    {self.samples} samples, t {self.t[0]:.6g} .. {self.t[-1]:.6g} s "
+            f"(reference {matched}"
+            + (f"; the first {self.skip_s:g} s left out" if self.skip_s else "")
+            + (f"; {self.outside} outside the reference's time span" if self.outside else "")
+            + ")",
+            (
+                f"  error:      rms {self.rms_um:.4g} µm{share}, max {self.max_um:.4g} µm, "
+                f"mean {self.mean_um:.4g} µm"
+            ),
+        ]
+        if self.hysteresis_pct is None:
+            lines.append("  hysteresis: - (the reference does not rise and fall)")
+        else:
+            lines.append(
+                f"  hysteresis: {self.hysteresis_pct:.3g} % of the range (top quarter, the "
+                f"saturation zone: {self.saturation_zone_pct:.3g} %)"
+            )
+        lines.append("  error over time:")
+        lines.append(f"    {'t (s)':>21}  {'rms (µm)':>9}  {'max (µm)':>9}")
+        for part in self.spans:
+            when = f"{part.t_start:.4g} .. {part.t_end:.4g}"
+            lines.append(f"    {when:>21}  {part.rms_um:9.4g}  {part.max_um:9.4g}")
+        return lines
+
     def to_dict(self) -> dict[str, Any]:
         """The figures (not the signals) as plain values, ready for JSON."""
         return {

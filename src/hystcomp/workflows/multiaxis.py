@@ -6,7 +6,7 @@ tracking estimate, warnings; ``--model auto`` ranks the families per axis) on it
 decoupled displacements:
 
 1. the coupling ``M`` (:func:`~hystcomp.identify.coupling.fit_coupling`);
-2. each axis's model on ``(v_i, (M^-1 x)_i)`` (:func:`~hystcomp.identify.workflow.
+2. each axis's model on ``(v_i, (M^-1 x)_i)`` (:func:`~hystcomp.workflows.identify.
    identify_record`, or :func:`~hystcomp.workflows.auto.identify_best` for ``auto``), in
    parallel with joblib (``n_jobs``);
 3. ``M`` again with the axes' models among the regressors
@@ -25,9 +25,9 @@ import numpy as np
 from hystcomp.errors import IdentificationError, InvalidSignalError
 from hystcomp.identify.coupling import fit_coupling, refine_coupling
 from hystcomp.identify.scoring import transient_end
-from hystcomp.identify.workflow import LABELS, SIZE_OPTIONS, identify_record
 from hystcomp.io.records import Record
 from hystcomp.models.multiaxis import MultiAxisModel
+from hystcomp.workflows.identify import LABELS, SIZE_OPTIONS, identify_record
 
 __all__ = ["MultiAxisResult", "identify_axes"]
 
@@ -45,7 +45,7 @@ class MultiAxisResult:
     warnings : list of str
         Each a sentence, its axis named.
     results : list
-        Each axis's :class:`~hystcomp.identify.workflow.IdentificationResult`.
+        Each axis's :class:`~hystcomp.workflows.identify.IdentificationResult`.
     """
 
     model: MultiAxisModel
@@ -91,7 +91,7 @@ def identify_axes(
     source : str
         The record's name, for the report.
     **options
-        Those of :func:`~hystcomp.identify.workflow.identify_record` (``voltage_range``,
+        Those of :func:`~hystcomp.workflows.identify.identify_record` (``voltage_range``,
         ``transient``, family options, ...); ``holdout`` is refused.
 
     Returns
@@ -110,8 +110,8 @@ def identify_axes(
         if np.ptp(V[:, i]) <= 0:
             raise InvalidSignalError(
                 f"The voltage column 'v{i + 1}' of {source} is constant ({V[0, i]!r} V): every "
-                "axis must sweep its range for its hysteresis to be identified (hystcomp excite "
-                "multiaxis). Check that the right column is named."
+                "axis must sweep its range for its hysteresis to be identified (as the "
+                "multi-axis excitation does). Check that the right column is named."
             )
     start = max(transient_end(V[:, i]) for i in range(n_axes))
     if coupling:

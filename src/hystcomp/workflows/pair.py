@@ -2,7 +2,7 @@
 
 :func:`identify_pair_record` is what ``hystcomp identify DATA --model KIND
 --dynamics-record DYN`` runs: the hysteresis model alone from ``DATA`` (as ``hystcomp
-identify`` fits it, :func:`hystcomp.identify.workflow.identify_record`), then the pair
+identify`` fits it, :func:`hystcomp.workflows.identify.identify_record`), then the pair
 (:func:`hystcomp.models.hammerstein.fit_pair`) from both records, then the tracking of
 both compensators estimated on the triangles of the dynamics record, which neither fit
 saw (:func:`tracking_estimates`).
@@ -18,14 +18,15 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from hystcomp._notice import Notice
 from hystcomp.errors import InvalidParameterError, InvalidTypeError
 from hystcomp.identify.dynamics import MAX_DAMPING, TRIANGLE_SPAN, record_layout
 from hystcomp.identify.scoring import turning_indices
-from hystcomp.identify.workflow import IdentificationResult, identify_record
 from hystcomp.io.records import uneven_sampling
 from hystcomp.models.dynamics import LinearDynamics
 from hystcomp.models.hammerstein import HammersteinModel, fit_pair
 from hystcomp.models.mpi import ModifiedPrandtlIshlinskii
+from hystcomp.workflows.identify import IdentificationResult, identify_record
 
 __all__ = [
     "DynamicsResult",
@@ -151,13 +152,13 @@ def identify_pair_record(
     dynamics_record : hystcomp.io.records.Record
         The answer to ``hystcomp excite dynamics``, at the rate the compensator will run.
     model : {'pi', 'mpi', 'preisach'} or estimator
-        As in :func:`~hystcomp.identify.workflow.identify_record`.
+        As in :func:`~hystcomp.workflows.identify.identify_record`.
     hysteresis : IdentificationResult, optional
         ``model`` already identified from ``record`` (by
-        :func:`~hystcomp.identify.workflow.identify_record`, as ``--model auto`` does): it
+        :func:`~hystcomp.workflows.identify.identify_record`, as ``--model auto`` does): it
         is the pair's first round, not fitted again.
     **options
-        Those of :func:`~hystcomp.identify.workflow.identify_record` (no ``holdout``), for
+        Those of :func:`~hystcomp.workflows.identify.identify_record` (no ``holdout``), for
         the hysteresis model's identification when it is not given.
 
     Returns
@@ -205,17 +206,23 @@ def identify_pair_record(
                 worse.append(f"{f:g} Hz ({e['pair_um']:.3g} vs {e['alone_um']:.3g} µm)")
         if worse:
             warnings.append(
-                "the pair is predicted to track worse than the hysteresis model alone at "
-                + ", ".join(worse)
-                + "; compensate warns when a reference runs at those rates. Check the "
-                "dynamics record (hystcomp excite dynamics, at the rate you compensate), or "
-                "compensate such references with the hysteresis model alone."
+                Notice(
+                    "the pair is predicted to track worse than the hysteresis model alone at "
+                    + ", ".join(worse)
+                    + "; compensate warns when a reference runs at those rates. Check the "
+                    "dynamics record ({excite_dynamics}, at the rate you compensate), or "
+                    "compensate such references with the hysteresis model alone.",
+                    kind="pair-worse",
+                )
             )
     else:
         warnings.append(
-            "the dynamics record holds no triangles (a record of an older 'hystcomp excite "
-            "dynamics'), so the pair's tracking cannot be estimated; record the answer to "
-            "'hystcomp excite dynamics' again."
+            Notice(
+                "the dynamics record holds no triangles (a record of an older "
+                "{excite_dynamics}), so the pair's tracking cannot be estimated; record the "
+                "answer to {excite_dynamics} again.",
+                kind="no-triangles",
+            )
         )
     return PairResult(pair, hysteresis, estimates, lines, warnings)
 

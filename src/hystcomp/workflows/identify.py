@@ -2,14 +2,13 @@
 
 :func:`identify_record` is what ``hystcomp identify`` runs for the hysteresis models (PI,
 MPI, Preisach), usable from Python: it leaves out the start-up transient, holds out the end
-of the record if asked, fits the model, scores the fit (:mod:`hystcomp.identify.scoring`),
-estimates the compensator's tracking error (:mod:`hystcomp.identify.compensation`), and
-returns all of it with the report lines and the warnings in an
-:class:`IdentificationResult`; it prints and writes nothing. The linear dynamics (beyond the
-paper) are identified by :mod:`hystcomp.workflows.pair`.
-
-It is the one module of :mod:`hystcomp.identify` that sits above the models: it builds them,
-while the models' ``fit`` methods delegate to the array-level fits of the other modules here.
+of the record if asked, fits a copy of the model, scores the fit
+(:mod:`hystcomp.identify.scoring`), estimates the compensator's tracking error
+(:mod:`hystcomp.identify.compensation`), and returns all of it in an
+:class:`IdentificationResult`: the figures, the fitted model, the report lines and the
+warnings, whose remedies are data (:class:`hystcomp._notice.Notice`) that the command line
+words as options. It prints and writes nothing. The linear dynamics (beyond the paper) are
+identified by :mod:`hystcomp.workflows.pair`.
 """
 
 from __future__ import annotations
@@ -22,6 +21,7 @@ import numpy as np
 
 from hystcomp import paper
 from hystcomp._hyperparameters import check_constraints
+from hystcomp._notice import Notice
 from hystcomp.errors import IdentificationError, InvalidParameterError, InvalidTypeError
 from hystcomp.identify.compensation import tracking_estimate
 from hystcomp.identify.outliers import check_isolated
@@ -94,7 +94,7 @@ def build_estimator(
     constraints=None,
     initial_memory=None,
 ):
-    """An unfitted hysteresis model of ``kind`` from the options of ``hystcomp identify``.
+    """An unfitted hysteresis model of ``kind`` from the identification options.
 
     Parameters
     ----------
@@ -160,50 +160,36 @@ def build_estimator(
                 f"The {name!r} option of build_estimator does not apply to kind {kind!r}, "
                 f"which takes {', '.join(SIZE_OPTIONS[kind])}; got {name}={value!r}. Leave it out."
             )
-    params = {"voltage_range": voltage_range}
-    if "operators" in SIZE_OPTIONS[kind]:
-        params["n_operators"] = DEFAULT_OPERATORS if operators is None else operators
-    if "deadzones" in SIZE_OPTIONS[kind]:
-        params["n_deadzones"] = DEFAULT_OPERATORS if deadzones is None else deadzones
-    if regularization is not None:
-        params["regularization"] = regularization
-    if initial_memory is not None:
-        params["initial_memory"] = initial_memory
-    if degree is not None:
-        params["degree"] = degree
-    if kind == "preisach":
-        params.update(_everett_params(fit, everett, degree, grid))
-        if constraints is not None:
-            params["zero_diagonal"] = (
-                check_constraints(constraints, "build_estimator") == "physical"
+    for name, value, wants, other in (
+        ("degree", degree, "polynomial", "table"),
+        ("grid", grid, "table", "polynomial"),
+    ):
+        if value is not None and everett == other:
+            raise InvalidParameterError(
+                f"The {name!r} option of build_estimator applies to everett={wants!r}; got "
+                f"{name}={value!r} with everett={other!r}. A {other} takes "
+                f"{'grid' if name == 'degree' else 'degree'!r}."
             )
-    elif constraints is not None:
-        params["constraints"] = constraints
+    if degree is not None and everett is None:
+        given["everett"] = "polynomial"  # a degree names eq. 5's polynomial, not the table
+    params = {"voltage_range": voltage_range}
+    for name in ("operators", "deadzones"):
+        if name in SIZE_OPTIONS[kind]:
+            params[f"n_{name}"] = DEFAULT_OPERATORS if given[name] is None else given[name]
+    params.update({_HYPERPARAMETERS.get(k, k): v for k, v in given.items() if v is not None})
+    if kind == "preisach" and constraints is not None:
+        check_constraints(constraints, "build_estimator")
+        params["zero_diagonal"] = params.pop("constraints") == "physical"
     return cls(**params)
 
 
-def _everett_params(fit, everett, degree, grid) -> dict:
-    """The Preisach estimator's ``fit_method``, ``everett`` and ``grid_size`` from the options."""
-    if everett == "table" and degree is not None:
-        raise InvalidParameterError(
-            f"The 'degree' option of build_estimator applies to everett='polynomial'; got "
-            f"degree={degree!r} with everett='table'. A table takes 'grid'."
-        )
-    if grid is not None and everett == "polynomial":
-        raise InvalidParameterError(
-            f"The 'grid' option of build_estimator applies to everett='table'; got "
-            f"grid={grid!r} with everett='polynomial'. A polynomial takes 'degree'."
-        )
-    if degree is not None and everett is None:
-        everett = "polynomial"  # a degree names the polynomial of eq. 5, not the default table
-    params = {}
-    if fit is not None:
-        params["fit_method"] = fit
-    if everett is not None:
-        params["everett"] = everett
-    if grid is not None:
-        params["grid_size"] = grid
-    return params
+#: The estimator's name of an option where it is not the option's.
+_HYPERPARAMETERS = {
+    "operators": "n_operators",
+    "deadzones": "n_deadzones",
+    "fit": "fit_method",
+    "grid": "grid_size",
+}
 
 
 def fit_samples(n: int, holdout: float | None) -> int:
@@ -268,11 +254,13 @@ class IdentificationResult:
         The hold-out figures (:func:`~hystcomp.identify.scoring.holdout_report`), or None
         without a hold-out.
     lines : list of str
-        The report, one line each, as ``hystcomp identify`` prints it.
+        The report, one line each; a line that names a remedy is a
+        :class:`~hystcomp._notice.Notice`, which the command line words as its option.
     warnings : list of str
-        Each a sentence (without the ``hystcomp: warning:`` prefix of the command line):
-        the compensator is predicted to track no better than a straight line, or the
-        hold-out leaves the fitted input range.
+        Each a sentence (without the ``hystcomp: warning:`` prefix of the command line),
+        a :class:`~hystcomp._notice.Notice` where it names a remedy: the compensator is
+        predicted to track no better than a straight line, the record does not cover what
+        a reference does, or the hold-out leaves the fitted input range.
     """
 
     model: object
@@ -319,9 +307,10 @@ def identify_record(
     ----------
     record : hystcomp.io.records.Record
         The measured record: time (s), voltage (V), displacement (µm).
-    model : {'pi', 'mpi', 'preisach'} or estimator, optional
+    model : {'pi', 'mpi', 'preisach'} or estimator
         The kind to build with ``voltage_range`` and ``options`` (:func:`build_estimator`),
-        or an unfitted estimator (then give neither).
+        or an estimator (then give neither), of which a copy with the same hyperparameters
+        is fitted: the estimator given stays as it is.
     voltage_range : (float, float), optional
         Amplifier range in V, the compensator's clamp [the fitted input's range].
     allow_extrapolation : bool, optional
@@ -335,8 +324,8 @@ def identify_record(
         Entered around the fit, e.g. ``hystcomp._progress.Progress(...).ticking()``.
     unit_check : bool, default True
         Warn if the displacement's span looks like metres or nanometres read as µm
-        (:func:`hystcomp.io.records.x_unit_warning`); ``hystcomp identify`` checks before
-        the fit instead.
+        (:func:`hystcomp.io.records.x_unit_warning`); a caller that checks before the fit
+        turns it off.
     **options
         ``operators``, ``deadzones``, ``regularization``, ``degree``, ``fit``,
         ``everett``, ``grid``, ``constraints``: see :func:`build_estimator`.
@@ -388,7 +377,7 @@ def identify_record(
         hint = "; ".join(f"{k} is called {names[k]!r} here" for k in unknown if k in names)
         raise InvalidParameterError(
             f"{_OWNER} got an unknown option {unknown[0]!r}; its options are "
-            f"{', '.join(known)} (hystcomp identify's names)" + (f": {hint}." if hint else ".")
+            f"{', '.join(known)} (build_estimator's names)" + (f": {hint}." if hint else ".")
         )
     if progress is not None and not hasattr(progress, "__enter__"):
         raise InvalidTypeError(
@@ -408,6 +397,7 @@ def identify_record(
             f"The 'model' argument of {_OWNER} must be 'pi', 'mpi', 'preisach' or an unfitted "
             f"PI, MPI or Preisach estimator; got {type(model).__name__}."
         )
+    model = type(model)(**model.get_params())  # fitted as a copy: the caller's stays as given
     if holdout is not None and not (isinstance(holdout, numbers.Real) and 0.0 < holdout < 1.0):
         raise InvalidParameterError(
             f"The 'holdout' argument of {_OWNER} must be a fraction strictly between 0 and 1; "
@@ -435,9 +425,13 @@ def identify_record(
         why = extrapolation_error(chosen_range, v)
         if why is not None:
             raise InvalidParameterError(
-                f"The 'voltage_range' of {_OWNER}, {why}: the compensator would command "
-                "voltages the model never saw. Give a range within the record, record over "
-                "the whole range, or pass allow_extrapolation=True."
+                Notice(
+                    f"The 'voltage_range' argument of {_OWNER}, "
+                    "{why}: the compensator would command voltages the model never saw. Give "
+                    "a range within the record, record over the whole range, or pass "
+                    "{allow_extrapolation}.",
+                    why=why,
+                )
             )
     if transient is None:
         start = transient_end(v)
@@ -447,7 +441,7 @@ def identify_record(
         try:
             if "transient" in model.get_params():
                 if transient is not None:
-                    model.transient = start
+                    model.set_params(transient=start)
                 model.fit(v, x)
             else:  # a model without its own transient option is fitted on the settled part
                 check_transient(start, v, f"{_OWNER} ({kind})", min_used=MIN_SETTLED)
@@ -455,10 +449,16 @@ def identify_record(
         except IdentificationError as exc:
             if holdout is None:
                 raise
+            cause = exc.args[0] if len(exc.args) == 1 else str(exc)
+            said = isinstance(cause, Notice)  # its remedies stay data
             raise IdentificationError(
-                f"{exc} The 'holdout' argument of {_OWNER}, {holdout}, leaves the first "
-                f"{n_fit} of {n} samples to fit on: hold out a smaller fraction (0.2 leaves "
-                f"{fit_samples(n, 0.2)})."
+                Notice(
+                    (cause.template if said else "{cause}")
+                    + f" The 'holdout' argument of {_OWNER}, {holdout}, leaves the first "
+                    f"{n_fit} of {n} samples to fit on: hold out a smaller fraction (0.2 "
+                    f"leaves {fit_samples(n, 0.2)}).",
+                    **(cause.data if said else {"cause": str(cause)}),
+                )
             ) from None
     x_model = model.simulate(v)
     fit = error_report(x, x_model, start)
@@ -484,8 +484,11 @@ def identify_record(
         lines.append(f"  initial memory: {memory} (given)")
     elif memory is not None and model.get_params().get("constraints") == "physical":
         lines.append(
-            f"  initial memory: {memory} (the better predicted tracking of 'virgin', eq. 18, "
-            "and 'descended'; --initial-memory gives it)"
+            Notice(
+                f"  initial memory: {memory} (the better predicted tracking of 'virgin', eq. 18, "
+                "and 'descended'; {initial_memory} gives it)",
+                kind="line",
+            )
         )
     if kind == "preisach":
         lines.append(f"  Everett fit: {_preisach_fit_line(model)}")
@@ -512,30 +515,37 @@ def identify_record(
     if not tracking["ratio"] < LINE_MARGIN:
         others = " or ".join(k for k in ESTIMATORS if k != kind)
         warnings.append(
-            f"the {label} compensator is predicted to track "
-            + (
-                "no better than a straight line"
-                if not tracking["ratio"] < 1.0
-                else f"barely better than a straight line ({tracking['ratio']:.2g}x)"
-            )
-            + f" ({tracking['tracking_rms_um']:.3g} vs {tracking['baseline_rms_um']:.3g} µm "
-            "rms), and other references may track worse than the line; "
-            + (
-                "record a signal with turning points across the range (hystcomp excite "
-                f"rich), or try --model {others}."
-                if coverage is not None
-                else f"try --model {others}."
+            Notice(
+                f"the {label} compensator is predicted to track "
+                + (
+                    "no better than a straight line"
+                    if not tracking["ratio"] < 1.0
+                    else f"barely better than a straight line ({tracking['ratio']:.2g}x)"
+                )
+                + f" ({tracking['tracking_rms_um']:.3g} vs {tracking['baseline_rms_um']:.3g} µm "
+                "rms), and other references may track worse than the line; "
+                + (
+                    "record a signal with turning points across the range ({excite_rich}), "
+                    "or try {model}."
+                    if coverage is not None
+                    else "try {model}."
+                ),
+                kind="line",
+                others=others,
             )
         )
     if coverage is not None:
         warnings.append(coverage)
     elif tracking["flatters"]:
         warnings.append(
-            f"on reversal branches it was not fitted on, the {label} model is "
-            f"{tracking['held_out_rms_um'] / tracking['tracking_rms_um']:.2g}x further from "
-            f"the record ({tracking['held_out_rms_um']:.3g} µm) than the estimate above: a "
-            "reference that turns inside the range may track that much worse. Record more "
-            "turning points (hystcomp excite rich), or compare the other models."
+            Notice(
+                f"on reversal branches it was not fitted on, the {label} model is "
+                f"{tracking['held_out_rms_um'] / tracking['tracking_rms_um']:.2g}x further "
+                f"from the record ({tracking['held_out_rms_um']:.3g} µm) than the estimate "
+                "above: a reference that turns inside the range may track that much worse. "
+                "Record more turning points ({excite_rich}), or compare the other models.",
+                kind="flatters",
+            )
         )
     if chosen_range is not None and allow_extrapolation:
         why = extrapolation_error(chosen_range, v)
