@@ -203,12 +203,24 @@ def _ramps(points, rate, sample_rate, owner) -> tuple[np.ndarray, np.ndarray]:
             f"{owner}: a rate of {rate:g} V/s at {sample_rate:g} Hz makes more than "
             f"{MAX_SIGNAL_SAMPLES:.0e} samples. Raise the rate or lower the sample rate."
         )
+    v = _ramps_through(points, step)
+    return np.arange(v.size) / sample_rate, v
+
+
+def _ramps_through(points, step: float) -> np.ndarray:
+    """Straight ramps of at most ``step`` V per sample through ``points`` (V), ending on the
+    last point: each ramp takes the fewest samples that keep its steps within ``step``.
+
+    Examples
+    --------
+    >>> _ramps_through(np.array([0.0, 2.0, 1.0]), 1.0).tolist()
+    [0.0, 1.0, 2.0, 1.0]
+    """
     pieces = []
     for lo, hi in itertools.pairwise(points):
         n = max(1, int(np.ceil(abs(hi - lo) / step)))
         pieces.append(lo + (hi - lo) * np.arange(n) / n)
-    v = np.r_[np.concatenate(pieces), points[-1]]
-    return np.arange(v.size) / sample_rate, v
+    return np.r_[np.concatenate(pieces), points[-1]]
 
 
 def rich_turning_points(
