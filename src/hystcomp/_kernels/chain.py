@@ -147,14 +147,6 @@ def deadzone_block(x, shift, r, w, out):
 
 
 @kernel
-def deadzone_sum(z, r, w):
-    """Weighted superposition of one-sided dead-zones (eqs. 13-14) at one point ``z``."""
-    out = np.empty(1)
-    deadzone_block(np.full(1, z), 0.0, r, w, out)
-    return out[0]
-
-
-@kernel
 def deadzone_values(z, r, out):
     """Each one-sided dead-zone of eq. (13) at ``z``: ``out[j] = s_{r_j}(z)``.
 

@@ -178,10 +178,6 @@ class TwinParameters:
         """A copy with some parameters changed (validated again)."""
         return dataclasses.replace(self, **changes)
 
-    def as_dict(self) -> dict:
-        """Plain values, e.g. for a report."""
-        return {k: (list(v) if isinstance(v, tuple) else v) for k, v in vars(self).items()}
-
 
 def dynamics_matrices(params: TwinParameters) -> tuple[np.ndarray, np.ndarray]:
     """``(Ad, Bd)`` of the exact zero-order-hold discretisation of ``D(s)``.
