@@ -128,17 +128,12 @@ def inverse_block(p, u, out, cuts):
 def inverse_step(p, u):
     """One reference sample ``u`` (µm) through the inverse filter; NaN (state kept) if not finite.
 
-    A one-sample :func:`inverse_block` run through the scratch slots of the state, so that
-    the streaming step and the batch run are the same code and agree bit for bit; the slot
-    :data:`ST_CUT` then says whether the clamp counted the sample.
+    A one-sample :func:`inverse_block` run (:func:`~hystcomp._kernels.chain.one_sample`), so
+    that the streaming step and the batch run are the same code and agree bit for bit; the
+    slot :data:`ST_CUT` (its scratch slot) then says whether the clamp counted the sample.
     """
     s = state_start(p)
-    i = s + ST_INPUT
-    o = s + ST_OUTPUT
-    q = s + ST_CUT
-    p[i] = u
-    inverse_block(p, p[i : i + 1], p[o : o + 1], p[q : q + 1])
-    return p[o]
+    return chain.one_sample(inverse_block, p, s + ST_INPUT, s + ST_OUTPUT, s + ST_CUT, u)
 
 
 @kernel
