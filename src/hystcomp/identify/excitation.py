@@ -22,8 +22,10 @@ PREISACH_AMPLITUDES = paper.PREISACH_AMPLITUDES  # V, Section III-A (i)
 MIN_SAMPLES_PER_PERIOD = 4  # fewer cannot draw a triangle or a sinusoid
 
 
-def _periods(owner, amplitudes, sample_rate, frequency, v_min):
-    """Validated amplitudes and ``v_min``, and the phase of one period in [0, 1)."""
+def _periods(owner, shape, amplitudes, sample_rate, frequency, v_min):
+    """``(t, v)``: one period of ``v_min + A * shape(phase)`` per amplitude ``A``, then
+    ``v_min`` (``shape`` maps the phase of a period, in [0, 1), to 0 .. 1 and back to 0),
+    after checking the arguments of ``owner``."""
     amplitudes = as_vector(amplitudes, "amplitudes", owner)
     if np.any(amplitudes < 0):
         raise InvalidParameterError(
@@ -52,7 +54,9 @@ def _periods(owner, amplitudes, sample_rate, frequency, v_min):
             f"{frequency:g} Hz) make {n * amplitudes.size + 1} samples, more than "
             f"{MAX_SIGNAL_SAMPLES:.0e}. Lower the sample rate or raise the frequency."
         )
-    return amplitudes, v_min, np.arange(n) / n
+    unit = shape(np.arange(n) / n)
+    v = np.concatenate([a * unit for a in amplitudes] + [np.zeros(1)]) + v_min
+    return np.arange(v.size) / sample_rate, v
 
 
 def triangle_sequence(
@@ -78,12 +82,11 @@ def triangle_sequence(
     >>> v.tolist()
     [0.0, 5.0, 10.0, 5.0, 0.0, 10.0, 20.0, 10.0, 0.0]
     """
-    amplitudes, v_min, phase = _periods(
-        "triangle_sequence", amplitudes, sample_rate, frequency, v_min
-    )
-    shape = 1.0 - np.abs(1.0 - 2.0 * phase)  # 0 -> 1 -> 0
-    v = np.concatenate([a * shape for a in amplitudes] + [np.zeros(1)]) + v_min
-    return np.arange(v.size) / sample_rate, v
+    return _periods(
+        "triangle_sequence",
+        lambda phase: 1.0 - np.abs(1.0 - 2.0 * phase),  # 0 -> 1 -> 0
+        amplitudes, sample_rate, frequency, v_min,
+    )  # fmt: skip
 
 
 def sinusoid_sequence(
@@ -104,12 +107,11 @@ def sinusoid_sequence(
     t, v : ndarray
         Time in s and voltage in V.
     """
-    amplitudes, v_min, phase = _periods(
-        "sinusoid_sequence", amplitudes, sample_rate, frequency, v_min
-    )
-    shape = 0.5 * (1.0 - np.cos(2.0 * np.pi * phase))
-    v = np.concatenate([a * shape for a in amplitudes] + [np.zeros(1)]) + v_min
-    return np.arange(v.size) / sample_rate, v
+    return _periods(
+        "sinusoid_sequence",
+        lambda phase: 0.5 * (1.0 - np.cos(2.0 * np.pi * phase)),
+        amplitudes, sample_rate, frequency, v_min,
+    )  # fmt: skip
 
 
 def scaled_amplitudes(
