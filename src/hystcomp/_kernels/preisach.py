@@ -530,12 +530,11 @@ def everett_basis(kind, exps, n_seg, v_min, v_max, alpha, beta, out):
             m += 1
 
 
-@inline_kernel
-def _basis_output(kind, exps, n_seg, v_min, v_max, e, q, top, value, work, out):
-    """``out[m]``: basis element ``m``'s output at input ``value`` on the branch from stored
-    extremum ``top`` (its prefix sum ``q[top]`` plus, rising from a minimum, ``X_m(value,
-    e[top])``, or, falling from a maximum, minus ``X_m(e[top], value)``), as
-    :func:`preisach_apply` forms the model's output. ``work`` holds the basis values."""
+@kernel
+def _push_basis(kind, exps, n_seg, v_min, v_max, e, q, top, value, work):
+    """:func:`_push` on the basis: a turning point and its prefix-sum vector."""
+    if top + 1 >= e.size:
+        top -= 2  # full: wipe out the innermost stored pair first, as the model does
     if top % 2 == 0:
         everett_basis(kind, exps, n_seg, v_min, v_max, value, e[top], work)
         sign = 1.0
@@ -543,15 +542,7 @@ def _basis_output(kind, exps, n_seg, v_min, v_max, e, q, top, value, work, out):
         everett_basis(kind, exps, n_seg, v_min, v_max, e[top], value, work)
         sign = -1.0
     for m in range(work.size):
-        out[m] = q[top, m] + sign * work[m]
-
-
-@kernel
-def _push_basis(kind, exps, n_seg, v_min, v_max, e, q, top, value, work):
-    """:func:`_push` on the basis: a turning point and its prefix-sum vector."""
-    if top + 1 >= e.size:
-        top -= 2  # full: wipe out the innermost stored pair first, as the model does
-    _basis_output(kind, exps, n_seg, v_min, v_max, e, q, top, value, work, q[top + 1])
+        q[top + 1, m] = q[top, m] + sign * work[m]
     e[top + 1] = value
     return top + 1
 
@@ -590,7 +581,14 @@ def preisach_rows(kind, exps, n_seg, v_min, v_max, v, x, first, start, stride, m
         previous = u
         if k >= start and (k - start) % stride == 0:
             row = rows[count]
-            _basis_output(kind, exps, n_seg, v_min, v_max, e, q, top, u, work, row)
+            if top % 2 == 0:
+                everett_basis(kind, exps, n_seg, v_min, v_max, u, e[top], work)
+                sign = 1.0
+            else:
+                everett_basis(kind, exps, n_seg, v_min, v_max, e[top], u, work)
+                sign = -1.0
+            for m in range(p):
+                row[m] = q[top, m] + sign * work[m]
             row[p] = 1.0
             row[p + 1] = x[k]
             count += 1
