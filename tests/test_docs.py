@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+import hystcomp
 from hystcomp import presets
 from hystcomp.identify.excitation import triangle_sequence
 from hystcomp.plant import Twin
@@ -72,7 +73,13 @@ def test_user_guide_first_python_block_runs(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     namespace: dict = {}
     exec(compile(code, "docs/guide.md", "exec"), namespace)  # noqa: S102 - our own guide
-    assert (tmp_path / "model.json").is_file()
+    # the file it saves is the model it fitted, whose fit error is its error on the record
+    model, v, x = namespace["model"], namespace["v"], namespace["x"]
+    loaded = hystcomp.load_model(tmp_path / "model.json")
+    np.testing.assert_array_equal(loaded.simulate(v), model.simulate(v))
+    rms = float(np.sqrt(np.mean((model.simulate(v) - x) ** 2)))
+    assert model.fit_report_["rms_error_um"] == pytest.approx(rms, rel=0.01)
+    assert rms < 0.01 * np.ptp(x)  # an MPI follows the axis within 1 % of its stroke
 
 
 @pytest.mark.skipif(shutil.which("cc") is None, reason="needs a C compiler (cc)")
