@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import hystcomp
-from hystcomp import presets
+from hystcomp import paper, presets
 from hystcomp.errors import ModelFileError
 from tests.conftest import random_walk
 
@@ -15,7 +15,12 @@ def test_pi_preset_is_eq_20_in_micrometres_per_volt():
     model = presets.paper_pi()
     assert model.weights_[0] == pytest.approx(0.1386)
     assert model.thresholds_[1] == pytest.approx(7.5)  # eq. (16): 120 / 16
-    assert model.simulate([0.0, 120.0])[-1] == pytest.approx(37.78875)
+    np.testing.assert_array_equal(model.weights_, paper.PI_WEIGHTS)
+    # from rest (eq. 18: every play at 0) up to 120 V, play i outputs 120 - r_i (eq. 11), so
+    # eq. (12) gives sum_i w_i (120 - 7.5 i), with the printed weights of eq. (20)
+    stroke = sum(w * (120.0 - 7.5 * i) for i, w in enumerate(paper.PI_WEIGHTS))
+    assert model.simulate([0.0, 120.0])[-1] == pytest.approx(stroke, rel=1e-12)
+    assert stroke == pytest.approx(37.8, abs=0.05)  # the stroke the presets' notes quote
 
 
 def test_mpi_preset_max_displacement_is_the_fixed_point():

@@ -159,8 +159,9 @@ def _check(before: dict, after: dict, expected: dict, rc: int, err: str, sig: in
 
 def _no_process_left(pgid: int) -> bool:
     """Whether the process group ``pgid`` is empty (no forked helper outlived the command),
-    within two seconds."""
-    deadline = time.monotonic() + 2.0
+    within five seconds (it returns as soon as the group is empty; the margin is for a
+    machine that the suite's other process, or other work, keeps busy)."""
+    deadline = time.monotonic() + 5.0
     while time.monotonic() < deadline:
         try:
             os.killpg(pgid, 0)

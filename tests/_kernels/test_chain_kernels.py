@@ -30,12 +30,16 @@ def test_play_is_backlash_with_the_expected_width():
     assert (out[10, 0], out[12, 0], out[-1, 0]) == (8.0, 8.0, 2.0)
 
 
-def test_deadzone_sum_matches_naive(rng):
+def test_one_sample_deadzone_block_matches_naive(rng):
+    # the folded one-sample path of deadzone_block (a streaming step), on both sides of
+    # every threshold and exactly on them
     r = np.array([0.0, 0.5, 2.0, 7.0])
     w = np.array([1.5, -0.4, 0.3, -0.2])
-    for z in rng.uniform(-5, 12, 200):
+    out = np.empty(1)
+    for z in [*rng.uniform(-5, 12, 200), *r, -0.0]:
+        chain.deadzone_block(np.array([z]), 0.0, r, w, out)
         expected = naive.saturation(np.array([z]), r, w)[0]
-        assert chain.deadzone_sum(z, r, w) == pytest.approx(expected, abs=1e-12)
+        assert out[0] == pytest.approx(expected, abs=1e-12)
 
 
 def test_chain_clamps_and_limits_slew():

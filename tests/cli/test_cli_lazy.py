@@ -74,8 +74,11 @@ def test_import_hystcomp_loads_no_heavy_module_until_asked():
 
 def test_every_public_name_resolves():
     assert set(hystcomp.__all__) == {"__version__", *hystcomp._LAZY}
-    for name in hystcomp.__all__:
-        assert getattr(hystcomp, name) is not None
+    for name, (module, attribute) in hystcomp._LAZY.items():  # the object it names
+        owner = importlib.import_module(module)
+        assert getattr(hystcomp, name) is (
+            owner if attribute is None else getattr(owner, attribute)
+        )
     assert set(hystcomp.__all__) <= set(dir(hystcomp))
     with pytest.raises(AttributeError, match="no attribute 'nothing'"):
         hystcomp.nothing  # noqa: B018

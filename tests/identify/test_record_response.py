@@ -50,8 +50,12 @@ def test_every_fit_refuses_a_displacement_that_does_not_respond(kind, what, rng)
 def test_a_noisy_response_is_still_identified(kind, rng):
     v = _signal(kind)
     x = _true_x(kind, v)
-    noisy = x + 0.05 * np.ptp(x) * rng.standard_normal(v.size)  # 5 % of the stroke
-    FITS[kind]().fit(v, noisy)
+    noise = 0.05 * np.ptp(x)  # rms, 5 % of the stroke
+    model = FITS[kind]().fit(v, x + noise * rng.standard_normal(v.size))
+    # the model found is the response under the noise: it misses the noisy record by the
+    # noise, and the noise-free response by much less (the noise averages out in the fit)
+    assert model.fit_report_["rms_error_um"] == pytest.approx(noise, rel=0.1)
+    assert np.sqrt(np.mean((model.simulate(v) - x) ** 2)) < 0.5 * noise
 
 
 def test_short_noise_is_refused_even_when_a_line_explains_much(rng):

@@ -1,5 +1,4 @@
-"""The io package: atomic outputs are a leaf, every public name is re-exported, and the
-deprecated ``hystcomp.data`` still gives the records API."""
+"""The io package: atomic outputs are a leaf, and every public name is re-exported."""
 
 from __future__ import annotations
 
@@ -87,18 +86,3 @@ def test_every_public_name_of_the_package_is_its_module_s_object():
     assert hystcomp.save_model is models.save_model
     with pytest.raises(AttributeError, match="no attribute 'nothing'"):
         hystcomp.io.nothing  # noqa: B018
-
-
-def test_hystcomp_data_is_a_deprecated_alias_of_the_records():
-    from hystcomp import data  # importing alone does not warn (doctests collect it)
-
-    for name in data.__all__:
-        with pytest.warns(DeprecationWarning, match=rf"hystcomp\.data is deprecated.*io\.{name}"):
-            value = getattr(data, name)
-        assert value is getattr(records, name), name
-    with pytest.warns(DeprecationWarning, match="hystcomp.data is deprecated"):
-        from hystcomp.data import Record, read_record
-    assert (Record, read_record) == (records.Record, records.read_record)
-    assert {"Record", "read_record", "read_table", "write_table"} <= set(dir(data))
-    with pytest.raises(AttributeError, match="no attribute 'nothing'"):
-        data.nothing  # noqa: B018

@@ -13,7 +13,7 @@ from hystcomp import presets
 from hystcomp.cli import main
 from hystcomp.identify.excitation import triangle_sequence
 from hystcomp.io.records import read_table, write_table
-from tests.codegen.test_codegen import CC, _compile, _run_c, needs_cc
+from tests.codegen.test_codegen import _compile, _run_c, needs_cc
 
 COMPENSATORS = {
     "pi": (presets.paper_pi, {}),
@@ -112,17 +112,20 @@ def test_a_first_nan_holds_a_voltage_inside_a_narrowed_range(name):
 def test_a_first_nan_in_c_holds_a_voltage_inside_a_narrowed_range(name, tmp_path):
     make, options = COMPENSATORS[name]
     comp = make().inverse(voltage_range=(10.0, 50.0), **options)
+    x_ref = np.array([np.nan, np.nan, 5.0])
     drive = _compile(comp, tmp_path, "comp") if "preisach" not in name else None
     if drive is None:
         from tests.codegen.test_codegen import _compile_preisach
 
-        v, _depth, held = _compile_preisach(comp, tmp_path)(np.array([np.nan, np.nan, 5.0]))
+        v, _depth, held = _compile_preisach(comp, tmp_path)(x_ref)
     else:
-        v, held = _run_c(drive, np.array([np.nan, np.nan, 5.0]))
+        v, held = _run_c(drive, x_ref)
     assert held == 2
     assert v[0] == v[1] == 10.0
     assert 10.0 <= v[2] <= 50.0
-    assert CC is not None
+    stepper = comp.stepper()  # and sample for sample the Python stepper's voltages
+    np.testing.assert_array_equal(v, [stepper.step(x) for x in x_ref])
+    assert stepper.nonfinite_count == held
 
 
 def _files(tmp_path, model, x_ref):

@@ -147,14 +147,6 @@ def deadzone_block(x, shift, r, w, out):
 
 
 @kernel
-def deadzone_sum(z, r, w):
-    """Weighted superposition of one-sided dead-zones (eqs. 13-14) at one point ``z``."""
-    out = np.empty(1)
-    deadzone_block(np.full(1, z), 0.0, r, w, out)
-    return out[0]
-
-
-@kernel
 def deadzone_values(z, r, out):
     """Each one-sided dead-zone of eq. (13) at ``z``: ``out[j] = s_{r_j}(z)``.
 
@@ -289,21 +281,29 @@ def chain_blocks(p, u, out, work):
     state[STATE_CLAMPED] = clamped
 
 
+@inline_kernel
+def one_sample(block, p, i, o, w, u):
+    """``u`` through ``block(p, u, out, work)`` as a one-sample block, the output.
+
+    The sample, the output and the work buffer are the slots ``i``, ``o`` and ``w`` of
+    ``p`` (a state's scratch slots), so that a streaming step and the batch run it mirrors
+    are the same code, bit for bit. Inlined into each step kernel, with ``block`` a
+    compile-time constant there.
+    """
+    p[i] = u
+    block(p, p[i : i + 1], p[o : o + 1], p[w : w + 1])
+    return p[o]
+
+
 @step_kernel
 def chain_step(p, u):
     """One sample through packed chain ``p``; updates the state in ``p`` and returns the output.
 
-    A one-sample :func:`chain_blocks` run through the scratch slots of the state, so that
-    the streaming step and the batch run are the same code, bit for bit. A non-finite ``u``
-    holds the last output and increments the non-finite counter.
+    A one-sample :func:`chain_blocks` run (:func:`one_sample`). A non-finite ``u`` holds the
+    last output and increments the non-finite counter.
     """
     s = chain_state_start(p)
-    i = s + STATE_INPUT
-    o = s + STATE_OUTPUT
-    w = s + STATE_WORK
-    p[i] = u
-    chain_blocks(p, p[i : i + 1], p[o : o + 1], p[w : w + 1])
-    return p[o]
+    return one_sample(chain_blocks, p, s + STATE_INPUT, s + STATE_OUTPUT, s + STATE_WORK, u)
 
 
 @kernel

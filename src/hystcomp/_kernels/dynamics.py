@@ -35,7 +35,7 @@ from __future__ import annotations
 import math
 
 from hystcomp._kernels import chain, preisach
-from hystcomp._kernels._jit import inner_kernel, kernel, step_kernel
+from hystcomp._kernels._jit import inline_kernel, inner_kernel, kernel, step_kernel
 from hystcomp._kernels.chain import CLAMP_TOLERANCE
 
 N_FIR, N_CREEP, SCALE, DIRECT, LOW, HIGH, BIAS = range(7)
@@ -128,17 +128,12 @@ def inverse_block(p, u, out, cuts):
 def inverse_step(p, u):
     """One reference sample ``u`` (µm) through the inverse filter; NaN (state kept) if not finite.
 
-    A one-sample :func:`inverse_block` run through the scratch slots of the state, so that
-    the streaming step and the batch run are the same code and agree bit for bit; the slot
-    :data:`ST_CUT` then says whether the clamp counted the sample.
+    A one-sample :func:`inverse_block` run (:func:`~hystcomp._kernels.chain.one_sample`), so
+    that the streaming step and the batch run are the same code and agree bit for bit; the
+    slot :data:`ST_CUT` (its scratch slot) then says whether the clamp counted the sample.
     """
     s = state_start(p)
-    i = s + ST_INPUT
-    o = s + ST_OUTPUT
-    q = s + ST_CUT
-    p[i] = u
-    inverse_block(p, p[i : i + 1], p[o : o + 1], p[q : q + 1])
-    return p[o]
+    return chain.one_sample(inverse_block, p, s + ST_INPUT, s + ST_OUTPUT, s + ST_CUT, u)
 
 
 @kernel
@@ -159,32 +154,39 @@ def inverse_run_cuts(p, u, out, cuts):
 # -- the inverse filter in front of a hysteresis compensator, one compiled call a sample ----
 
 
+@inline_kernel
+def _pair_step(pd, ph, clamped, step, u):
+    """``u`` (µm) through the inverse filter ``pd``, then ``step`` of the packed compensator
+    ``ph`` whose clamp count is in slot ``clamped``: the voltage.
+
+    A sample that the filter's clamp counted (out of reach) is not counted again by the
+    voltage range's: the compensator's count is put back. A non-finite ``u`` leaves the
+    filter as it was, and the compensator holds its last output and counts it. Inlined into
+    each pair's step kernel, with ``step`` a compile-time constant there.
+    """
+    counted = ph[clamped]
+    v = step(ph, inverse_step(pd, u))
+    if pd[state_start(pd) + ST_CUT] != 0.0:
+        ph[clamped] = counted
+    return v
+
+
 @step_kernel
 def chain_pair_step(pd, ph, u):
     """``u`` (µm) through the inverse filter ``pd``, then the packed chain ``ph``: the voltage.
 
-    The streaming step of a compensator with dynamics in one compiled call. A sample that
-    the filter's clamp counted (out of reach) is not counted again by the voltage range's:
-    the chain's count is put back. A non-finite ``u`` leaves the filter as it was, and the
-    chain holds its last output and counts it.
+    The streaming step of a compensator with dynamics in one compiled call
+    (:func:`_pair_step`).
     """
-    slot = chain.chain_state_start(ph) + chain.STATE_CLAMPED
-    counted = ph[slot]
-    v = chain.chain_step(ph, inverse_step(pd, u))
-    if pd[state_start(pd) + ST_CUT] != 0.0:
-        ph[slot] = counted
-    return v
+    clamped = chain.chain_state_start(ph) + chain.STATE_CLAMPED
+    return _pair_step(pd, ph, clamped, chain.chain_step, u)
 
 
 @step_kernel
 def preisach_pair_step(pd, ph, u):
     """:func:`chain_pair_step` with a packed Preisach compensator ``ph`` behind the filter."""
-    slot = preisach.state_start(ph) + preisach.ST_CLAMPED
-    counted = ph[slot]
-    v = preisach.preisach_step(ph, inverse_step(pd, u))
-    if pd[state_start(pd) + ST_CUT] != 0.0:
-        ph[slot] = counted
-    return v
+    clamped = preisach.state_start(ph) + preisach.ST_CLAMPED
+    return _pair_step(pd, ph, clamped, preisach.preisach_step, u)
 
 
 #: The step kernel of the inverse filter in front of a compensator, by the compensator's

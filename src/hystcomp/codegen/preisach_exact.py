@@ -6,9 +6,9 @@ input is followed through the stored extrema (where wipe-outs change it) until i
 ``target``, then solved by the Illinois variant of regula falsi with a bisection every
 fourth step. A reference out of reach gives the range ends; a reference inside the step
 that a non-zero ``X(v, v)`` opens at a reversal holds the voltage. The iteration, its
-tolerances and its comparisons are the Python kernel's, in the same order (its ``_solve``
-serves both directions with a sign; here ``{p}_solve_up`` and ``{p}_solve_down`` write the
-two out).
+tolerances and its comparisons are the Python kernel's, in the same order (``{p}_solve``
+serves both directions, as ``_solve`` does with its sign; a comparison multiplied by a sign
+of 1 or -1 in Python is written as the comparison itself in C, the same test).
 """
 
 from __future__ import annotations
@@ -17,9 +17,8 @@ from hystcomp.codegen.c99 import c_double
 
 
 def exact_functions(v_min: float, v_max: float) -> list[str]:
-    """C definitions of ``{p}_branch``, ``{p}_root``, ``{p}_solve_up``, ``{p}_solve_down``
-    and ``{p}_exact_input`` for a Preisach plane ``v_min .. v_max`` (V); they call
-    ``{p}_everett``.
+    """C definitions of ``{p}_branch``, ``{p}_root``, ``{p}_solve`` and ``{p}_exact_input``
+    for a Preisach plane ``v_min .. v_max`` (V); they call ``{p}_everett``.
 
     Parameters
     ----------
@@ -34,7 +33,7 @@ def exact_functions(v_min: float, v_max: float) -> list[str]:
         The C definitions, one string each.
     """
     ends = {"V_MIN": c_double(v_min), "V_MAX": c_double(v_max)}
-    functions = [_BRANCH, _ROOT, _SOLVE_UP, _SOLVE_DOWN, _EXACT_INPUT]
+    functions = [_BRANCH, _ROOT, _SOLVE, _EXACT_INPUT]
     out = []
     for text in functions:
         for name, value in ends.items():
@@ -120,82 +119,53 @@ static double {p}_root(double base, double pivot, int rising, double lo, double 
     return -f_lo < f_hi ? lo : hi;
 }"""
 
-_SOLVE_UP = """\
-/* Smallest rise of the input whose branch output reaches target (> h). */
-static double {p}_solve_up(const {p}_state *s, long top, double previous, double target)
+_SOLVE = """\
+/* Smallest rise (rising) or fall of the input from previous whose branch output reaches
+   target (above, or below, h). The branch runs from the near end previous to the far end,
+   the next stored extremum in that direction (or the range end); past it, that extremum
+   and its partner are wiped out and the next outer branch goes on. */
+static double {p}_solve(const {p}_state *s, long top, double previous, double target,
+                        int rising)
 {
-    double base, pivot, lo, hi, b_lo, b_hi;
+    double end = rising ? V_MAX : V_MIN;
+    double base, pivot, near, far, b_near, b_far;
     long k;
     int first = 1;
-    if (top % 2 == 1) { /* a reversal: the branch starts at a new minimum beta = previous */
-        base = s->q[top] - {p}_everett(s->e[top], previous);
+    if ((top % 2 == 1) == rising) {
+        /* a reversal: the branch starts at a new extremum (a minimum rising, a maximum
+           falling) at previous */
+        base = rising ? s->q[top] - {p}_everett(s->e[top], previous)
+                      : s->q[top] + {p}_everett(previous, s->e[top]);
         pivot = previous;
-        hi = s->e[top];
+        far = s->e[top];
         k = top - 1;
     } else {
         base = s->q[top];
         pivot = s->e[top];
-        hi = top >= 2 ? s->e[top - 1] : V_MAX;
+        far = top >= 1 ? s->e[top - 1] : end;
         k = top - 2;
     }
-    lo = previous;
+    near = previous;
     for (;;) {
-        b_hi = {p}_branch(base, pivot, 1, hi);
-        if (target <= b_hi) {
-            b_lo = {p}_branch(base, pivot, 1, lo);
-            if (first && b_lo >= target) {
+        b_far = {p}_branch(base, pivot, rising, far);
+        if (rising ? target <= b_far : target >= b_far) {
+            b_near = {p}_branch(base, pivot, rising, near);
+            if (first && (rising ? b_near >= target : b_near <= target)) {
                 return previous; /* in the step a non-zero X(v, v) opens at a reversal */
             }
-            return {p}_root(base, pivot, 1, lo, hi, target, b_lo, b_hi);
+            if (rising) {
+                return {p}_root(base, pivot, 1, near, far, target, b_near, b_far);
+            }
+            return {p}_root(base, pivot, 0, far, near, target, b_far, b_near);
         }
         if (k < 0) {
-            return V_MAX;
+            return end;
         }
-        first = 0; /* past a stored maximum: wiped out, the next outer branch */
-        lo = hi;
+        first = 0; /* past a stored extremum: wiped out, the next outer branch */
+        near = far;
         base = s->q[k];
         pivot = s->e[k];
-        hi = k >= 2 ? s->e[k - 1] : V_MAX;
-        k -= 2;
-    }
-}"""
-
-_SOLVE_DOWN = """\
-/* Smallest fall of the input whose branch output reaches target (< h). */
-static double {p}_solve_down(const {p}_state *s, long top, double previous, double target)
-{
-    double base, pivot, lo, hi, b_lo, b_hi;
-    long k;
-    int first = 1;
-    if (top % 2 == 0) { /* a reversal: the branch starts at a new maximum alpha = previous */
-        base = s->q[top] + {p}_everett(previous, s->e[top]);
-        pivot = previous;
-        lo = s->e[top];
-        k = top - 1;
-    } else {
-        base = s->q[top];
-        pivot = s->e[top];
-        lo = s->e[top - 1];
-        k = top - 2;
-    }
-    hi = previous;
-    for (;;) {
-        b_lo = {p}_branch(base, pivot, 0, lo);
-        if (target >= b_lo) {
-            b_hi = {p}_branch(base, pivot, 0, hi);
-            if (first && b_hi <= target) {
-                return previous; /* in the step a non-zero X(v, v) opens at a reversal */
-            }
-            return {p}_root(base, pivot, 0, lo, hi, target, b_lo, b_hi);
-        }
-        if (k < 1) {
-            return V_MIN;
-        }
-        first = 0; /* past a stored minimum: wiped out, the next outer branch */
-        hi = lo;
-        base = s->q[k];
-        pivot = s->e[k];
-        lo = s->e[k - 1];
+        far = k >= 1 ? s->e[k - 1] : end;
         k -= 2;
     }
 }"""
@@ -206,10 +176,10 @@ _EXACT_INPUT = """\
 static double {p}_exact_input(const {p}_state *s, double target)
 {
     if (target > s->h) {
-        return {p}_solve_up(s, s->top, s->input, target);
+        return {p}_solve(s, s->top, s->input, target, 1);
     }
     if (target < s->h) {
-        return {p}_solve_down(s, s->top, s->input, target);
+        return {p}_solve(s, s->top, s->input, target, 0);
     }
     return s->input;
 }"""

@@ -21,7 +21,13 @@ from matplotlib.ticker import (
     NullFormatter,
 )
 
+from hystcomp.errors import InvalidParameterError
 from hystcomp.io.atomic import atomic_path
+
+#: The image formats a figure is saved in, by the output's suffix.
+FORMATS = (".png", ".pdf", ".svg")
+#: Resolution of a saved figure (dots per inch) where its module sets none of its own.
+DPI = 150
 
 #: ``set_title(..., y=TITLE_Y)``: the title just above the axes, where matplotlib's automatic
 #: placement puts it when the tick labels are below them, without that placement (which
@@ -42,7 +48,7 @@ MAJOR_TICKS = 5
 LOG_MINOR_SUBS = (2.0, 5.0)
 
 
-def _thin(n: int, points: int = 5000) -> slice:
+def thin_slice(n: int, points: int = 5000) -> slice:
     """Every k-th sample, so that a line has about ``points`` points (plots only)."""
     return slice(None, None, max(1, n // points))
 
@@ -103,6 +109,27 @@ def fixed_layout(fig: Figure, *, left, right, top, bottom, hgap=0.0, wgap=0.0, r
         wspace=wgap / axes_w,
         hspace=hgap / axes_h,
     )
+
+
+def check_figure_path(path) -> Path:
+    """``path`` as a Path if a figure can be saved there (by its suffix), else raise.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The figure's file.
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``, checked.
+    """
+    path = Path(os.fspath(path))
+    if path.suffix.lower() not in FORMATS:
+        raise InvalidParameterError(
+            f"Cannot save a figure as {str(path)!r}: use a name ending in {', '.join(FORMATS)}."
+        )
+    return path
 
 
 def save_figure(fig: Figure, path: str | os.PathLike, *, dpi: float) -> None:

@@ -3,16 +3,7 @@ measured displacement against the reference."""
 
 from __future__ import annotations
 
-from hystcomp.experiment._layout import (
-    TITLE_Y,
-    _thin,
-    envelope,
-    fixed_layout,
-    new_figure,
-    pixel_columns,
-    save_figure,
-)
-from hystcomp.experiment.fig_identification import DPI, check_figure_path
+from hystcomp.experiment import _layout as layout
 
 
 def plot_evaluation(result, path) -> None:
@@ -30,12 +21,12 @@ def plot_evaluation(result, path) -> None:
     path : str or path-like
         Output image, ``.png``, ``.pdf`` or ``.svg`` (written atomically).
     """
-    path = check_figure_path(path)
-    fig = new_figure((10.0, 4.2))
-    fixed_layout(fig, left=0.75, right=0.15, top=0.4, bottom=0.6, wgap=0.75, cols=2)
+    path = layout.check_figure_path(path)
+    fig = layout.new_figure((10.0, 4.2))
+    layout.fixed_layout(fig, left=0.75, right=0.15, top=0.4, bottom=0.6, wgap=0.75, cols=2)
     ax_e, ax_x = fig.subplots(1, 2)
     t, e = result.t, result.e
-    t_env, e_env = envelope(t, e, pixel_columns(fig, ax_e, DPI))
+    t_env, e_env = layout.envelope(t, e, layout.pixel_columns(fig, ax_e, layout.DPI))
     ax_e.plot(t_env, e_env, color="tab:blue", lw=0.6, label="error x - x_ref")
     for i, span in enumerate(result.spans):
         ax_e.plot(
@@ -48,22 +39,22 @@ def plot_evaluation(result, path) -> None:
     ax_e.axhline(0.0, color="0.3", lw=0.6)
     ax_e.set_title(
         f"(a) tracking error: rms {result.rms_um:.3g} µm, max {result.max_um:.3g} µm",
-        y=TITLE_Y,
+        y=layout.TITLE_Y,
     )
     ax_e.set_xlabel("time t (s)")
     ax_e.set_ylabel("error x - x_ref (µm)")
     ax_e.grid(alpha=0.3)
     ax_e.legend(loc="lower right", fontsize="small", framealpha=0.9)
-    thin = _thin(t.size, 20_000)
+    thin = layout.thin_slice(t.size, 20_000)
     lo, hi = float(result.x_ref.min()), float(result.x_ref.max())
     ax_x.plot([lo, hi], [lo, hi], color="0.55", lw=1.6, label="x = x_ref (perfect tracking)")
     ax_x.plot(result.x_ref[thin], result.x[thin], color="tab:blue", lw=0.7, label="measured x")
     loop = (
         f", hysteresis {result.hysteresis_pct:.2g} %" if result.hysteresis_pct is not None else ""
     )
-    ax_x.set_title(f"(b) measured against reference{loop}", y=TITLE_Y)
+    ax_x.set_title(f"(b) measured against reference{loop}", y=layout.TITLE_Y)
     ax_x.set_xlabel("reference x_ref (µm)")
     ax_x.set_ylabel("displacement x (µm)")
     ax_x.grid(alpha=0.3)
     ax_x.legend(loc="upper left")
-    save_figure(fig, path, dpi=DPI)
+    layout.save_figure(fig, path, dpi=layout.DPI)

@@ -10,46 +10,24 @@ largest value), the hold-out in its own colour and the excerpts shaded.
 
 from __future__ import annotations
 
-import os
 from pathlib import Path
 
 import numpy as np
 
-from hystcomp.errors import InvalidParameterError
 from hystcomp.experiment._layout import (
+    DPI,
+    FORMATS,
     TITLE_Y,
-    _thin,
+    check_figure_path,
     envelope,
     fixed_layout,
     new_figure,
     pixel_columns,
     save_figure,
+    thin_slice,
 )
 
-FORMATS = (".png", ".pdf", ".svg")
-DPI = 150
-
-
-def check_figure_path(path) -> Path:
-    """``path`` as a Path if a figure can be saved there (by its suffix), else raise.
-
-    Parameters
-    ----------
-    path : str or os.PathLike
-        The figure's file.
-
-    Returns
-    -------
-    pathlib.Path
-        ``path``, checked.
-    """
-    path = Path(os.fspath(path))
-    if path.suffix.lower() not in FORMATS:
-        raise InvalidParameterError(
-            f"Cannot save a figure as {str(path)!r}: use a name ending in {', '.join(FORMATS)}."
-        )
-    return path
-
+__all__ = ["FORMATS", "plot_identification", "plot_identification_result", "turning_points"]
 
 #: Turning points of the input above which a record is drawn as excerpts (about 6 loops).
 LONG_TURNS = 12
@@ -165,7 +143,7 @@ def _whole(v, x, before, after, path: Path, model_name: str) -> None:
         ("(a) before identification (straight line)", before),
         (f"(b) after identification ({model_name})", after),
     ]
-    thin = _thin(v.size)  # the drawn lines only; the rms is over every sample
+    thin = thin_slice(v.size)  # the drawn lines only; the rms is over every sample
     for ax, (title, model_x) in zip(axes, panels, strict=True):
         ax.plot(v[thin], x[thin], color=MEASURED, lw=1.6, label="measured")
         label = f"model (rms error {_rms(model_x, x):.3g} µm)"

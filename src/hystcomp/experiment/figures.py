@@ -2,10 +2,10 @@
 
 Every figure is drawn on its own :class:`~matplotlib.figure.Figure` (no global pyplot
 state) and saved through :func:`hystcomp.io.atomic.atomic_path`, so a failure never leaves a
-broken image. The margins are fixed in inches (:func:`fixed_layout`) rather than computed by
-matplotlib's constrained layout, which measures every label again and doubled the cost of
-drawing a figure; lines are thinned to a few thousand points (:func:`_thin`), time
-series to their envelope per pixel column (:func:`envelope`).
+broken image. The margins are fixed in inches (``_layout.fixed_layout``) rather than computed
+by matplotlib's constrained layout, which measures every label again and doubled the cost of
+drawing a figure; lines are thinned to a few thousand points (``_layout.thin_slice``), time
+series to their envelope per pixel column (``_layout.envelope``).
 """
 
 from __future__ import annotations
@@ -15,15 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from hystcomp.experiment._layout import (
-    TITLE_Y,
-    _thin,
-    envelope,
-    fixed_layout,
-    new_figure,
-    pixel_columns,
-    save_figure,
-)
+from hystcomp.experiment import _layout as layout
 from hystcomp.experiment.fig_identification import plot_identification
 from hystcomp.experiment.fig_preisach import plot_preisach_loops
 from hystcomp.experiment.metrics import SATURATION_ZONE
@@ -49,8 +41,8 @@ def figure_9(results: dict, path: Path) -> None:
     path : pathlib.Path
         The figure's file.
     """
-    fig = new_figure((7.5, 6.0))
-    fixed_layout(fig, left=0.75, right=0.15, top=0.4, bottom=0.6)
+    fig = layout.new_figure((7.5, 6.0))
+    layout.fixed_layout(fig, left=0.75, right=0.15, top=0.4, bottom=0.6)
     ax = fig.add_subplot()
     top = max(float(r.x_ref.max()) for r in results.values())
     zone = SATURATION_ZONE * top
@@ -62,7 +54,7 @@ def figure_9(results: dict, path: Path) -> None:
         ref, x = r.x_ref[w], r.x[w]
         near = ref >= zone
         low_y, high_y = min(low_y, float(x[near].min())), max(high_y, float(x[near].max()))
-        ref, x = ref[_thin(ref.size)], x[_thin(x.size)]
+        ref, x = ref[layout.thin_slice(ref.size)], x[layout.thin_slice(x.size)]
         style: dict[str, Any] = {"color": COLOURS[method], "lw": 0.9}
         label = f"{LABELS[method]} ({r.saturation_zone_pct:.1f} % in the saturation zone)"
         ax.plot(ref, x, label=label, **style)
@@ -73,15 +65,15 @@ def figure_9(results: dict, path: Path) -> None:
     ax.plot([], [], color="k", lw=0.6, ls="--", label="ideal (x = x_ref)")
     inset.set_xlim(zone, top)
     inset.set_ylim(low_y, high_y)
-    inset.set_title("saturation zone", fontsize=8, y=TITLE_Y)
+    inset.set_title("saturation zone", fontsize=8, y=layout.TITLE_Y)
     inset.tick_params(labelsize=7)
     ax.indicate_inset_zoom(inset, edgecolor="0.3")
     ax.set_xlabel("reference x_ref (µm)")
     ax.set_ylabel("measured displacement x (µm)")
     frequency = next(iter(results.values())).frequency
-    ax.set_title(f"Hysteresis compensation, {frequency:g} Hz triangle (twin)", y=TITLE_Y)
+    ax.set_title(f"Hysteresis compensation, {frequency:g} Hz triangle (twin)", y=layout.TITLE_Y)
     ax.legend(loc="upper left", fontsize=8)
-    save_figure(fig, path, dpi=DPI)
+    layout.save_figure(fig, path, dpi=DPI)
 
 
 def figure_10(results: dict, path: Path) -> None:
@@ -97,34 +89,34 @@ def figure_10(results: dict, path: Path) -> None:
         The figure's file.
     """
     frequencies = sorted(results)
-    fig = new_figure((11.0, 3.0 * len(frequencies) + 0.3))
-    fixed_layout(
+    fig = layout.new_figure((11.0, 3.0 * len(frequencies) + 0.3))
+    layout.fixed_layout(
         fig, left=0.75, right=0.15, top=0.75, bottom=0.55, hgap=0.85, wgap=0.9,
         rows=len(frequencies), cols=2,
     )  # fmt: skip
     axes = fig.subplots(len(frequencies), 2, squeeze=False)
-    columns = pixel_columns(fig, axes[0, 0], DPI)
+    columns = layout.pixel_columns(fig, axes[0, 0], DPI)
     for row, f in zip(axes, frequencies, strict=True):
         first = results[f][METHODS[0]]
         w = first.window
         t = first.t[w]
-        ref = envelope(t, first.x_ref[w], columns)
+        ref = layout.envelope(t, first.x_ref[w], columns)
         row[0].plot(*ref, color="k", lw=0.8, ls="--", label="reference")
         for method in METHODS:
             r = results[f][method]
             style = {"color": COLOURS[method], "lw": 0.8, "label": LABELS[method]}
-            row[0].plot(*envelope(t, r.x[w], columns), **style)
-            row[1].plot(*envelope(t, r.e[w], columns), **style)
+            row[0].plot(*layout.envelope(t, r.x[w], columns), **style)
+            row[1].plot(*layout.envelope(t, r.e[w], columns), **style)
         row[0].set_ylabel("displacement (µm)")
         row[1].set_ylabel("tracking error e (µm)")
-        row[0].set_title(f"{f:g} Hz: tracking", y=TITLE_Y)
-        row[1].set_title(f"{f:g} Hz: tracking error e = x - x_ref", y=TITLE_Y)
+        row[0].set_title(f"{f:g} Hz: tracking", y=layout.TITLE_Y)
+        row[1].set_title(f"{f:g} Hz: tracking error e = x - x_ref", y=layout.TITLE_Y)
         for ax in row:
             ax.set_xlabel("time (s)")
             ax.grid(alpha=0.3)
     handles, labels = axes[0, 0].get_legend_handles_labels()
     fig.legend(handles, labels, loc="upper center", ncols=len(labels), frameon=False)
-    save_figure(fig, path, dpi=DPI)
+    layout.save_figure(fig, path, dpi=DPI)
 
 
 def _fig9(comparison, path: Path) -> None:

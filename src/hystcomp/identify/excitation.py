@@ -22,8 +22,10 @@ PREISACH_AMPLITUDES = paper.PREISACH_AMPLITUDES  # V, Section III-A (i)
 MIN_SAMPLES_PER_PERIOD = 4  # fewer cannot draw a triangle or a sinusoid
 
 
-def _periods(owner, amplitudes, sample_rate, frequency, v_min):
-    """Validated amplitudes and ``v_min``, and the phase of one period in [0, 1)."""
+def _periods(owner, shape, amplitudes, sample_rate, frequency, v_min):
+    """``(t, v)``: one period of ``v_min + A * shape(phase)`` per amplitude ``A``, then
+    ``v_min`` (``shape`` maps the phase of a period, in [0, 1), to 0 .. 1 and back to 0),
+    after checking the arguments of ``owner``."""
     amplitudes = as_vector(amplitudes, "amplitudes", owner)
     if np.any(amplitudes < 0):
         raise InvalidParameterError(
@@ -52,7 +54,9 @@ def _periods(owner, amplitudes, sample_rate, frequency, v_min):
             f"{frequency:g} Hz) make {n * amplitudes.size + 1} samples, more than "
             f"{MAX_SIGNAL_SAMPLES:.0e}. Lower the sample rate or raise the frequency."
         )
-    return amplitudes, v_min, np.arange(n) / n
+    unit = shape(np.arange(n) / n)
+    v = np.concatenate([a * unit for a in amplitudes] + [np.zeros(1)]) + v_min
+    return np.arange(v.size) / sample_rate, v
 
 
 def triangle_sequence(
@@ -89,12 +93,11 @@ def triangle_sequence(
     >>> v.tolist()
     [0.0, 5.0, 10.0, 5.0, 0.0, 10.0, 20.0, 10.0, 0.0]
     """
-    amplitudes, v_min, phase = _periods(
-        "triangle_sequence", amplitudes, sample_rate, frequency, v_min
-    )
-    shape = 1.0 - np.abs(1.0 - 2.0 * phase)  # 0 -> 1 -> 0
-    v = np.concatenate([a * shape for a in amplitudes] + [np.zeros(1)]) + v_min
-    return np.arange(v.size) / sample_rate, v
+    return _periods(
+        "triangle_sequence",
+        lambda phase: 1.0 - np.abs(1.0 - 2.0 * phase),  # 0 -> 1 -> 0
+        amplitudes, sample_rate, frequency, v_min,
+    )  # fmt: skip
 
 
 def sinusoid_sequence(
@@ -126,12 +129,11 @@ def sinusoid_sequence(
     t, v : ndarray
         Time in s and voltage in V.
     """
-    amplitudes, v_min, phase = _periods(
-        "sinusoid_sequence", amplitudes, sample_rate, frequency, v_min
-    )
-    shape = 0.5 * (1.0 - np.cos(2.0 * np.pi * phase))
-    v = np.concatenate([a * shape for a in amplitudes] + [np.zeros(1)]) + v_min
-    return np.arange(v.size) / sample_rate, v
+    return _periods(
+        "sinusoid_sequence",
+        lambda phase: 0.5 * (1.0 - np.cos(2.0 * np.pi * phase)),
+        amplitudes, sample_rate, frequency, v_min,
+    )  # fmt: skip
 
 
 def scaled_amplitudes(
@@ -237,12 +239,24 @@ def _ramps(points, rate, sample_rate, owner) -> tuple[np.ndarray, np.ndarray]:
             f"{owner}: a rate of {rate:g} V/s at {sample_rate:g} Hz makes more than "
             f"{MAX_SIGNAL_SAMPLES:.0e} samples. Raise the rate or lower the sample rate."
         )
+    v = _ramps_through(points, step)
+    return np.arange(v.size) / sample_rate, v
+
+
+def _ramps_through(points, step: float) -> np.ndarray:
+    """Straight ramps of at most ``step`` V per sample through ``points`` (V), ending on the
+    last point: each ramp takes the fewest samples that keep its steps within ``step``.
+
+    Examples
+    --------
+    >>> _ramps_through(np.array([0.0, 2.0, 1.0]), 1.0).tolist()
+    [0.0, 1.0, 2.0, 1.0]
+    """
     pieces = []
     for lo, hi in itertools.pairwise(points):
         n = max(1, int(np.ceil(abs(hi - lo) / step)))
         pieces.append(lo + (hi - lo) * np.arange(n) / n)
-    v = np.r_[np.concatenate(pieces), points[-1]]
-    return np.arange(v.size) / sample_rate, v
+    return np.r_[np.concatenate(pieces), points[-1]]
 
 
 def rich_turning_points(

@@ -10,14 +10,16 @@ function of another's input.
 
 from __future__ import annotations
 
-import itertools
-
 import numpy as np
 
 from hystcomp import paper
 from hystcomp._validation import check_int, check_range, check_real
 from hystcomp.errors import InvalidParameterError
-from hystcomp.identify.excitation import DEFAULT_SAMPLE_RATE, rich_turning_points
+from hystcomp.identify.excitation import (
+    DEFAULT_SAMPLE_RATE,
+    _ramps_through,
+    rich_turning_points,
+)
 
 #: Most axes :func:`multiaxis_sequence` makes an input for.
 MAX_AXES = 16
@@ -34,15 +36,6 @@ def _axis_points(i: int, lo: float, hi: float) -> np.ndarray:
     blocks = [body[j * n_sweep : (j + 1) * n_sweep] for j in range(4)] + [body[4 * n_sweep :]]
     shift = i % len(blocks)
     return np.concatenate([[lo], *(blocks[shift:] + blocks[:shift])])
-
-
-def _ramp(points: np.ndarray, step: float) -> np.ndarray:
-    """Ramps of at most ``step`` V per sample through ``points``."""
-    pieces = []
-    for a, b in itertools.pairwise(points):
-        n = max(1, int(np.ceil(abs(b - a) / step)))
-        pieces.append(a + (b - a) * np.arange(n) / n)
-    return np.r_[np.concatenate(pieces), points[-1]]
 
 
 def multiaxis_sequence(
@@ -93,14 +86,14 @@ def multiaxis_sequence(
     signals = []
     for i in range(n_axes):
         step = base / (1.0 + RATE_STEP * i) / sample_rate
-        signals.append(_ramp(_axis_points(i, lo, hi), step))
+        signals.append(_ramps_through(_axis_points(i, lo, hi), step))
     n = max(v.size for v in signals)
     rng = np.random.default_rng(1000 + n_axes)
     out = []
     for i, v in enumerate(signals):
         step = base / (1.0 + RATE_STEP * i) / sample_rate
         while v.size < n:  # a faster axis goes on through random turning points
-            v = np.r_[v[:-1], _ramp(np.r_[v[-1], rng.uniform(lo, hi, 8), lo], step)]
+            v = np.r_[v[:-1], _ramps_through(np.r_[v[-1], rng.uniform(lo, hi, 8), lo], step)]
         out.append(v[:n])
     tail = int(np.ceil((hi - lo) / (base / sample_rate)))  # then every axis back to lo
     V = np.column_stack(

@@ -189,16 +189,6 @@ class TwinParameters:
         """
         return dataclasses.replace(self, **changes)
 
-    def as_dict(self) -> dict:
-        """Plain values, e.g. for a report.
-
-        Returns
-        -------
-        dict
-            Each parameter by name.
-        """
-        return {k: (list(v) if isinstance(v, tuple) else v) for k, v in vars(self).items()}
-
 
 def dynamics_matrices(params: TwinParameters) -> tuple[np.ndarray, np.ndarray]:
     """``(Ad, Bd)`` of the exact zero-order-hold discretisation of ``D(s)``.
