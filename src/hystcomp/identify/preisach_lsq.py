@@ -36,6 +36,7 @@ import math
 import numpy as np
 
 from hystcomp._kernels import preisach as pk
+from hystcomp._notice import Notice
 from hystcomp.errors import IdentificationError
 from hystcomp.identify.compensation import inside_training
 from hystcomp.identify.lsq import solve_inequality_qp
@@ -370,10 +371,12 @@ def fit_preisach_lsq(v, x, *, everett, degree, grid_size, voltage_range, start=N
     lo, hi = voltage_range
     if used < 2 or np.ptp(v[start:]) <= 1e-9 * (hi - lo):
         raise IdentificationError(
-            "After the start-up transient (first sample used: "
-            f"{start}) the input does not move, so it traces no hysteresis. Record the "
-            "actuator while the voltage sweeps its range (any waveform: `hystcomp excite "
-            "preisach`, `hystcomp excite pi`, or a random one)."
+            Notice(
+                "After the start-up transient (first sample used: "
+                f"{start}) the input does not move, so it traces no hysteresis. Record the "
+                "actuator while the voltage sweeps its range (any waveform: {excite_preisach}, "
+                "{excite_pi}, or a random one)."
+            )
         )
     max_rows = max(MIN_ROWS, int(GRAM_BUDGET / (basis.size + 2) ** 2))
     stride = max(1, math.ceil(used / max_rows))

@@ -17,6 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
+from hystcomp._notice import Notice
 from hystcomp._validation import as_path, check_real
 from hystcomp.errors import DataFileError, InvalidParameterError
 from hystcomp.io._formats import read_raw
@@ -209,9 +210,14 @@ def read_axes(
     n_axes = max(counts.values(), default=0)
     if n_axes == 0:
         raise DataFileError(
-            f"{where} has no N-axis columns ({', '.join(k + '1' for k in keys)}, ...); its "
-            f"columns are {', '.join(map(str, names or [])) or 'unnamed'}. Name them, or map "
-            "them with --columns v1=2,x1=3,..."
+            Notice(
+                "{where} has no N-axis columns ({wanted}, ...); its columns are {found}. Name "
+                "them, or map them with {columns_eg},...",
+                where=where,
+                wanted=", ".join(k + "1" for k in keys),
+                found=", ".join(map(str, names or [])) or "unnamed",
+                eg="v1=2,x1=3",
+            )
         )
     if n_axes > MAX_AXES:
         raise DataFileError(f"{where} has {n_axes} axes, more than {MAX_AXES}.")

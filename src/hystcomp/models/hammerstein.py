@@ -26,6 +26,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from hystcomp._notice import Notice
 from hystcomp._validation import as_signal, as_signal_pair, check_int, check_real
 from hystcomp.errors import IdentificationError, InvalidTypeError
 from hystcomp.identify.scoring import transient_end
@@ -81,8 +82,11 @@ class HammersteinModel(ModelFile):
             )
         if not isinstance(dynamics, LinearDynamics):
             raise InvalidTypeError(
-                "The 'dynamics' argument of HammersteinModel must be a LinearDynamics "
-                f"(hystcomp identify --model dynamics). Got {type(dynamics).__name__}."
+                Notice(
+                    "The 'dynamics' argument of HammersteinModel must be a LinearDynamics, "
+                    "identified from a record: {identify_dynamics}. Got {got}.",
+                    got=type(dynamics).__name__,
+                )
             )
         hysteresis._check_fitted()
         dynamics._check_fitted()

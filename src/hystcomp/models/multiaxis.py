@@ -33,6 +33,7 @@ from hystcomp._hyperparameters import (
     Unchecked,
 )
 from hystcomp._kernels.multiaxis import mix_rows
+from hystcomp._notice import Notice
 from hystcomp._validation import MAX_MAGNITUDE, check_range
 from hystcomp.errors import (
     IdentificationError,
@@ -324,9 +325,11 @@ class MultiAxisModel(Estimator):
         for i in range(V.shape[1]):
             if np.ptp(V[:, i]) <= 0:
                 raise InvalidSignalError(
-                    f"The input of axis {i + 1} is constant ({V[0, i]!r} V): every axis must "
-                    "sweep its range for its hysteresis to be identified (hystcomp excite "
-                    "multiaxis)."
+                    Notice(
+                        f"The input of axis {i + 1} is constant ({V[0, i]!r} V): every axis "
+                        "must sweep its range for its hysteresis to be identified "
+                        "({excite_multiaxis})."
+                    )
                 )
         n_axes = V.shape[1]
         ranges = self._axis_ranges(n_axes)
