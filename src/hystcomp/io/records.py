@@ -250,19 +250,23 @@ def _find(path: Path, names, label: str) -> int | None:
     folded = [i for i, name in enumerate(names) if str(name).casefold() == label.casefold()]
     if len(exact) > 1 or len(folded) > 1:
         found = ", ".join(repr(names[i]) for i in (exact if len(exact) > 1 else folded))
-        raise DataFileError(
-            Notice(
-                "Data file {path} has {count} columns named like {label} ({found}), so which "
-                "one is meant is unclear. Rename them apart in the file, or name the right one "
-                "by number, e.g. {columns_eg}.",
-                path=repr(str(path)),
-                count=len(exact) or len(folded),
-                label=repr(label),
-                found=found,
-                eg="x=3",
-            )
+        raise _file_error(
+            path,
+            "Data file {path} has {count} columns named like {label} ({found}), so which "
+            "one is meant is unclear. Rename them apart in the file, or name the right one "
+            "by number, e.g. {columns_eg}.",
+            count=len(exact) or len(folded),
+            label=repr(label),
+            found=found,
+            eg="x=3",
         )
     return folded[0] if folded else None
+
+
+def _file_error(path, template: str, **data) -> DataFileError:
+    """A :class:`DataFileError` about the file at ``path``: ``template`` names it ``{path}``
+    and its remedies by :class:`~hystcomp._notice.Notice` keys."""
+    return DataFileError(Notice(template, path=repr(str(path)), **data))
 
 
 def _pick(path: Path, raw: _Raw, key: str, spec, required: bool):
@@ -365,31 +369,27 @@ def _units(path: Path, raw: _Raw, key: str, index: int | None, x_unit) -> float:
     given = None if raw.units is None or index is None else raw.units[index]
     if key == "x" and x_unit is not None:
         if given and UNITS["x"].get(given.lower()) not in (None, UNITS["x"][x_unit]):
-            raise DataFileError(
-                Notice(
-                    "The units row of {path} says the displacement is in {given}, but {x_unit} "
-                    "says {unit}. {drop_x_unit}, or correct the units row.",
-                    path=repr(str(path)),
-                    given=given,
-                    unit=x_unit,
-                )
+            raise _file_error(
+                path,
+                "The units row of {path} says the displacement is in {given}, but {x_unit} "
+                "says {unit}. {drop_x_unit}, or correct the units row.",
+                given=given,
+                unit=x_unit,
             )
         return UNITS["x"][x_unit]
     if not given:
         return 1.0
     factor = UNITS[key].get(given.lower())
     if factor is None:
-        raise DataFileError(
-            Notice(
-                "The units row of {path} gives {given} for {key} ({meaning}); known units "
-                "are {known}. Convert the column, or correct the unit in the file"
-                + (", or give {x_unit}." if key == "x" else "."),
-                path=repr(str(path)),
-                given=repr(given),
-                key=repr(key),
-                meaning=MEANINGS[key],
-                known=", ".join(UNITS[key]),
-            )
+        raise _file_error(
+            path,
+            "The units row of {path} gives {given} for {key} ({meaning}); known units "
+            "are {known}. Convert the column, or correct the unit in the file"
+            + (", or give {x_unit}." if key == "x" else "."),
+            given=repr(given),
+            key=repr(key),
+            meaning=MEANINGS[key],
+            known=", ".join(UNITS[key]),
         )
     return factor
 
@@ -511,19 +511,17 @@ def _read_table(path, keys, columns, sample_rate, min_samples, x_unit, progress,
     for key in ("t", *both):
         index, label = _pick(path, raw, key, columns.get(key), key in keys)
         if index is not None and index in taken:
-            raise DataFileError(
-                Notice(
-                    "Data file {path}: {label} would be read both as {first} ({first_meaning}) "
-                    "and as {key} ({meaning}). Name another column for one of them "
-                    "({columns_eg}...).",
-                    path=repr(str(path)),
-                    label=label,
-                    first=repr(taken[index]),
-                    first_meaning=MEANINGS[taken[index]],
-                    key=repr(key),
-                    meaning=MEANINGS[key],
-                    eg=f"{key}=",
-                )
+            raise _file_error(
+                path,
+                "Data file {path}: {label} would be read both as {first} ({first_meaning}) "
+                "and as {key} ({meaning}). Name another column for one of them "
+                "({columns_eg}...).",
+                label=label,
+                first=repr(taken[index]),
+                first_meaning=MEANINGS[taken[index]],
+                key=repr(key),
+                meaning=MEANINGS[key],
+                eg=f"{key}=",
             )
         if index is not None:
             taken[index] = key
@@ -640,11 +638,9 @@ def uneven_sampling(t, what: str) -> str | None:
 def _time(path: Path, t, n: int, sample_rate):
     if t is None:
         if sample_rate is None:
-            raise DataFileError(
-                Notice(
-                    "Data file {path} has no time column 't': give the sample rate, {fs_hz}.",
-                    path=repr(str(path)),
-                )
+            raise _file_error(
+                path,
+                "Data file {path} has no time column 't': give the sample rate, {fs_hz}.",
             )
         with np.errstate(over="ignore"):
             t = np.arange(n) / sample_rate
@@ -667,16 +663,14 @@ def _time(path: Path, t, n: int, sample_rate):
         rising = t[1:] > t[:-1]  # (one byte a sample, not a copy of the steps; NaN fails)
     if not rising.all():
         k = int(np.flatnonzero(~rising)[0]) + 1
-        raise DataFileError(
-            Notice(
-                "The time column 't' of {path} is not strictly increasing: data row {row} has "
-                "t = {t!r} s after t = {before!r} s. Sort the rows and remove duplicates, or "
-                "drop the time column and {give_fs}.",
-                path=repr(str(path)),
-                row=k + 1,
-                t=float(t[k]),
-                before=float(t[k - 1]),
-            )
+        raise _file_error(
+            path,
+            "The time column 't' of {path} is not strictly increasing: data row {row} has "
+            "t = {t!r} s after t = {before!r} s. Sort the rows and remove duplicates, or "
+            "drop the time column and {give_fs}.",
+            row=k + 1,
+            t=float(t[k]),
+            before=float(t[k - 1]),
         )
     # the rate for these checks: the median step, of at most 100 000 steps spread over the
     # record (the same to the checks' 1 % on a long record; Record.sample_rate is exact)
@@ -685,15 +679,13 @@ def _time(path: Path, t, n: int, sample_rate):
         sample = t[1::stride] - t[:-1:stride]
         rate = float(1.0 / np.median(sample)) if sample.size else np.inf
     if not (np.isfinite(span) and 0.0 < rate < np.inf):
-        raise DataFileError(
-            Notice(
-                "The time column 't' of {path} spans {first!r} to {last!r} s, which gives no "
-                "usable sample rate. Check the units of the time column, or drop it and "
-                "{give_fs}.",
-                path=repr(str(path)),
-                first=float(t[0]),
-                last=float(t[-1]),
-            )
+        raise _file_error(
+            path,
+            "The time column 't' of {path} spans {first!r} to {last!r} s, which gives no "
+            "usable sample rate. Check the units of the time column, or drop it and "
+            "{give_fs}.",
+            first=float(t[0]),
+            last=float(t[-1]),
         )
     if sample_rate is not None and abs(rate - sample_rate) > RATE_TOLERANCE * sample_rate:
         raise DataFileError(
@@ -732,14 +724,12 @@ def read_record(path, *, columns=None, sample_rate=None, x_unit=None, progress=N
     )
     v = table["v"]
     if v.max() <= v.min():
-        raise DataFileError(
-            Notice(
-                "The voltage column 'v' of {path} is constant ({v!r} V): an identification "
-                "record needs an input that sweeps the actuator's range (see {excite_any}). "
-                "Check that the right column is named.",
-                path=repr(str(path)),
-                v=float(v[0]),
-            )
+        raise _file_error(
+            path,
+            "The voltage column 'v' of {path} is constant ({v!r} V): an identification "
+            "record needs an input that sweeps the actuator's range (see {excite_any}). "
+            "Check that the right column is named.",
+            v=float(v[0]),
         )
     return Record._checked(table["t"], v, table["x"], str(path))
 

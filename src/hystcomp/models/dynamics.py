@@ -603,6 +603,20 @@ class LinearDynamics(ModelFile):
         )
 
 
+def check_dynamics(dynamics, what: str) -> None:
+    """Refuse ``dynamics`` unless it is a :class:`LinearDynamics`; ``what`` names the
+    argument ("The 'dynamics' parameter of inverse")."""
+    if not isinstance(dynamics, LinearDynamics):
+        raise InvalidTypeError(
+            Notice(
+                "{what} must be a LinearDynamics, identified from a record: "
+                "{identify_dynamics}. Got {got}.",
+                what=what,
+                got=type(dynamics).__name__,
+            )
+        )
+
+
 def _check_mode(hz, zeta, sample_rate: float, prefix: str, owner: str) -> tuple[float, float]:
     """A mode's frequency (Hz) and damping ratio, checked: below Nyquist, resolved in
     double precision. ``prefix`` names the parameters (``""`` or ``"second_"``)."""
@@ -681,14 +695,7 @@ def with_dynamics(
     DynamicCompensator
         The compensator in series with the inverse of the dynamics.
     """
-    if not isinstance(dynamics, LinearDynamics):
-        raise InvalidTypeError(
-            Notice(
-                "The 'dynamics' parameter of inverse must be a LinearDynamics, identified from "
-                "a record: {identify_dynamics}. Got {got}.",
-                got=type(dynamics).__name__,
-            )
-        )
+    check_dynamics(dynamics, "The 'dynamics' parameter of inverse")
     lo, hi = compensator.voltage_range
     rest, top, back = (float(x) for x in model.simulate([lo, hi, lo]))
     output_range = (min(rest, top), max(rest, top))

@@ -26,13 +26,12 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from hystcomp._notice import Notice
 from hystcomp._validation import as_signal, as_signal_pair, check_int, check_real
 from hystcomp.errors import IdentificationError, InvalidTypeError
 from hystcomp.identify.scoring import transient_end
 from hystcomp.models.base import HysteresisModel
 from hystcomp.models.dynamic_compensator import DynamicCompensator
-from hystcomp.models.dynamics import LinearDynamics, with_dynamics
+from hystcomp.models.dynamics import LinearDynamics, check_dynamics, with_dynamics
 from hystcomp.models.estimator import ModelFile
 from hystcomp.models.mpi import ModifiedPrandtlIshlinskii
 from hystcomp.models.pi import PrandtlIshlinskii
@@ -80,14 +79,7 @@ class HammersteinModel(ModelFile):
                 "The 'hysteresis' argument of HammersteinModel must be a fitted PI, MPI or "
                 f"Preisach model. Got {type(hysteresis).__name__}."
             )
-        if not isinstance(dynamics, LinearDynamics):
-            raise InvalidTypeError(
-                Notice(
-                    "The 'dynamics' argument of HammersteinModel must be a LinearDynamics, "
-                    "identified from a record: {identify_dynamics}. Got {got}.",
-                    got=type(dynamics).__name__,
-                )
-            )
+        check_dynamics(dynamics, "The 'dynamics' argument of HammersteinModel")
         hysteresis._check_fitted()
         dynamics._check_fitted()
         self.hysteresis = hysteresis
