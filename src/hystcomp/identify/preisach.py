@@ -235,12 +235,9 @@ def fit_everett_polynomial(
 
     Parameters
     ----------
-    alpha : array_like
-        Upper switching voltages of the samples, V.
-    beta : array_like
-        Lower switching voltages, V.
-    value : array_like
-        ``X(alpha, beta)``, µm.
+    alpha, beta, value : array_like
+        The samples of eq. (2): upper and lower switching voltages (V) and
+        ``X(alpha, beta)`` (µm), e.g. from :func:`everett_samples`.
     degree : int
         The polynomial's degree (3 is eq. 5).
     voltage_range : tuple of (float, float)
@@ -299,12 +296,9 @@ def fit_everett_table(alpha, beta, value, *, grid_size: int, voltage_range) -> n
 
     Parameters
     ----------
-    alpha : array_like
-        Upper switching voltages of the samples, V.
-    beta : array_like
-        Lower switching voltages, V.
-    value : array_like
-        ``X(alpha, beta)``, µm.
+    alpha, beta, value : array_like
+        The samples of eq. (2): upper and lower switching voltages (V) and
+        ``X(alpha, beta)`` (µm), e.g. from :func:`everett_samples`.
     grid_size : int
         Nodes per axis.
     voltage_range : tuple of (float, float)

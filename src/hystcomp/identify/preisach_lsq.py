@@ -94,10 +94,8 @@ class EverettBasis:
 
         Parameters
         ----------
-        alpha : array_like
-            Upper switching voltages, V.
-        beta : array_like
-            Lower switching voltages, V.
+        alpha, beta : array_like
+            Upper and lower switching voltages, V, broadcast together (one row each).
 
         Returns
         -------
@@ -116,14 +114,10 @@ class EverettBasis:
 
         Parameters
         ----------
-        v : array_like
-            The record's voltage, V.
-        x : array_like
-            The record's displacement, µm.
-        start : int, optional
-            The first sample.
-        stride : int, optional
-            Every how many samples a row is taken.
+        v, x : array_like
+            The record: voltage (V) and displacement (µm), one sample each.
+        start, stride : int, optional
+            The rows taken: samples ``start, start + stride, ...``.
         block : int, optional
             The most rows in a block.
 
@@ -168,10 +162,8 @@ class EverettBasis:
             The record's voltage, V.
         x : array_like, optional
             Not used; the regressors depend on the voltage only.
-        start : int, optional
-            The first sample.
-        stride : int, optional
-            Every how many samples a row is taken.
+        start, stride : int, optional
+            The rows taken: samples ``start, start + stride, ...``.
 
         Returns
         -------
@@ -194,14 +186,10 @@ class EverettBasis:
 
         Parameters
         ----------
-        v : array_like
-            The record's voltage, V.
-        x : array_like
-            The record's displacement, µm.
-        start : int, optional
-            The first sample.
-        stride : int, optional
-            Every how many samples a row is taken.
+        v, x : array_like
+            The record: voltage (V) and displacement (µm), one sample each.
+        start, stride : int, optional
+            The rows taken: samples ``start, start + stride, ...``.
         folds : array_like of int, optional
             The fold of every sample (-1 for none).
         n_folds : int, optional
