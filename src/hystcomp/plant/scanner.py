@@ -265,7 +265,7 @@ class Scanner:
         Returns
         -------
         numpy.ndarray
-            The times, s.
+            ``arange(n_samples) / sample_rate``, s.
         """
         return np.arange(int(n_samples)) / self.sample_rate
 

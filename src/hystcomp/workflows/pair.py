@@ -355,7 +355,8 @@ def identify_dynamics_record(record) -> DynamicsResult:
     Parameters
     ----------
     record : hystcomp.io.records.Record
-        The measured record: time (s), voltage (V), displacement (µm).
+        The measured record: time (s), voltage (V), displacement (µm), evenly sampled (an
+        uneven record is refused, as the fit assumes one sample rate).
 
     Returns
     -------
