@@ -49,6 +49,7 @@ PYTHON = {
     "clamp": "the compensator's voltage_range, as in Preisach.inverse(voltage_range=...)",
     "same_rate": "at the same sample rate",
     "columns_eg": "columns='{eg}'",
+    "axis_columns": "columns={{'v1': 2, 'x1': 3, ...}}",
     "x_unit": "x_unit",
     "drop_x_unit": "Leave out x_unit",
     "fs_hz": "sample_rate=HZ",

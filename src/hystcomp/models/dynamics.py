@@ -95,7 +95,8 @@ class LinearDynamics(ModelFile):
     """Creep modes and the first resonance (and a second) of an actuator, unit steady-state gain.
 
     Build it with :meth:`from_parameters`, identify it with :meth:`fit`
-    (``hystcomp identify --model dynamics``) or load it with :func:`hystcomp.load_model`.
+    (:func:`hystcomp.workflows.pair.identify_dynamics_record` reports the fit) or load it with
+    :func:`hystcomp.load_model`.
 
     Attributes
     ----------

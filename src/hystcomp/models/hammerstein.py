@@ -50,8 +50,8 @@ class HammersteinModel(ModelFile):
     """A hysteresis model in series with linear dynamics, identified as one pair.
 
     Building one from parts that were identified apart is the caller's statement that they
-    belong together; :func:`fit_pair` (``hystcomp identify DATA --model KIND
-    --dynamics-record DYN``) identifies them as a pair.
+    belong together; :func:`fit_pair` (reported by
+    :func:`hystcomp.workflows.pair.identify_pair_record`) identifies them as a pair.
 
     Parameters
     ----------

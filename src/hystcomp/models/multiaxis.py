@@ -67,8 +67,8 @@ AXIS_KINDS: dict[str, type[HysteresisModel]] = {
     "mpi": ModifiedPrandtlIshlinskii,
     "preisach": Preisach,
 }
-#: The families ``family="auto"`` tries, in the order that breaks a tie (as ``hystcomp
-#: identify --model auto``).
+#: The families ``family="auto"`` tries, in the order that breaks a tie (as
+#: :func:`hystcomp.workflows.auto.identify_best`).
 AUTO_FAMILIES = ("preisach", "mpi", "pi")
 #: Most axes of one model (a coupling matrix of N^2 entries; a mirror's independent
 #: channels belong in a :class:`~hystcomp.models.channels.ChannelBank`).
@@ -150,7 +150,7 @@ def fit_axis(family, v: np.ndarray, h: np.ndarray, voltage_range=None) -> Hyster
         The family, or an unfitted estimator whose hyperparameters every axis gets (a copy
         each). ``'auto'`` fits the three families and keeps the one whose compensator is
         predicted to track best (:func:`~hystcomp.identify.compensation.tracking_estimate`,
-        as ``hystcomp identify --model auto``).
+        as :func:`hystcomp.workflows.auto.identify_best` does).
     v, h : ndarray
         The axis's input and its decoupled displacement.
     voltage_range : (float, float), optional

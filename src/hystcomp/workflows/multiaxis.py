@@ -2,7 +2,7 @@
 
 The steps of :meth:`MultiAxisModel.fit <hystcomp.models.multiaxis.MultiAxisModel.fit>`,
 with each axis identified as ``hystcomp identify`` identifies one axis (start-up transient,
-tracking estimate, warnings; ``--model auto`` ranks the families per axis) on its
+tracking estimate, warnings; the family ``'auto'`` ranks the families per axis) on its
 decoupled displacements:
 
 1. the coupling ``M`` (:func:`~hystcomp.identify.coupling.fit_coupling`);
