@@ -447,8 +447,20 @@ class MultiAxisModel(Estimator):
         H = np.column_stack([axis.simulate(V[:, i]) for i, axis in enumerate(self.axes_)])
         return _mix(np.asarray(self.coupling_), np.ascontiguousarray(H))
 
-    #: :meth:`simulate`, under scikit-learn's name.
-    predict = simulate
+    def predict(self, V) -> np.ndarray:
+        """:meth:`simulate`, under scikit-learn's name.
+
+        Parameters
+        ----------
+        V : array_like
+            The voltages, V, shape ``(n, N)``.
+
+        Returns
+        -------
+        numpy.ndarray
+            The displacements, µm, shape ``(n, N)``.
+        """
+        return self.simulate(V)
 
     def score(self, V, X) -> float:
         """R² of the predicted displacements over all axes (each axis about its own mean).
