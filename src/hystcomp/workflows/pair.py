@@ -40,7 +40,7 @@ __all__ = [
 ]
 
 #: Least share (%) of the frequency response the dynamics must explain to be used without a
-#: warning (Benchmarks, "Dynamics").
+#: warning (Benchmarks, "The H+D pair").
 MIN_DYNAMICS_FIT = 80.0
 #: The pair is said to track worse than the hysteresis model alone where its estimate is
 #: above this multiple of the other's (the estimates' own scatter stays within it).
