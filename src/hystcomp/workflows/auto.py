@@ -3,10 +3,11 @@
 Which family tracks best changes from stage to stage, and the fit error cannot tell (every
 family fits its record about equally well; Benchmarks, "Choosing the model family").
 :func:`identify_best` fits every family the record determines
-(:func:`~hystcomp.workflows.identify.identify_record` for each) and keeps the one whose compensator is predicted to track a reference over the
-range best (:func:`~hystcomp.identify.compensation.tracking_estimate`). The ranking, each
-family's estimate and its error on held-out reversal branches (references that turn inside
-the range) go with the result.
+(:func:`~hystcomp.workflows.identify.identify_record` for each) and keeps the one whose
+compensator is predicted to track a reference over the range best
+(:func:`~hystcomp.identify.compensation.tracking_estimate`). The ranking, each family's
+estimate and its error on held-out reversal branches (references that turn inside the range)
+go with the result.
 """
 
 from __future__ import annotations
