@@ -40,6 +40,22 @@ PYTHON = {
     "identify_pair": "hystcomp.workflows.pair.identify_pair_record",
     "slew": "The slew-rate limit",
     "give_fs": "give the sample rate",
+    "excite_preisach": "excitation_signal('preisach')",
+    "excite_pi": "excitation_signal('pi')",
+    "excite_any": "hystcomp.identify.excitation.excitation_signal",
+    "fit_lsq": "fit_method='least-squares'",
+    "fit_rc": "fit_method='reversal-curves'",
+    "zero_diagonal": "zero_diagonal=True",
+    "clamp": "the compensator's voltage_range, as in Preisach.inverse(voltage_range=...)",
+    "same_rate": "at the same sample rate",
+    "columns_eg": "columns='{eg}'",
+    "axis_columns": "columns={{'v1': 2, 'x1': 3, ...}}",
+    "x_unit": "x_unit",
+    "drop_x_unit": "Leave out x_unit",
+    "fs_hz": "sample_rate=HZ",
+    "rate_name": "sample_rate",
+    "saved_by": "hystcomp.save_model",
+    "export_model": "generate_c(model.inverse(), ...)",
 }
 
 

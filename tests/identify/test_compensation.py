@@ -193,7 +193,7 @@ def test_identify_paper_constraints_reach_the_model_file(tmp_path, twin_record):
     assert model.weights_[1:].min() < 0
     bad = run("identify", path, "--model", "preisach", "--constraints", "paper", "-o", "x.json")
     assert bad.exit_code == 2  # the least-squares fit's density implies X(v, v) = 0
-    assert "fit_method='reversal-curves'" in bad.output
+    assert "--fit reversal-curves" in bad.output
     assert read_table(path, ("v",))["v"].size == v.size
 
 

@@ -131,7 +131,9 @@ def test_fitted_model_reproduces_a_continuous_non_polynomial_preisach_system(exc
 
 def test_reversal_curve_fit_of_a_record_without_them_names_the_fix():
     ramp = np.linspace(0.0, 120.0, 1000)
-    with pytest.raises(IdentificationError, match=r"no first-order descending.*excite preisach"):
+    with pytest.raises(
+        IdentificationError, match=r"no first-order descending.*excitation_signal\('preisach'\)"
+    ):
         Preisach(fit_method="reversal-curves").fit(ramp, 0.3 * ramp)
     # least squares (the default, and auto's choice here) is determined along X(v, 0)
     model = Preisach(fit_method="auto").fit(ramp, 0.3 * ramp)
@@ -144,7 +146,7 @@ def test_reversal_curve_fit_of_one_amplitude_names_what_is_missing(rng):
     _, v = triangle_sequence([3.6] * 6, sample_rate=200.0)
     x = presets.paper_preisach(zero_diagonal=True).simulate(v * 120 / 3.6) - 120.0
     with pytest.raises(
-        IdentificationError, match=r"1 distinct maximum \(3\.6 V\).*excite preisach"
+        IdentificationError, match=r"1 distinct maximum \(3\.6 V\).*excitation_signal\('preisach'\)"
     ):
         Preisach(**PAPER).fit(v, x)
     with pytest.raises(IdentificationError, match=r"1 distinct maximum"):

@@ -102,8 +102,8 @@ def _csv(tmp_path, text, name="rec.csv"):
         ("t,v,x\n0,0,1\n1,1,2\n1,2,3\n", {}, r"not strictly increasing: data row 3 has t = 1"),
         ("t,v,x\n0,0,1\n", {}, r"has 1 sample; at least 2"),
         ("t,v,x\n0,0,1\n1,0,2\n2,0,3\n", {}, r"'v' of .* is constant \(0\.0 V\)"),
-        ("t,v\n0,0\n1,1\n", {}, r"no column 'x' .*columns are t, v.*--columns x=NAME"),
-        ("v,x\n0,1\n1,2\n", {}, r"no time column 't'.*--fs HZ"),
+        ("t,v\n0,0\n1,1\n", {}, r"no column 'x' .*columns are t, v.*columns='x=NAME'"),
+        ("v,x\n0,1\n1,2\n", {}, r"no time column 't'.*sample_rate=HZ"),
         ("t,v,x\n0,0,1\n0.1,1,2\n", {"sample_rate": 50.0}, r"says 10 Hz .* 50 Hz"),
         ("t,v,x\n0,0,1\n1,a,2\n", {}, r"numbers \(.*'a' to float64 in data row 2, column 2\)"),
         ("t,v,x\n0,0,1\n1,1\n2,1,2\n", {}, r"numbers \(data row 2 has 2 columns, not 3\)"),
@@ -128,7 +128,7 @@ def test_a_title_line_above_the_header_is_no_units_row(tmp_path):
 
 def test_headerless_text_without_column_names_says_how(tmp_path):
     path = _csv(tmp_path, "0 1\n1 2\n", name="rig.dat")
-    with pytest.raises(DataFileError, match=r"no header row.*--columns v=1,x=2"):
+    with pytest.raises(DataFileError, match=r"no header row.*columns='v=1,x=2'"):
         read_record(path, sample_rate=10.0)
 
 

@@ -281,7 +281,7 @@ def test_bad_parameters_are_refused():
         _stage().inverse(bandwidth_hz=10_000.0)
     with pytest.raises(InvalidTypeError, match="LinearDynamics"):
         hystcomp.presets.paper_mpi().inverse(dynamics="dyn.json")
-    with pytest.raises(IdentificationError, match="excite dynamics"):
+    with pytest.raises(IdentificationError, match=r"excitation_signal\('dynamics'\)"):
         LinearDynamics().fit(np.r_[np.zeros(10), np.ones(100)], np.zeros(110), FS)
 
 
@@ -480,7 +480,7 @@ def test_dynamics_identified_apart_are_warned_about_and_matched_at_1_hz():
     """model.inverse(dynamics=dyn): the two were not identified together; the composition
     still works as before (matched at 1 Hz), with a warning that says how to pair them."""
     dyn = _stage()
-    with pytest.warns(HystcompWarning, match="identified apart.*--dynamics-record"):
+    with pytest.warns(HystcompWarning, match="identified apart.*identify_pair_record"):
         comp = hystcomp.presets.paper_mpi().inverse(dynamics=dyn)
     gain = abs(dyn.frequency_response([1.0])[0])
     paired = _pair(hystcomp.presets.paper_mpi(), dyn)

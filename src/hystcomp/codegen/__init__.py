@@ -67,8 +67,7 @@ def generate_c(
     if callable(getattr(compensator, "inverse", None)):  # a model, not its compensator
         raise InvalidTypeError(
             f"'compensator' must be a compensator; got the model {type(compensator).__name__}. "
-            "Export its inverse: generate_c(model.inverse(), ...) (hystcomp export-c MODEL "
-            "does this)."
+            "Export its inverse: generate_c(model.inverse(), ...)."
         )
     if not hasattr(compensator, "voltage_range") or not isinstance(kind, str):
         raise InvalidTypeError(

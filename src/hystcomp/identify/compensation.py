@@ -114,10 +114,8 @@ def tracking_scorer(v, x, *, start: int = 0, max_samples=MAX_SCORED_SAMPLES, fol
 
     Parameters
     ----------
-    v : array_like
-        The record's voltage, V.
-    x : array_like
-        The record's displacement, µm.
+    v, x : array_like
+        The record: voltage (V) and displacement (µm), one sample each.
     start : int, optional
         The first sample scored (after the start-up transient).
     max_samples : int, optional

@@ -42,6 +42,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from hystcomp._kernels import chain
+from hystcomp._notice import Notice
 from hystcomp.errors import IdentificationError
 
 #: Plays per axis in the regressors of :func:`fit_coupling`.
@@ -184,10 +185,13 @@ def fit_coupling(
     if together:
         i, j = together[0]
         raise IdentificationError(
-            f"Axes {i + 1} and {j + 1} move together in the record (the input of one explains "
-            f"{100 * max(shared[i, j], shared[j, i]):.3g} % of the other's displacement), so "
-            "the coupling between them cannot be told from their own hysteresis. Record the "
-            "axes moving independently, each over its range (hystcomp excite multiaxis)."
+            Notice(
+                f"Axes {i + 1} and {j + 1} move together in the record (the input of one "
+                f"explains {100 * max(shared[i, j], shared[j, i]):.3g} % of the other's "
+                "displacement), so the coupling between them cannot be told from their own "
+                "hysteresis. Record the axes moving independently, each over its range "
+                "({excite_multiaxis})."
+            )
         )
     B = np.zeros((n_axes, n_axes))
     residual = np.zeros(n_axes)
@@ -198,9 +202,11 @@ def fit_coupling(
     d = np.diag(inner).copy()
     if not np.all(d > 0):
         raise IdentificationError(
-            "The record gives a coupling between the axes that reverses an axis's own "
-            "direction (a diagonal of M^-1 <= 0): check that every v column drives the x "
-            "column of the same number (--columns)."
+            Notice(
+                "The record gives a coupling between the axes that reverses an axis's own "
+                "direction (a diagonal of M^-1 <= 0): check that every v column drives the x "
+                "column of the same number ({columns})."
+            )
         )
     M = inner / d[None, :]
     # Refinements: each sensor on its own input's regressors and the other axes' decoupled

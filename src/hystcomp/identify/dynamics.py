@@ -72,6 +72,7 @@ from hystcomp._lti import (
     resonance_response,
     resonance_zoh,
 )
+from hystcomp._notice import Notice
 from hystcomp._validation import MAX_SIGNAL_SAMPLES, as_signal_pair, check_real
 from hystcomp.errors import IdentificationError, InvalidParameterError
 from hystcomp.identify.modes import fit_modes, keeps_second_mode
@@ -202,7 +203,7 @@ def dynamics_excitation(
     seconds = _duration(fs, lo, hi, amplitude)
     if seconds * fs > MAX_SIGNAL_SAMPLES:
         raise InvalidParameterError(
-            f"The 'sample_rate' parameter of {owner} (--fs) makes the {seconds:.3g} s signal "
+            f"The 'sample_rate' parameter of {owner} makes the {seconds:.3g} s signal "
             f"{seconds * fs:.3g} samples long, more than {MAX_SIGNAL_SAMPLES:.0e}. Got {fs:g} Hz; "
             f"use at most {MAX_SIGNAL_SAMPLES / seconds:g} Hz."
         )
@@ -431,8 +432,10 @@ def record_layout(v, sample_rate: float) -> Layout:
     moved = np.flatnonzero(v != v[0])
     if moved.size == 0:
         raise IdentificationError(
-            "The record's voltage never moves. Record the answer to 'hystcomp excite "
-            "dynamics' (a step, a hold, then a multisine)."
+            Notice(
+                "The record's voltage never moves. Record the answer to {excite_dynamics} (a "
+                "step, a hold, then a multisine)."
+            )
         )
     step = int(moved[0])
     after = np.flatnonzero(v[step:] != v[step])
@@ -440,10 +443,13 @@ def record_layout(v, sample_rate: float) -> Layout:
     hold = (multisine - step) / fs
     if hold < 0.1 or (v.size - multisine) < 2 * n_period:
         raise IdentificationError(
-            f"The record does not have the layout of 'hystcomp excite dynamics': found a "
-            f"hold of {hold:.3g} s (at least 0.1 s needed) and {(v.size - multisine) / fs:.3g} "
-            f"s of multisine (at least {2 * PERIOD:g} s: two periods of {PERIOD:g} s). Record "
-            "the answer to 'hystcomp excite dynamics' with the same --fs."
+            Notice(
+                "The record does not have the layout of {excite_dynamics}: found a "
+                f"hold of {hold:.3g} s (at least 0.1 s needed) and "
+                f"{(v.size - multisine) / fs:.3g} s of multisine (at least {2 * PERIOD:g} s: "
+                f"two periods of {PERIOD:g} s). Record the answer to {{excite_dynamics}} "
+                "{same_rate}."
+            )
         )
     first = v[multisine : multisine + n_period]
     span = float(np.ptp(v))
@@ -455,9 +461,11 @@ def record_layout(v, sample_rate: float) -> Layout:
         periods += 1
     if periods < 2:
         raise IdentificationError(
-            "The record does not have the layout of 'hystcomp excite dynamics': its "
-            f"multisine does not repeat after {PERIOD:g} s. Record the answer to 'hystcomp "
-            "excite dynamics' with the same --fs."
+            Notice(
+                "The record does not have the layout of {excite_dynamics}: its multisine "
+                f"does not repeat after {PERIOD:g} s. Record the answer to {{excite_dynamics}} "
+                "{same_rate}."
+            )
         )
     lo = float(v[0])
     hi = lo + (float(v[step]) - lo) / BIAS_FRACTION
@@ -608,9 +616,11 @@ def _fit_creep(rise, modes, fs, lags):
     coef[1:][seen] = solved[1:]
     if not coef[0] > 0:
         raise IdentificationError(
-            "The step of the record gives no displacement that the model can follow: check "
-            "that x answers v, that the record is the answer to 'hystcomp excite dynamics', "
-            f"and that the rig's latency is within {DELAY_RANGE[1]} samples."
+            Notice(
+                "The step of the record gives no displacement that the model can follow: "
+                "check that x answers v, that the record is the answer to {excite_dynamics}, "
+                f"and that the rig's latency is within {DELAY_RANGE[1]} samples."
+            )
         )
     weights = coef[1:] / coef[0]
     return weights, float(coef.sum())

@@ -1,4 +1,4 @@
-"""The identification input of a multi-axis stage: ``hystcomp excite multiaxis --axes N``.
+"""The identification input of a multi-axis stage (N axes, each sweeping its range).
 
 Every axis sweeps its whole range with turning points at many levels, as
 :func:`~hystcomp.identify.excitation.rich_sequence` does for one axis, while the others move

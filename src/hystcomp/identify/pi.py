@@ -248,10 +248,8 @@ def prepare_record(
 
     Parameters
     ----------
-    v : array_like
-        The record's voltage, V.
-    x : array_like
-        The record's displacement, µm.
+    v, x : array_like
+        The record: voltage (V) and displacement (µm), one sample each.
     n_weights : int
         The number of weights to fit (the record must hold more samples).
     transient : int or None

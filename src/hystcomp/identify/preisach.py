@@ -32,6 +32,7 @@ from hystcomp._hyperparameters import (
     validate_parameters,
 )
 from hystcomp._kernels import preisach as pk
+from hystcomp._notice import Notice
 from hystcomp._validation import as_signal, check_range, check_real
 from hystcomp.errors import (
     IdentificationError,
@@ -53,11 +54,9 @@ N_BINS = 200  # X samples per full-range curve: each curve is averaged in bins o
 FIT_METHODS = ("auto", "reversal-curves", "least-squares")
 #: ``fit="auto"`` uses the reversal curves when they descend from this many distinct maxima.
 AUTO_MIN_MAXIMA = 8
-_FIX = "Record the response to the Preisach excitation (run `hystcomp excite preisach`)"
-_ANY = (
-    " Or fit by least squares, which takes any record that sweeps the range: "
-    "fit_method='least-squares' (`hystcomp identify --fit least-squares`)."
-)
+#: The remedies of a record the reversal-curve fit cannot use (templates of a Notice).
+_FIX = "Record the response to the Preisach excitation ({excite_preisach})"
+_ANY = " Or fit by least squares, which takes any record that sweeps the range: {fit_lsq}."
 
 
 @dataclass(frozen=True)
@@ -236,12 +235,9 @@ def fit_everett_polynomial(
 
     Parameters
     ----------
-    alpha : array_like
-        Upper switching voltages of the samples, V.
-    beta : array_like
-        Lower switching voltages, V.
-    value : array_like
-        ``X(alpha, beta)``, µm.
+    alpha, beta, value : array_like
+        The samples of eq. (2): upper and lower switching voltages (V) and
+        ``X(alpha, beta)`` (µm), e.g. from :func:`everett_samples`.
     degree : int
         The polynomial's degree (3 is eq. 5).
     voltage_range : tuple of (float, float)
@@ -274,11 +270,14 @@ def fit_everett_polynomial(
     if rank < len(free) or sv[-1] < 1e-9 * sv[0]:
         maxima = _distinct(np.asarray(alpha), 1e-3 * span)
         raise IdentificationError(
-            f"The reversal curves do not determine a degree-{degree} Everett polynomial: "
-            f"they descend from {len(maxima)} distinct maxim{'um' if len(maxima) == 1 else 'a'} "
-            f"({', '.join(f'{m:.4g}' for m in maxima)} V) and eq. (5) needs at least "
-            f"{degree} spread over the range. {_FIX}, whose sinusoids rise to 24 "
-            f"different maxima, or lower the degree.{_ANY}"
+            Notice(
+                f"The reversal curves do not determine a degree-{degree} Everett polynomial: "
+                f"they descend from {len(maxima)} distinct "
+                f"maxim{'um' if len(maxima) == 1 else 'a'} "
+                f"({', '.join(f'{m:.4g}' for m in maxima)} V) and eq. (5) needs at least "
+                f"{degree} spread over the range. {_FIX}, whose sinusoids rise to 24 "
+                f"different maxima, or lower the degree.{_ANY}"
+            )
         )
     fitted = dict(zip(free, coef, strict=True))
     if zero_diagonal:
@@ -297,12 +296,9 @@ def fit_everett_table(alpha, beta, value, *, grid_size: int, voltage_range) -> n
 
     Parameters
     ----------
-    alpha : array_like
-        Upper switching voltages of the samples, V.
-    beta : array_like
-        Lower switching voltages, V.
-    value : array_like
-        ``X(alpha, beta)``, µm.
+    alpha, beta, value : array_like
+        The samples of eq. (2): upper and lower switching voltages (V) and
+        ``X(alpha, beta)`` (µm), e.g. from :func:`everett_samples`.
     grid_size : int
         Nodes per axis.
     voltage_range : tuple of (float, float)
@@ -448,7 +444,9 @@ def identify_preisach(
     if voltage_range is None:
         if data_range[0] == data_range[1]:
             raise IdentificationError(
-                f"The input is constant ({data_range[0]:g} V): it traces no hysteresis. {_FIX}."
+                Notice(
+                    f"The input is constant ({data_range[0]:g} V): it traces no hysteresis. {_FIX}."
+                )
             )
         voltage_range = data_range
     else:
@@ -456,11 +454,17 @@ def identify_preisach(
         slack = 1e-9 * (voltage_range[1] - voltage_range[0])
         if data_range[0] < voltage_range[0] - slack or data_range[1] > voltage_range[1] + slack:
             raise InvalidParameterError(
-                f"The 'voltage_range' parameter of {owner} (--voltage-range) must contain "
-                f"the record's input, which spans {data_range[0]:g}..{data_range[1]:g} V: the "
-                f"Preisach plane covers all of it. Got {voltage_range[0]:g}..{voltage_range[1]:g} "
-                "V; widen it, or leave it out and narrow the compensator's clamp instead "
-                "(--voltage-range of compensate and export-c; Preisach.inverse(voltage_range=))."
+                Notice(
+                    "The 'voltage_range' parameter of {owner} must contain the record's input, "
+                    "which spans {lo:g}..{hi:g} V: the Preisach plane covers all of it. Got "
+                    "{got_lo:g}..{got_hi:g} V; widen it, or leave it out and narrow the "
+                    "compensator's clamp instead ({clamp}).",
+                    owner=owner,
+                    lo=data_range[0],
+                    hi=data_range[1],
+                    got_lo=voltage_range[0],
+                    got_hi=voltage_range[1],
+                )
             )
     if fit_method == "auto":
         span = voltage_range[1] - voltage_range[0]
@@ -472,9 +476,12 @@ def identify_preisach(
         )
     if not curves:
         raise IdentificationError(
-            "The record holds no first-order descending reversal curve (eq. 2): the input "
-            f"never rises from its minimum ({data_range[0]:g} V) to a maximum and falls back. "
-            f"{_FIX}: sinusoids of growing amplitude, each from v_min, and identify from it.{_ANY}"
+            Notice(
+                "The record holds no first-order descending reversal curve (eq. 2): the input "
+                f"never rises from its minimum ({data_range[0]:g} V) to a maximum and falls "
+                f"back. {_FIX}: sinusoids of growing amplitude, each from v_min, and identify "
+                f"from it.{_ANY}"
+            )
         )
     lo, hi = voltage_range
     alpha, beta, value = everett_samples(curves, v_min=lo, bin_width=(hi - lo) / N_BINS)
@@ -488,9 +495,11 @@ def identify_preisach(
         maxima = _distinct(alpha, 1e-3 * (hi - lo))
         if len(maxima) < 2:
             raise IdentificationError(
-                f"The reversal curves descend from {len(maxima)} distinct maximum "
-                f"({maxima[0]:.4g} V); a table of X needs curves from several maxima "
-                f"spread over the range. {_FIX}.{_ANY}"
+                Notice(
+                    f"The reversal curves descend from {len(maxima)} distinct maximum "
+                    f"({maxima[0]:.4g} V); a table of X needs curves from several maxima "
+                    f"spread over the range. {_FIX}.{_ANY}"
+                )
             )
         theta = None
         table = fit_everett_table(alpha, beta, value, grid_size=grid_size, voltage_range=(lo, hi))
@@ -526,11 +535,12 @@ def _least_squares(v, x, curves, degree, everett, grid_size, voltage_range, zero
     """:func:`identify_preisach` by density-constrained least squares over the whole record."""
     if not zero_diagonal:
         raise InvalidParameterError(
-            "zero_diagonal=False is the paper's unconstrained fit to reversal curves; the "
-            "least-squares fit keeps X(v, v) = 0 (eq. 2), which a non-negative density implies. "
-            "Pass zero_diagonal=True (--constraints physical), or fit_method='reversal-curves' "
-            "(--fit reversal-curves) with a record of first-order descending curves "
-            "(`hystcomp excite preisach`)."
+            Notice(
+                "zero_diagonal=False is the paper's unconstrained fit to reversal curves; the "
+                "least-squares fit keeps X(v, v) = 0 (eq. 2), which a non-negative density "
+                "implies. Pass {zero_diagonal}, or {fit_rc} with a record of first-order "
+                "descending curves ({excite_preisach})."
+            )
         )
     if everett == "table" and grid_size > MAX_LSQ_GRID:
         raise InvalidParameterError(

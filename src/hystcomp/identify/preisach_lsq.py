@@ -36,6 +36,7 @@ import math
 import numpy as np
 
 from hystcomp._kernels import preisach as pk
+from hystcomp._notice import Notice
 from hystcomp.errors import IdentificationError
 from hystcomp.identify.compensation import inside_training
 from hystcomp.identify.lsq import solve_inequality_qp
@@ -93,10 +94,8 @@ class EverettBasis:
 
         Parameters
         ----------
-        alpha : array_like
-            Upper switching voltages, V.
-        beta : array_like
-            Lower switching voltages, V.
+        alpha, beta : array_like
+            Upper and lower switching voltages, V, broadcast together (one row each).
 
         Returns
         -------
@@ -115,14 +114,10 @@ class EverettBasis:
 
         Parameters
         ----------
-        v : array_like
-            The record's voltage, V.
-        x : array_like
-            The record's displacement, µm.
-        start : int, optional
-            The first sample.
-        stride : int, optional
-            Every how many samples a row is taken.
+        v, x : array_like
+            The record: voltage (V) and displacement (µm), one sample each.
+        start, stride : int, optional
+            The rows taken: samples ``start, start + stride, ...``.
         block : int, optional
             The most rows in a block.
 
@@ -167,10 +162,8 @@ class EverettBasis:
             The record's voltage, V.
         x : array_like, optional
             Not used; the regressors depend on the voltage only.
-        start : int, optional
-            The first sample.
-        stride : int, optional
-            Every how many samples a row is taken.
+        start, stride : int, optional
+            The rows taken: samples ``start, start + stride, ...``.
 
         Returns
         -------
@@ -193,14 +186,10 @@ class EverettBasis:
 
         Parameters
         ----------
-        v : array_like
-            The record's voltage, V.
-        x : array_like
-            The record's displacement, µm.
-        start : int, optional
-            The first sample.
-        stride : int, optional
-            Every how many samples a row is taken.
+        v, x : array_like
+            The record: voltage (V) and displacement (µm), one sample each.
+        start, stride : int, optional
+            The rows taken: samples ``start, start + stride, ...``.
         folds : array_like of int, optional
             The fold of every sample (-1 for none).
         n_folds : int, optional
@@ -370,10 +359,12 @@ def fit_preisach_lsq(v, x, *, everett, degree, grid_size, voltage_range, start=N
     lo, hi = voltage_range
     if used < 2 or np.ptp(v[start:]) <= 1e-9 * (hi - lo):
         raise IdentificationError(
-            "After the start-up transient (first sample used: "
-            f"{start}) the input does not move, so it traces no hysteresis. Record the "
-            "actuator while the voltage sweeps its range (any waveform: `hystcomp excite "
-            "preisach`, `hystcomp excite pi`, or a random one)."
+            Notice(
+                "After the start-up transient (first sample used: "
+                f"{start}) the input does not move, so it traces no hysteresis. Record the "
+                "actuator while the voltage sweeps its range (any waveform: {excite_preisach}, "
+                "{excite_pi}, or a random one)."
+            )
         )
     max_rows = max(MIN_ROWS, int(GRAM_BUDGET / (basis.size + 2) ** 2))
     stride = max(1, math.ceil(used / max_rows))

@@ -28,7 +28,7 @@ guessing from statistics, unlike :class:`csv.Sniffer`):
    separator at the end of the first data row (``0,0.5,1,``) is a **trailing separator**,
    its empty last field ignored in every row (and in the header and units row). A separator
    at the start of the first data row (``,0,-1.617,0``, as some acquisition scripts write)
-   is a **leading separator**: the empty first column keeps its number (``--columns t=2``
+   is a **leading separator**: the empty first column keeps its number (``columns="t=2"``
    is the first number) and is never read.
 
 The data rows are parsed by pandas' C reader (:func:`pandas.read_csv`, the separator, the
@@ -63,7 +63,7 @@ SMALL_TABLE = 200_000
 HEAD_BYTES = 1 << 16
 #: The longest first line read to find it whole (a line of many columns).
 MAX_LINE_BYTES = 1 << 20
-#: Units understood in a units row or ``--x-unit``, per column, as factors to s, V, µm.
+#: Units understood in a units row or ``x_unit``, per column, as factors to s, V, µm.
 UNITS = {
     "t": {"s": 1.0, "sec": 1.0, "ms": 1e-3, "us": 1e-6, "µs": 1e-6, "μs": 1e-6},
     "v": {"v": 1.0, "volt": 1.0, "volts": 1.0, "mv": 1e-3, "kv": 1e3},

@@ -115,12 +115,7 @@ def remove_pending() -> None:
     outputs that are still empty (when a signal ends the command)."""
     with _signals.lock():
         for tmp in list(_PENDING):
-            with contextlib.suppress(OSError):
-                if tmp.is_dir() and not tmp.is_symlink():
-                    shutil.rmtree(tmp)
-                else:
-                    os.unlink(tmp)
-            _PENDING.discard(tmp)
+            discard_temporary(tmp)
         for folder in sorted(_MADE, key=lambda p: len(p.parts), reverse=True):
             with contextlib.suppress(OSError):
                 folder.rmdir()  # only if empty

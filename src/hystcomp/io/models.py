@@ -19,6 +19,7 @@ import json
 import os
 from typing import Any, TypeAlias
 
+from hystcomp._notice import Notice
 from hystcomp._validation import as_path
 from hystcomp.errors import HystcompError, InvalidTypeError, ModelFileError
 from hystcomp.io._formats import utf16
@@ -145,8 +146,12 @@ def _check_document(doc: Any, source: str) -> type[Model]:
     """Check the shape of a model document and return the class of its kind."""
     if not isinstance(doc, dict) or doc.get("format") != MODEL_FORMAT:
         raise ModelFileError(
-            f'{source} is not a hystcomp model file (no "format": "{MODEL_FORMAT}"). '
-            "Give a file written by 'hystcomp identify' or hystcomp.save_model."
+            Notice(
+                '{source} is not a hystcomp model file (no "format": "{format}"). Give a file '
+                "written by {saved_by}.",
+                source=source,
+                format=MODEL_FORMAT,
+            )
         )
     version = doc.get("version")
     if not isinstance(version, int) or isinstance(version, bool):
@@ -342,8 +347,13 @@ def load_model(path: str | os.PathLike) -> Model:
         doc = json.loads(text, parse_constant=_refuse_constant)
     except json.JSONDecodeError as exc:
         raise ModelFileError(
-            f"{name} is not valid JSON (line {exc.lineno}: {exc.msg}); "
-            "a model file is written by 'hystcomp identify' or hystcomp.save_model."
+            Notice(
+                "{name} is not valid JSON (line {line}: {why}); a model file is written by "
+                "{saved_by}.",
+                name=name,
+                line=exc.lineno,
+                why=exc.msg,
+            )
         ) from None
     except ValueError as exc:  # NaN/Infinity, or an integer too long to read
         if "integer string conversion" in str(exc):

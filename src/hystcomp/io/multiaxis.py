@@ -2,11 +2,12 @@
 ``t, x1..xN``.
 
 The columns are found by their names, in any case (``V1``, ``x2``), numbered from 1 without
-gaps; ``--columns v1=2,x1=5,v2=3,x2=6`` (1-based numbers or names) maps others. Everything
+gaps; ``columns={"v1": 2, "x1": 5, "v2": 3, "x2": 6}`` (1-based numbers or names, or that
+text parsed by :func:`parse_axis_columns`) maps others. Everything
 else is as for one axis (:mod:`hystcomp.io.records`): the same formats, the same checks of
 every column (finite, bounded, a time column that increases or a sample rate), units rows
 and ``x_unit`` for the displacements. A file is an N-axis file when a column is named
-``v1`` or ``x1`` (or ``--columns`` names one).
+``v1`` or ``x1`` (or ``columns`` names one).
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
+from hystcomp._notice import Notice
 from hystcomp._validation import as_path, check_real
 from hystcomp.errors import DataFileError, InvalidParameterError
 from hystcomp.io._formats import read_raw
@@ -54,12 +56,12 @@ def axis_key(name) -> tuple[str, int] | None:
 
 
 def parse_axis_columns(text: str) -> dict[str, int | str]:
-    """Parse ``--columns`` of an N-axis file, such as ``t=1,v1=2,v2=3,x1=4,x2=5``.
+    """Parse the column mapping of an N-axis file as text, such as ``t=1,v1=2,v2=3,x1=4,x2=5``.
 
     Parameters
     ----------
     text : str
-        The ``--columns`` text, ``key=column`` pairs separated by commas.
+        ``key=column`` pairs separated by commas.
 
     Returns
     -------
@@ -117,7 +119,7 @@ def is_multiaxis(path, columns: dict | None = None) -> bool:
     path : str or os.PathLike
         A data file.
     columns : dict, optional
-        The column mapping the user gave (``--columns``).
+        The column mapping the user gave.
 
     Returns
     -------
@@ -209,9 +211,13 @@ def read_axes(
     n_axes = max(counts.values(), default=0)
     if n_axes == 0:
         raise DataFileError(
-            f"{where} has no N-axis columns ({', '.join(k + '1' for k in keys)}, ...); its "
-            f"columns are {', '.join(map(str, names or [])) or 'unnamed'}. Name them, or map "
-            "them with --columns v1=2,x1=3,..."
+            Notice(
+                "{where} has no N-axis columns ({wanted}, ...); its columns are {found}. Name "
+                "them, or map them with {axis_columns}",
+                where=where,
+                wanted=", ".join(k + "1" for k in keys),
+                found=", ".join(map(str, names or [])) or "unnamed",
+            )
         )
     if n_axes > MAX_AXES:
         raise DataFileError(f"{where} has {n_axes} axes, more than {MAX_AXES}.")

@@ -10,9 +10,9 @@ Formats, chosen by the file's suffix:
   units row are recognised by the rules of :mod:`hystcomp.io._text`.
 
 Columns can be named explicitly: ``{"v": 1, "x": 5}`` (1-based column numbers, for text
-files and one-matrix files) or ``{"v": "volts", "x": "disp"}`` (header names or keys); on
-the command line ``--columns v=1,x=5``. A file without a time column needs the sample rate.
-Displacements in other units are converted with ``x_unit`` (``--x-unit``). A record has at
+files and one-matrix files) or ``{"v": "volts", "x": "disp"}`` (header names or keys), or as
+text, ``"v=1,x=5"``. A file without a time column needs the sample rate. Displacements in
+other units are converted with ``x_unit``. A record has at
 most :data:`hystcomp.io._formats.MAX_SAMPLES` samples (``HYSTCOMP_MAX_SAMPLES``), checked
 before a large array is loaded. CSV is written in chunks with every value as its
 ``repr``; writes go through :func:`hystcomp.io.atomic.atomic_path`: a failing write never
@@ -36,6 +36,7 @@ from typing import Any
 
 import numpy as np
 
+from hystcomp._notice import Notice
 from hystcomp._validation import MAX_MAGNITUDE, as_path, as_signal, check_int, check_real
 from hystcomp.errors import DataFileError, InvalidParameterError, InvalidSignalError
 from hystcomp.io._formats import read_raw
@@ -47,7 +48,7 @@ MEANINGS = {"t": "time in s", "v": "voltage in V", "x": "displacement in µm"}
 WRITABLE = (".csv", ".npz", ".mat")
 #: Largest relative disagreement between a time column and a given sample rate.
 RATE_TOLERANCE = 0.01
-#: Displacement units of ``x_unit`` / ``--x-unit``, converted to µm.
+#: Displacement units of ``x_unit``, converted to µm.
 X_UNITS = ("m", "mm", "um", "nm")
 #: Displacement spans (µm) below or above which :func:`x_unit_warning` suspects m or nm.
 SPAN_METRES = 0.01
@@ -249,12 +250,23 @@ def _find(path: Path, names, label: str) -> int | None:
     folded = [i for i, name in enumerate(names) if str(name).casefold() == label.casefold()]
     if len(exact) > 1 or len(folded) > 1:
         found = ", ".join(repr(names[i]) for i in (exact if len(exact) > 1 else folded))
-        raise DataFileError(
-            f"Data file {str(path)!r} has {len(exact) or len(folded)} columns named like "
-            f"{label!r} ({found}), so which one is meant is unclear. Rename them apart in "
-            "the file, or name the right one by number, e.g. --columns x=3."
+        raise _file_error(
+            path,
+            "Data file {path} has {count} columns named like {label} ({found}), so which "
+            "one is meant is unclear. Rename them apart in the file, or name the right one "
+            "by number, e.g. {columns_eg}.",
+            count=len(exact) or len(folded),
+            label=repr(label),
+            found=found,
+            eg="x=3",
         )
     return folded[0] if folded else None
+
+
+def _file_error(path, template: str, **data) -> DataFileError:
+    """A :class:`DataFileError` about the file at ``path``: ``template`` names it ``{path}``
+    and its remedies by :class:`~hystcomp._notice.Notice` keys."""
+    return DataFileError(Notice(template, path=repr(str(path)), **data))
 
 
 def _pick(path: Path, raw: _Raw, key: str, spec, required: bool):
@@ -277,9 +289,15 @@ def _pick(path: Path, raw: _Raw, key: str, spec, required: bool):
         if spec is None and not required:
             return None, ""
         raise DataFileError(
-            f"{where} {raw.nameless}, so its columns have no names: say which column "
-            f"holds {key!r} ({MEANINGS[key]}), e.g. --columns {raw.example} on the command "
-            "line (columns={'v': 1, 'x': 2} in Python; 1-based)."
+            Notice(
+                "{where} {nameless}, so its columns have no names: say which column holds "
+                "{key} ({meaning}), e.g. {columns_eg} (1-based).",
+                where=where,
+                nameless=raw.nameless,
+                key=repr(key),
+                meaning=MEANINGS[key],
+                eg=raw.example,
+            )
         )
     label = spec if spec is not None else key
     index = _find(path, names, label)
@@ -289,8 +307,16 @@ def _pick(path: Path, raw: _Raw, key: str, spec, required: bool):
         if not names:
             raise DataFileError(f"{where} holds no columns (no named arrays or variables).")
         raise DataFileError(
-            f"{where} has no column {label!r} for {key!r} ({MEANINGS[key]}); its columns "
-            f"are {', '.join(map(str, names))}. Name the right one, e.g. --columns {key}=NAME."
+            Notice(
+                "{where} has no column {label} for {key} ({meaning}); its columns are "
+                "{names}. Name the right one, e.g. {columns_eg}.",
+                where=where,
+                label=repr(label),
+                key=repr(key),
+                meaning=MEANINGS[key],
+                names=", ".join(map(str, names)),
+                eg=f"{key}=NAME",
+            )
         )
     return index, f"column {names[index]!r}"
 
@@ -343,19 +369,27 @@ def _units(path: Path, raw: _Raw, key: str, index: int | None, x_unit) -> float:
     given = None if raw.units is None or index is None else raw.units[index]
     if key == "x" and x_unit is not None:
         if given and UNITS["x"].get(given.lower()) not in (None, UNITS["x"][x_unit]):
-            raise DataFileError(
-                f"The units row of {str(path)!r} says the displacement is in {given}, but "
-                f"--x-unit says {x_unit}. Drop --x-unit, or correct the units row."
+            raise _file_error(
+                path,
+                "The units row of {path} says the displacement is in {given}, but {x_unit} "
+                "says {unit}. {drop_x_unit}, or correct the units row.",
+                given=given,
+                unit=x_unit,
             )
         return UNITS["x"][x_unit]
     if not given:
         return 1.0
     factor = UNITS[key].get(given.lower())
     if factor is None:
-        raise DataFileError(
-            f"The units row of {str(path)!r} gives {given!r} for {key!r} ({MEANINGS[key]}); "
-            f"known units are {', '.join(UNITS[key])}. Convert the column, or correct the "
-            "unit in the file" + (", or give --x-unit." if key == "x" else ".")
+        raise _file_error(
+            path,
+            "The units row of {path} gives {given} for {key} ({meaning}); known units "
+            "are {known}. Convert the column, or correct the unit in the file"
+            + (", or give {x_unit}." if key == "x" else "."),
+            given=repr(given),
+            key=repr(key),
+            meaning=MEANINGS[key],
+            known=", ".join(UNITS[key]),
         )
     return factor
 
@@ -414,8 +448,8 @@ def read_table(
         The columns needed besides time, among ``"v"`` and ``"x"``.
     columns : dict or str, optional
         Which column holds which key: 1-based numbers (text files, or the columns of the one
-        matrix of an NPZ/MAT file) or names, as a dict (``{"v": 1, "x": 5}``) or as the
-        command line's ``--columns`` text (``"v=1,x=5"``). By default each key is the
+        matrix of an NPZ/MAT file) or names, as a dict (``{"v": 1, "x": 5}``) or as text
+        (``"v=1,x=5"``). By default each key is the
         column of the same name, in any case (``T``, ``V``, ``X`` do).
     sample_rate : float, optional
         Samples per second (Hz). Needed when the file has no time column ``t``; if both are
@@ -477,10 +511,17 @@ def _read_table(path, keys, columns, sample_rate, min_samples, x_unit, progress,
     for key in ("t", *both):
         index, label = _pick(path, raw, key, columns.get(key), key in keys)
         if index is not None and index in taken:
-            raise DataFileError(
-                f"Data file {str(path)!r}: {label} would be read both as {taken[index]!r} "
-                f"({MEANINGS[taken[index]]}) and as {key!r} ({MEANINGS[key]}). Name "
-                f"another column for one of them (--columns {key}=...)."
+            raise _file_error(
+                path,
+                "Data file {path}: {label} would be read both as {first} ({first_meaning}) "
+                "and as {key} ({meaning}). Name another column for one of them "
+                "({columns_eg}...).",
+                label=label,
+                first=repr(taken[index]),
+                first_meaning=MEANINGS[taken[index]],
+                key=repr(key),
+                meaning=MEANINGS[key],
+                eg=f"{key}=",
             )
         if index is not None:
             taken[index] = key
@@ -515,7 +556,7 @@ def x_unit_warning(x, source: str, given: str | None = None) -> str | None:
 
     A piezo actuator's stroke is between about 0.01 µm and a few mm: a span below
     :data:`SPAN_METRES` µm is likely metres, one above :data:`SPAN_NANOMETRES` µm likely
-    nanometres (give ``--x-unit``). ``given``, the unit the user gave (``--x-unit``), if any:
+    nanometres (the message names the command line's ``--x-unit``). ``given``, the unit the user gave, if any:
     then the message asks to check it. Returns the message, or None if the span is plausible.
 
     Parameters
@@ -525,7 +566,7 @@ def x_unit_warning(x, source: str, given: str | None = None) -> str | None:
     source : str
         How the message names the file.
     given : str, optional
-        The unit the user gave (``--x-unit``).
+        The unit the user gave (the ``x_unit`` of :func:`read_record`).
 
     Returns
     -------
@@ -597,18 +638,24 @@ def uneven_sampling(t, what: str) -> str | None:
 def _time(path: Path, t, n: int, sample_rate):
     if t is None:
         if sample_rate is None:
-            raise DataFileError(
-                f"Data file {str(path)!r} has no time column 't': give the sample rate, "
-                "--fs HZ on the command line (sample_rate=HZ in Python)."
+            raise _file_error(
+                path,
+                "Data file {path} has no time column 't': give the sample rate, {fs_hz}.",
             )
         with np.errstate(over="ignore"):
             t = np.arange(n) / sample_rate
         if not t[-1] <= MAX_MAGNITUDE:  # inf, or times that no reader here takes back
             raise InvalidParameterError(
-                f"The sample rate {sample_rate:g} Hz (--fs; sample_rate in Python) makes the "
-                f"time of the last of the {n} samples of {str(path)!r} {float(t[-1]):g} s, "
-                f"beyond the {MAX_MAGNITUDE:g} s a time column may hold. Give the sample "
-                "rate in Hz."
+                Notice(
+                    "The sample rate {rate:g} Hz ({rate_name}) makes the time of the last of "
+                    "the {n} samples of {path} {last:g} s, beyond the {most:g} s a time column "
+                    "may hold. Give the sample rate in Hz.",
+                    rate=sample_rate,
+                    n=n,
+                    path=repr(str(path)),
+                    last=float(t[-1]),
+                    most=MAX_MAGNITUDE,
+                )
             )
         return t
     with np.errstate(over="ignore", invalid="ignore"):
@@ -616,11 +663,14 @@ def _time(path: Path, t, n: int, sample_rate):
         rising = t[1:] > t[:-1]  # (one byte a sample, not a copy of the steps; NaN fails)
     if not rising.all():
         k = int(np.flatnonzero(~rising)[0]) + 1
-        raise DataFileError(
-            f"The time column 't' of {str(path)!r} is not strictly increasing: data row "
-            f"{k + 1} has t = {float(t[k])!r} s after t = {float(t[k - 1])!r} s. Sort the "
-            "rows and remove duplicates, or drop the time column and give the sample rate "
-            "(--fs)."
+        raise _file_error(
+            path,
+            "The time column 't' of {path} is not strictly increasing: data row {row} has "
+            "t = {t!r} s after t = {before!r} s. Sort the rows and remove duplicates, or "
+            "drop the time column and {give_fs}.",
+            row=k + 1,
+            t=float(t[k]),
+            before=float(t[k - 1]),
         )
     # the rate for these checks: the median step, of at most 100 000 steps spread over the
     # record (the same to the checks' 1 % on a long record; Record.sample_rate is exact)
@@ -629,10 +679,13 @@ def _time(path: Path, t, n: int, sample_rate):
         sample = t[1::stride] - t[:-1:stride]
         rate = float(1.0 / np.median(sample)) if sample.size else np.inf
     if not (np.isfinite(span) and 0.0 < rate < np.inf):
-        raise DataFileError(
-            f"The time column 't' of {str(path)!r} spans {float(t[0])!r} to {float(t[-1])!r} s, "
-            "which gives no usable sample rate. Check the units of the time column, or drop "
-            "it and give the sample rate (--fs)."
+        raise _file_error(
+            path,
+            "The time column 't' of {path} spans {first!r} to {last!r} s, which gives no "
+            "usable sample rate. Check the units of the time column, or drop it and "
+            "{give_fs}.",
+            first=float(t[0]),
+            last=float(t[-1]),
         )
     if sample_rate is not None and abs(rate - sample_rate) > RATE_TOLERANCE * sample_rate:
         raise DataFileError(
@@ -671,10 +724,12 @@ def read_record(path, *, columns=None, sample_rate=None, x_unit=None, progress=N
     )
     v = table["v"]
     if v.max() <= v.min():
-        raise DataFileError(
-            f"The voltage column 'v' of {str(path)!r} is constant ({float(v[0])!r} V): an "
-            "identification record needs an input that sweeps the actuator's range "
-            "(see 'hystcomp excite'). Check that the right column is named."
+        raise _file_error(
+            path,
+            "The voltage column 'v' of {path} is constant ({v!r} V): an identification "
+            "record needs an input that sweeps the actuator's range (see {excite_any}). "
+            "Check that the right column is named.",
+            v=float(v[0]),
         )
     return Record._checked(table["t"], v, table["x"], str(path))
 

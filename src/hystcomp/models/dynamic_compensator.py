@@ -448,7 +448,7 @@ class DynamicCompensator:
         Parameters
         ----------
         x_ref : array_like
-            The reference displacement, µm.
+            The reference displacement, µm, one sample per period of :attr:`sample_rate`.
 
         Returns
         -------

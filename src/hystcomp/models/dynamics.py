@@ -54,6 +54,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from hystcomp import _lti
+from hystcomp._notice import Notice
 from hystcomp._validation import as_signal, as_vector, check_int, check_real
 from hystcomp.errors import (
     HystcompWarning,
@@ -94,7 +95,8 @@ class LinearDynamics(ModelFile):
     """Creep modes and the first resonance (and a second) of an actuator, unit steady-state gain.
 
     Build it with :meth:`from_parameters`, identify it with :meth:`fit`
-    (``hystcomp identify --model dynamics``) or load it with :func:`hystcomp.load_model`.
+    (:func:`hystcomp.workflows.pair.identify_dynamics_record` reports the fit) or load it with
+    :func:`hystcomp.load_model`.
 
     Attributes
     ----------
@@ -602,6 +604,20 @@ class LinearDynamics(ModelFile):
         )
 
 
+def check_dynamics(dynamics, what: str) -> None:
+    """Refuse ``dynamics`` unless it is a :class:`LinearDynamics`; ``what`` names the
+    argument ("The 'dynamics' parameter of inverse")."""
+    if not isinstance(dynamics, LinearDynamics):
+        raise InvalidTypeError(
+            Notice(
+                "{what} must be a LinearDynamics, identified from a record: "
+                "{identify_dynamics}. Got {got}.",
+                what=what,
+                got=type(dynamics).__name__,
+            )
+        )
+
+
 def _check_mode(hz, zeta, sample_rate: float, prefix: str, owner: str) -> tuple[float, float]:
     """A mode's frequency (Hz) and damping ratio, checked: below Nyquist, resolved in
     double precision. ``prefix`` names the parameters (``""`` or ``"second_"``)."""
@@ -615,17 +631,21 @@ def _check_mode(hz, zeta, sample_rate: float, prefix: str, owner: str) -> tuple[
         )
     if hz < MIN_RESONANCE * sample_rate:
         raise InvalidParameterError(
-            f"The {name!r} parameter of {owner} must be at least {MIN_RESONANCE:g} of the "
-            f"sample rate ({MIN_RESONANCE * sample_rate:g} Hz at {sample_rate:g} Hz): "
-            f"slower, the resonance's poles cannot be told from 1 in double precision. Got "
-            f"{hz:g}; identify the dynamics from a record (hystcomp identify --model dynamics)."
+            Notice(
+                f"The {name!r} parameter of {owner} must be at least {MIN_RESONANCE:g} of the "
+                f"sample rate ({MIN_RESONANCE * sample_rate:g} Hz at {sample_rate:g} Hz): "
+                f"slower, the resonance's poles cannot be told from 1 in double precision. Got "
+                f"{hz:g}; identify the dynamics from a record instead: {{identify_dynamics}}."
+            )
         )
     if not DAMPING_RANGE[0] <= zeta <= DAMPING_RANGE[1]:
         raise InvalidParameterError(
-            f"The {damping!r} parameter of {owner} must be in {DAMPING_RANGE[0]:g} .. "
-            f"{DAMPING_RANGE[1]:g} (outside, the resonance's poles leave double precision). "
-            f"Got {zeta:g}; identify the dynamics from a record (hystcomp identify --model "
-            "dynamics)."
+            Notice(
+                f"The {damping!r} parameter of {owner} must be in {DAMPING_RANGE[0]:g} .. "
+                f"{DAMPING_RANGE[1]:g} (outside, the resonance's poles leave double "
+                f"precision). Got {zeta:g}; identify the dynamics from a record instead: "
+                "{identify_dynamics}."
+            )
         )
     return hz, zeta
 
@@ -676,12 +696,7 @@ def with_dynamics(
     DynamicCompensator
         The compensator in series with the inverse of the dynamics.
     """
-    if not isinstance(dynamics, LinearDynamics):
-        raise InvalidTypeError(
-            "The 'dynamics' parameter of inverse must be a LinearDynamics (hystcomp "
-            "identify --model dynamics, then hystcomp.load_model). Got "
-            f"{type(dynamics).__name__}."
-        )
+    check_dynamics(dynamics, "The 'dynamics' parameter of inverse")
     lo, hi = compensator.voltage_range
     rest, top, back = (float(x) for x in model.simulate([lo, hi, lo]))
     output_range = (min(rest, top), max(rest, top))
@@ -705,9 +720,9 @@ def with_dynamics(
 
 
 #: The warning of a hysteresis model and dynamics identified apart, put in series.
-APART = (
+APART = Notice(
     "the hysteresis model and the dynamics were identified apart, so the inverse of the "
     "dynamics is matched to the model at 1 Hz and may correct creep and lag that the model "
-    "already holds; identify them as one pair: hystcomp identify DATA --model KIND "
-    "--dynamics-record DYN.csv (hystcomp.models.hammerstein.fit_pair)."
+    "already holds; identify them as one pair: {identify_pair}.",
+    kind="apart",
 )

@@ -31,7 +31,7 @@ from hystcomp.errors import IdentificationError, InvalidTypeError
 from hystcomp.identify.scoring import transient_end
 from hystcomp.models.base import HysteresisModel
 from hystcomp.models.dynamic_compensator import DynamicCompensator
-from hystcomp.models.dynamics import LinearDynamics, with_dynamics
+from hystcomp.models.dynamics import LinearDynamics, check_dynamics, with_dynamics
 from hystcomp.models.estimator import ModelFile
 from hystcomp.models.mpi import ModifiedPrandtlIshlinskii
 from hystcomp.models.pi import PrandtlIshlinskii
@@ -50,8 +50,8 @@ class HammersteinModel(ModelFile):
     """A hysteresis model in series with linear dynamics, identified as one pair.
 
     Building one from parts that were identified apart is the caller's statement that they
-    belong together; :func:`fit_pair` (``hystcomp identify DATA --model KIND
-    --dynamics-record DYN``) identifies them as a pair.
+    belong together; :func:`fit_pair` (reported by
+    :func:`hystcomp.workflows.pair.identify_pair_record`) identifies them as a pair.
 
     Parameters
     ----------
@@ -79,11 +79,7 @@ class HammersteinModel(ModelFile):
                 "The 'hysteresis' argument of HammersteinModel must be a fitted PI, MPI or "
                 f"Preisach model. Got {type(hysteresis).__name__}."
             )
-        if not isinstance(dynamics, LinearDynamics):
-            raise InvalidTypeError(
-                "The 'dynamics' argument of HammersteinModel must be a LinearDynamics "
-                f"(hystcomp identify --model dynamics). Got {type(dynamics).__name__}."
-            )
+        check_dynamics(dynamics, "The 'dynamics' argument of HammersteinModel")
         hysteresis._check_fitted()
         dynamics._check_fitted()
         self.hysteresis = hysteresis

@@ -33,6 +33,7 @@ from hystcomp._hyperparameters import (
     Unchecked,
 )
 from hystcomp._kernels.multiaxis import mix_rows
+from hystcomp._notice import Notice
 from hystcomp._validation import MAX_MAGNITUDE, check_range
 from hystcomp.errors import (
     IdentificationError,
@@ -66,8 +67,8 @@ AXIS_KINDS: dict[str, type[HysteresisModel]] = {
     "mpi": ModifiedPrandtlIshlinskii,
     "preisach": Preisach,
 }
-#: The families ``family="auto"`` tries, in the order that breaks a tie (as ``hystcomp
-#: identify --model auto``).
+#: The families ``family="auto"`` tries, in the order that breaks a tie (as
+#: :func:`hystcomp.workflows.auto.identify_best`).
 AUTO_FAMILIES = ("preisach", "mpi", "pi")
 #: Most axes of one model (a coupling matrix of N^2 entries; a mirror's independent
 #: channels belong in a :class:`~hystcomp.models.channels.ChannelBank`).
@@ -149,7 +150,7 @@ def fit_axis(family, v: np.ndarray, h: np.ndarray, voltage_range=None) -> Hyster
         The family, or an unfitted estimator whose hyperparameters every axis gets (a copy
         each). ``'auto'`` fits the three families and keeps the one whose compensator is
         predicted to track best (:func:`~hystcomp.identify.compensation.tracking_estimate`,
-        as ``hystcomp identify --model auto``).
+        as :func:`hystcomp.workflows.auto.identify_best` does).
     v, h : ndarray
         The axis's input and its decoupled displacement.
     voltage_range : (float, float), optional
@@ -324,9 +325,11 @@ class MultiAxisModel(Estimator):
         for i in range(V.shape[1]):
             if np.ptp(V[:, i]) <= 0:
                 raise InvalidSignalError(
-                    f"The input of axis {i + 1} is constant ({V[0, i]!r} V): every axis must "
-                    "sweep its range for its hysteresis to be identified (hystcomp excite "
-                    "multiaxis)."
+                    Notice(
+                        f"The input of axis {i + 1} is constant ({V[0, i]!r} V): every axis "
+                        "must sweep its range for its hysteresis to be identified "
+                        "({excite_multiaxis})."
+                    )
                 )
         n_axes = V.shape[1]
         ranges = self._axis_ranges(n_axes)

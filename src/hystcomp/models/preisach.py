@@ -378,10 +378,8 @@ class Preisach(HysteresisModel):
 
         Parameters
         ----------
-        alpha : array_like
-            Upper switching voltages, V.
-        beta : array_like
-            Lower switching voltages, V.
+        alpha, beta : array_like
+            Upper and lower switching voltages, V (clamped to the plane).
 
         Returns
         -------

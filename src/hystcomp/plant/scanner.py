@@ -197,12 +197,12 @@ class Scanner:
         Parameters
         ----------
         V : array_like
-            The voltages, V, shape ``(n, N)``.
+            The voltages, V, shape ``(n, N)``; each axis's is clipped to its range.
 
         Returns
         -------
         numpy.ndarray
-            The displacements, µm, shape ``(n, N)``.
+            The displacements, µm, shape ``(n, N)``, 0 at rest.
         """
         U = self._normalised(V)
         H = np.empty_like(U)
@@ -223,7 +223,8 @@ class Scanner:
         Returns
         -------
         numpy.ndarray
-            The positions, µm, shape ``(n, N)``.
+            The positions, µm, shape ``(n, N)``: each axis's hysteresis through its mode,
+            then the coupling.
         """
         H = self.hysteresis(V)
         Y = np.empty_like(H)
@@ -264,7 +265,7 @@ class Scanner:
         Returns
         -------
         numpy.ndarray
-            The times, s.
+            ``arange(n_samples) / sample_rate``, s.
         """
         return np.arange(int(n_samples)) / self.sample_rate
 

@@ -139,7 +139,8 @@ class Twin:
         Returns
         -------
         numpy.ndarray
-            The measured displacement, µm.
+            The measured displacement, µm: :meth:`run_noiseless` plus white sensor noise of
+            ``sensor_noise / sensor_gain`` µm rms, from the twin's random generator.
         """
         x = self.run_noiseless(v)
         return x + self._noise(x.size)

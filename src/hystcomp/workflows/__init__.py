@@ -4,12 +4,12 @@ line words. A sentence that names a remedy is a :class:`hystcomp._notice.Notice`
 words by default, the command line's options when it says it.
 
 * :mod:`hystcomp.workflows.identify`: a hysteresis model (PI, MPI, Preisach) from a record,
-  its fit, hold-out and tracking estimate (``hystcomp identify --model KIND``).
+  its fit, hold-out and tracking estimate (``hystcomp identify``).
 * :mod:`hystcomp.workflows.auto`: the model family whose compensator is predicted to track
-  best (``hystcomp identify --model auto``).
+  best (the family ``'auto'``).
 * :mod:`hystcomp.workflows.pair`: a hysteresis model and the linear dynamics identified as
-  one pair (``hystcomp identify --dynamics-record``), the dynamics alone (``--model
-  dynamics``), and what ``compensate`` reads of the pair's estimates.
+  one pair (from a hysteresis record and a dynamics record), the dynamics alone, and what
+  :mod:`~hystcomp.workflows.compensate` reads of the pair's estimates.
 * :mod:`hystcomp.workflows.multiaxis`: N coupled axes from one record.
 * :mod:`hystcomp.workflows.record`: whichever of these the options ask for.
 * :mod:`hystcomp.workflows.compensate`: the voltage for a reference, with what to know of it

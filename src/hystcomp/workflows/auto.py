@@ -1,14 +1,13 @@
-"""Choose the model family by what its compensator will do: ``hystcomp identify --model auto``.
+"""Choose the model family by what its compensator will do.
 
-Which family tracks best changes from stage to stage (on the panel of
-``benchmarks/bench_accuracy.py`` the Preisach model is best on Bouc-Wen and Duhem stages,
-MPI on a Maxwell-slip stage and on one with narrow minor loops, and PI never), and the fit
-error cannot tell: every family fits its record to R^2 = 0.998 or so. :func:`identify_best`
-fits every family the record determines (:func:`~hystcomp.workflows.identify.identify_record`
-for each) and keeps the one whose compensator is predicted to track a reference over the
-range best (:func:`~hystcomp.identify.compensation.tracking_estimate`). The ranking, each
-family's estimate and its error on held-out reversal branches (references that turn inside
-the range) go with the result.
+Which family tracks best changes from stage to stage, and the fit error cannot tell (every
+family fits its record about equally well; Benchmarks, "Choosing the model family").
+:func:`identify_best` fits every family the record determines
+(:func:`~hystcomp.workflows.identify.identify_record` for each) and keeps the one whose
+compensator is predicted to track a reference over the range best
+(:func:`~hystcomp.identify.compensation.tracking_estimate`). The ranking, each family's
+estimate and its error on held-out reversal branches (references that turn inside the range)
+go with the result.
 """
 
 from __future__ import annotations
@@ -47,8 +46,7 @@ class AutoResult:
     results : dict
         ``{kind: IdentificationResult}`` of every family fitted.
     lines : list of str
-        The ranking, as ``hystcomp identify --model auto`` prints it before the chosen
-        model's own report.
+        The ranking, one line a family, to be printed before the chosen model's own report.
     """
 
     best: IdentificationResult
@@ -91,6 +89,8 @@ def identify_best(record, *, families=FAMILIES, progress=None, **options) -> Aut
     Returns
     -------
     AutoResult
+        The chosen family's identification, the ranking by tracking estimate (µm rms),
+        the families skipped and why, and the ranking's report lines.
 
     Raises
     ------

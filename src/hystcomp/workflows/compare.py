@@ -65,6 +65,8 @@ def compare_on_twin(
     Returns
     -------
     CompareRun
+        The measured comparison (tracking errors in µm), the files written and the
+        run's duration (s).
     """
     from hystcomp.experiment import warmup
     from hystcomp.experiment.background import BackgroundJob, draw_in_background
@@ -144,6 +146,7 @@ def collecting_garbage_less():
     Returns
     -------
     context manager
+        Entered around the run; on exit the collector's thresholds are restored.
     """
     thresholds = gc.get_threshold()
     gc.freeze()

@@ -98,6 +98,7 @@ def load_dynamics(path) -> LinearDynamics:
     Returns
     -------
     LinearDynamics
+        The fitted dynamics the file holds.
     """
     from hystcomp.io.models import load_model
 
@@ -180,6 +181,7 @@ def slew_sample_rate(t, path) -> float:
     Returns
     -------
     float
+        The rate (Hz).
     """
     steps = np.diff(t)
     k = int(np.argmin(steps))
@@ -313,6 +315,8 @@ def compensate_reference(
     Returns
     -------
     CompensationResult
+        The voltage (V) for each sample of ``x_ref``, the compensator, the samples clamped
+        and the warnings (clamps, extrapolation, eq. 10's own turns) as data.
     """
     import contextlib
 
@@ -576,6 +580,7 @@ def export_compensator(
     Returns
     -------
     ExportResult
+        The files written (header and source) and the warnings.
     """
     from hystcomp.codegen import export_c
     from hystcomp.codegen.multiaxis import export_multiaxis_c

@@ -171,7 +171,14 @@ class Evaluation:
         return lines
 
     def to_dict(self) -> dict[str, Any]:
-        """The figures (not the signals) as plain values, ready for JSON."""
+        """The figures (not the signals) as plain values, ready for JSON.
+
+        Returns
+        -------
+        dict
+            The file names, the errors (µm: rms, max, mean), the range (µm), the hysteresis
+            and saturation-zone figures (%), the sample count and the time span (s).
+        """
         return {
             "reference": self.reference,
             "measured": self.measured,
@@ -285,6 +292,8 @@ def evaluate(
     Returns
     -------
     Evaluation
+        The errors (µm), the hysteresis and saturation-zone figures (%) and the error
+        over time (s, µm).
 
     Raises
     ------

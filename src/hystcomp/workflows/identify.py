@@ -63,7 +63,7 @@ ESTIMATORS = {"pi": PrandtlIshlinskii, "mpi": ModifiedPrandtlIshlinskii, "preisa
 _OWNER = "identify_record"
 #: A compensator predicted to track within this fraction of a straight line's error is
 #: warned about: the estimate is measured on the record, and another reference can lose
-#: that margin (PI on a saturating stage: estimated 0.90-0.998x, measured up to 1.24x).
+#: that margin (Benchmarks, "The tracking estimate").
 LINE_MARGIN = 0.8
 #: The fewest samples left after the transient for a model without a transient option of
 #: its own (Preisach's fit needs three).

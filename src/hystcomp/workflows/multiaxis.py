@@ -2,7 +2,7 @@
 
 The steps of :meth:`MultiAxisModel.fit <hystcomp.models.multiaxis.MultiAxisModel.fit>`,
 with each axis identified as ``hystcomp identify`` identifies one axis (start-up transient,
-tracking estimate, warnings; ``--model auto`` ranks the families per axis) on its
+tracking estimate, warnings; the family ``'auto'`` ranks the families per axis) on its
 decoupled displacements:
 
 1. the coupling ``M`` (:func:`~hystcomp.identify.coupling.fit_coupling`);
@@ -41,7 +41,7 @@ class MultiAxisResult:
     model : MultiAxisModel
         The fitted stage.
     lines : list of str
-        The report, as ``hystcomp identify`` prints it.
+        The report, one line each.
     warnings : list of str
         Each a sentence, its axis named.
     results : list
@@ -97,6 +97,8 @@ def identify_axes(
     Returns
     -------
     MultiAxisResult
+        The fitted multi-axis model, and each axis's report lines and warnings,
+        prefixed with the axis.
 
     Raises
     ------

@@ -1,15 +1,14 @@
 """Hysteresis and dynamics identified as one pair, and how well the pair will track.
 
-:func:`identify_pair_record` is what ``hystcomp identify DATA --model KIND
---dynamics-record DYN`` runs: the hysteresis model alone from ``DATA`` (as ``hystcomp
-identify`` fits it, :func:`hystcomp.workflows.identify.identify_record`), then the pair
-(:func:`hystcomp.models.hammerstein.fit_pair`) from both records, then the tracking of
-both compensators estimated on the triangles of the dynamics record, which neither fit
+:func:`identify_pair_record` identifies the hysteresis model alone from its record (as
+:func:`hystcomp.workflows.identify.identify_record` fits it), then the pair
+(:func:`hystcomp.models.hammerstein.fit_pair`) from both records, then estimates the
+tracking of both compensators on the triangles of the dynamics record, which neither fit
 saw (:func:`tracking_estimates`).
 
-:func:`dynamics_alone` is what ``hystcomp identify DYN --model dynamics`` runs: the
-dynamics behind a hysteresis model of the dynamics record's own, for a user who pairs them
-with a hysteresis model later (``compensate --dynamics``), which is then warned about.
+:func:`dynamics_alone` fits the dynamics behind a hysteresis model of the dynamics record's
+own, for a user who pairs them with a hysteresis model later (the dynamics given to
+:func:`hystcomp.workflows.compensate.compensate_reference`), which is then warned about.
 """
 
 from __future__ import annotations
@@ -40,9 +39,8 @@ __all__ = [
     "tracking_estimates",
 ]
 
-#: Least share of the frequency response the dynamics must explain to be used without a
-#: warning: one mode behind a good hysteresis model explains 90 % and more on the panel of
-#: ``benchmarks/bench_dynamics_panel.py``.
+#: Least share (%) of the frequency response the dynamics must explain to be used without a
+#: warning (Benchmarks, "The H+D pair").
 MIN_DYNAMICS_FIT = 80.0
 #: The pair is said to track worse than the hysteresis model alone where its estimate is
 #: above this multiple of the other's (the estimates' own scatter stays within it).
@@ -58,7 +56,8 @@ class PairResult:
     model : HammersteinModel
         The pair, with ``fit_report_["tracking_estimates"]``.
     hysteresis : IdentificationResult
-        The hysteresis model alone, as ``hystcomp identify`` fits it from the hysteresis
+        The hysteresis model alone, as
+        :func:`~hystcomp.workflows.identify.identify_record` fits it from the hysteresis
         record (its report and warnings).
     estimates : dict
         ``{frequency (Hz): {"alone_um": rms, "pair_um": rms}}``: see
@@ -89,17 +88,25 @@ def tracking_estimates(pair, alone, v, x) -> dict:
     ``f`` through ``C`` and then ``D[H[.]]``. It holds the dynamics that the hysteresis
     model alone does not invert, and what the pair's own inverse cannot (its band limit).
     ``e_stage`` is how far the pair is from the stage: its forward error on that triangle
-    of the record, which neither fit saw. On the six tuning stages of
-    ``benchmarks/bench_dynamics_panel.py`` it lies within 1.5x of the measured tracking in
-    92 of 96 cells (0.76x to 2.7x), and says which of the two tracks better in 45 of 48;
-    on the held-out stage within 1.5x in 16 of 16, the better in 7 of 8 (``python
-    benchmarks/bench_dynamics_panel.py --estimates``).
+    of the record, which neither fit saw. How close the estimate comes to the measured
+    tracking: (Benchmarks, "The H+D pair").
+
+    Parameters
+    ----------
+    pair : hystcomp.models.hammerstein.HammersteinModel
+        The fitted pair ``D[H[v]]``.
+    alone : hystcomp.models.base.HysteresisModel
+        The hysteresis model fitted alone (its compensator ignores the dynamics).
+    v : array_like
+        The dynamics record's voltage (V), sampled at the pair's dynamics rate.
+    x : array_like
+        The dynamics record's displacement (µm).
 
     Returns
     -------
     dict
-        ``{f: {"alone_um": ..., "pair_um": ...}}``, empty if the record has no triangles
-        (a record of the former layout).
+        ``{f (Hz): {"alone_um": rms, "pair_um": rms}}`` (µm), empty if the record has no
+        triangles (a record of the former layout).
     """
     dynamics = pair.dynamics
     fs = dynamics.sample_rate_
@@ -148,15 +155,18 @@ def identify_pair_record(
     Parameters
     ----------
     record : hystcomp.io.records.Record
-        The hysteresis record (``hystcomp excite mpi``, ``rich``, ...).
+        The hysteresis record: time (s), voltage (V), displacement (µm), e.g. the answer to
+        ``excitation_signal('mpi')`` or ``'rich'``.
     dynamics_record : hystcomp.io.records.Record
-        The answer to ``hystcomp excite dynamics``, at the rate the compensator will run.
+        The answer to ``excitation_signal('dynamics')``, at the rate the compensator will
+        run.
     model : {'pi', 'mpi', 'preisach'} or estimator
         As in :func:`~hystcomp.workflows.identify.identify_record`.
     hysteresis : IdentificationResult, optional
         ``model`` already identified from ``record`` (by
-        :func:`~hystcomp.workflows.identify.identify_record`, as ``--model auto`` does): it
-        is the pair's first round, not fitted again.
+        :func:`~hystcomp.workflows.identify.identify_record`, as
+        :func:`~hystcomp.workflows.auto.identify_best` does): it is the pair's first round,
+        not fitted again.
     **options
         Those of :func:`~hystcomp.workflows.identify.identify_record` (no ``holdout``), for
         the hysteresis model's identification when it is not given.
@@ -164,6 +174,8 @@ def identify_pair_record(
     Returns
     -------
     PairResult
+        The pair (with its tracking estimates in ``fit_report_``), the hysteresis model's
+        own identification, and the report lines and warnings.
     """
     uneven = uneven_sampling(dynamics_record.t, f"the dynamics record {dynamics_record.source}")
     if uneven:
@@ -228,7 +240,21 @@ def identify_pair_record(
 
 
 def dynamics_lines(dyn: LinearDynamics, record) -> list[str]:
-    """The report of a dynamics model: record, resonance, latency, creep, fit."""
+    """The report of a dynamics model: record, resonance, latency, creep, fit.
+
+    Parameters
+    ----------
+    dyn : hystcomp.models.dynamics.LinearDynamics
+        The fitted dynamics (with their ``fit_report_``).
+    record : hystcomp.io.records.Record
+        The record they were fitted to: time (s), voltage (V), displacement (µm).
+
+    Returns
+    -------
+    list of str
+        One line each: the record's length and rate (Hz, s), the resonance (Hz), the
+        latency (samples, µs), the creep (%, s), the fit (%, dB) and the step error (µm).
+    """
     report = dyn.fit_report_
     lo, hi = report["fit_band_hz"]
     taus = dyn.creep_time_constants_
@@ -306,7 +332,7 @@ class DynamicsResult:
     source : str
         Where the record came from.
     lines : list of str
-        The report, one line each, as ``hystcomp identify --model dynamics`` prints it.
+        The report, one line each.
     warnings : list of str
         Each a sentence (without the command line's ``hystcomp: warning:`` prefix): when
         the model follows the record too poorly for its inverse to be trusted.
@@ -329,7 +355,8 @@ def identify_dynamics_record(record) -> DynamicsResult:
     Parameters
     ----------
     record : hystcomp.io.records.Record
-        The measured record: time (s), voltage (V), displacement (µm).
+        The measured record: time (s), voltage (V), displacement (µm), evenly sampled (an
+        uneven record is refused, as the fit assumes one sample rate).
 
     Returns
     -------
@@ -352,7 +379,7 @@ def identify_dynamics_record(record) -> DynamicsResult:
 
 
 def dynamics_alone(record) -> LinearDynamics:
-    """The linear dynamics of a record of ``hystcomp excite dynamics``, on their own.
+    """The linear dynamics of the answer to ``excitation_signal('dynamics')``, on their own.
 
     ``D`` is fitted behind a hysteresis model (MPI) of the record itself, fitted on its
     1 Hz triangles (from the ramp before them, which sets the model's memory), the two
@@ -360,6 +387,16 @@ def dynamics_alone(record) -> LinearDynamics:
     record drives the stage through its hysteresis, which a fit on the voltage would take
     for dynamics. The hysteresis model is not kept. A record of the former layout (a small
     multisine, no triangles) is fitted on the voltage, as it was.
+
+    Parameters
+    ----------
+    record : hystcomp.io.records.Record
+        The dynamics record: time (s), voltage (V), displacement (µm).
+
+    Returns
+    -------
+    hystcomp.models.dynamics.LinearDynamics
+        The fitted dynamics, at the record's sample rate.
     """
     v, x = record.v, record.x
     triangles = record_layout(v, record.sample_rate).triangles
@@ -378,6 +415,18 @@ def reference_rate(x_ref, sample_rate: float) -> float:
 
     Turns smaller than 5 % of its span are not counted; a reference that never turns back
     (a ramp, a step, a hold) has rate 0.
+
+    Parameters
+    ----------
+    x_ref : array_like
+        The reference displacement (µm).
+    sample_rate : float
+        Its sample rate (Hz).
+
+    Returns
+    -------
+    float
+        The rate (Hz), 0.0 for a reference that never turns back.
 
     Examples
     --------
@@ -419,6 +468,22 @@ def predicted_worse(pair: HammersteinModel, x_ref, sample_rate: float):
     The estimates of :func:`tracking_estimates` (in the pair's file) are interpolated in
     the logarithm of the frequency at the reference's :func:`reference_rate`, held at the
     ends of the frequencies estimated (a step or a hold is the slowest).
+
+    Parameters
+    ----------
+    pair : hystcomp.models.hammerstein.HammersteinModel
+        The pair, with ``fit_report_["tracking_estimates"]`` (as its model file holds it).
+    x_ref : array_like
+        The reference displacement (µm).
+    sample_rate : float
+        The reference's sample rate (Hz).
+
+    Returns
+    -------
+    tuple of float or None
+        ``(rate (Hz), alone_um, pair_um)``, the estimates in µm rms, if the pair is
+        predicted to track worse than the hysteresis model alone; None if it is not, or if
+        the pair holds no estimates.
     """
     rows = _estimate_rows(getattr(pair, "fit_report_", None))
     if not rows:

@@ -83,6 +83,8 @@ def identify_model(
     Returns
     -------
     ModelResult
+        The fitted model (hysteresis, pair or dynamics), the hysteresis model's
+        identification and each step's result with its report lines and warnings.
     """
     if dynamics_record is not None and holdout is not None:
         raise InvalidParameterError(

@@ -64,6 +64,8 @@ def simulate_voltage(
     Returns
     -------
     SimulationResult
+        The displacement (µm) for each sample of ``v``, the warnings (the voltage leaving
+        the model's range) and the validation lines against a measured displacement (µm).
     """
     import contextlib
 
