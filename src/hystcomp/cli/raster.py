@@ -5,31 +5,23 @@ The work is :func:`hystcomp.experiment.raster.raster_experiment`.
 
 from __future__ import annotations
 
-import functools
 from pathlib import Path
 
 import click
 
 from hystcomp.cli import _options as opts
 from hystcomp.cli import command
-from hystcomp.cli import option as cli_option
 
-option = functools.partial(cli_option, "raster")
+FAMILIES = click.Choice(["auto", "pi", "mpi", "preisach"])
 
 
 @command("raster")
-@option("--axes", "n_axes", type=click.IntRange(2, 3), default=2, show_default=True)
-@option(
-    "--model",
-    "family",
-    type=click.Choice(["auto", "pi", "mpi", "preisach"]),
-    default="auto",
-    show_default=True,
-)
-@option("--lines", type=click.IntRange(4, 1024), default=64, show_default=True)
-@option("--out", "out_dir", metavar="DIR")
-@option("--jobs", "n_jobs", type=int)
-@opts._shared("--quiet", "-q", is_flag=True)
+@click.option("--axes", "n_axes", type=click.IntRange(2, 3), default=2, show_default=True)
+@click.option("--model", "family", type=FAMILIES, default="auto", show_default=True)
+@click.option("--lines", type=click.IntRange(4, 1024), default=64, show_default=True)
+@click.option("--out", "out_dir", metavar="DIR")
+@click.option("--jobs", "n_jobs", type=int)
+@opts.quiet
 def raster(out_dir, quiet, **experiment):
     """``hystcomp raster``: parse, run the experiment, print, write."""
     from hystcomp.experiment.raster import plot_raster, raster_experiment

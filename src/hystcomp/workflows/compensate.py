@@ -43,6 +43,7 @@ __all__ = [
     "compensate_reference",
     "export_compensator",
     "inverse_for",
+    "load_compensation",
     "load_dynamics",
     "own_turns",
     "reach",
@@ -594,3 +595,28 @@ def export_compensator(
     options = {"prefix": prefix, "source": source, "sample_rate": sample_rate, "inputs": inputs}
     paths = list(write(compensator, directory, **options))
     return ExportResult(paths, [APART] if dynamics is not None else [])
+
+
+def load_compensation(path, dynamics=None) -> tuple[Any, LinearDynamics | None]:
+    """The model of a model file to invert, and the linear dynamics of a second one if given.
+
+    Parameters
+    ----------
+    path : str or path-like
+        A model file: a hysteresis model, a pair or an N-axis model, not linear dynamics
+        alone (:func:`refuse_dynamics_as_model`).
+    dynamics : str or path-like, optional
+        A model file of linear dynamics (:func:`load_dynamics`), inverted in series.
+
+    Returns
+    -------
+    model : object
+        The model of ``path``.
+    dynamics : LinearDynamics or None
+        The linear dynamics of ``dynamics``, if given.
+    """
+    from hystcomp.io.models import load_model
+
+    model = load_model(path)
+    refuse_dynamics_as_model(model, path)
+    return model, None if dynamics is None else load_dynamics(dynamics)
