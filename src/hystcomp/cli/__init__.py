@@ -115,7 +115,7 @@ class _Command(click.Command):
         try:
             return super().invoke(ctx)
         except InvalidParameterError as exc:
-            found = _PARAMETER.fullmatch(say(exc.args[0] if len(exc.args) == 1 else str(exc)))
+            found = _PARAMETER.fullmatch(_said(exc))
             if found is None:
                 raise
             name = OPTIONS.get(found["name"], "--" + found["name"].replace("_", "-"))

@@ -45,18 +45,6 @@ def check(test, words: str):
     return callback
 
 
-def parsed(parse):
-    """A callback: the value as the library's ``parse`` reads it, or its refusal."""
-
-    def callback(ctx, param, value):
-        try:
-            return parse(value)
-        except InvalidParameterError as exc:
-            raise click.BadParameter(str(exc), param=param) from None
-
-    return callback
-
-
 def positive(unit: str, strict: bool = True):
     """A callback: a finite number > 0 (>= 0 unless ``strict``) in ``unit``."""
     return check(
@@ -84,10 +72,14 @@ class Alias(click.Option):
         return f"'{self.opts[0]}'"
 
 
-def _columns(text):
-    from hystcomp.io.multiaxis import parse_any_columns  # v=1,x=5, or v1=2,... of N axes
+def _columns(ctx, param, value):
+    """A callback: a column mapping such as ``v=1,x=5``, or ``v1=2,...`` of an N-axis file."""
+    from hystcomp.io.multiaxis import parse_any_columns
 
-    return parse_any_columns(text)
+    try:
+        return parse_any_columns(value)
+    except InvalidParameterError as exc:
+        raise click.BadParameter(str(exc), param=param) from None
 
 
 #: ``--voltage-range LO HI`` of compensate and export-c: a clamp inside the model's range.
@@ -110,7 +102,7 @@ def reading(f):
     """The options of a command that reads a data file: --columns, --fs, --x-unit, --quiet."""
     f = click.option("--x-unit", type=click.Choice(X_UNITS))(quiet(f))
     f = click.option("--fs", "sample_rate", type=float, metavar="HZ", callback=positive("Hz"))(f)
-    return click.option("--columns", metavar="SPEC", callback=parsed(_columns))(f)
+    return click.option("--columns", metavar="SPEC", callback=_columns)(f)
 
 
 def report(*results, lines: bool = True, warnings: bool = True) -> None:
@@ -183,15 +175,6 @@ def warn_x_unit(x, source, given: dict) -> None:
         click.echo(f"hystcomp: warning: {message}", err=True)
 
 
-def check_data_output(path, *, inputs=(), what: str = "output"):
-    """Refuse, before any work, a data output that cannot be written or would overwrite an input."""
-    from hystcomp.io.atomic import check_output_path
-    from hystcomp.io.records import check_writable
-
-    check_output_path(path, inputs=inputs, what=what)
-    return check_writable(path)
-
-
 def check_plot(plot, *, inputs=(), output=None) -> None:
     """Refuse, before any work, a figure of an unknown format, or one that would overwrite
     an input or the command's other output."""
@@ -205,21 +188,20 @@ def check_plot(plot, *, inputs=(), output=None) -> None:
         raise click.BadParameter("names the same file as -o.", param_hint="--plot")
 
 
-def write_files(writers: dict, *, reverse: bool = False) -> None:
-    """Write every output at once (:func:`hystcomp.io.atomic.write_all`), then say so."""
-    from hystcomp.io.atomic import write_all
-
-    for path in write_all(writers)[:: -1 if reverse else 1]:
+def wrote(paths) -> None:
+    """Say that each of ``paths`` was written."""
+    for path in paths:
         click.echo(f"  wrote {path}")
 
 
 def write_model(model, output, plot=None, draw=None) -> None:
     """Write ``model`` to ``output`` and, with ``plot``, the figure ``draw(path)`` makes."""
+    from hystcomp.io.atomic import write_all
     from hystcomp.io.models import model_text
 
     text = model_text(model)
     writers = {output: lambda tmp: tmp.write_text(text, encoding="utf-8")}
-    write_files(writers if plot is None else {**writers, plot: draw}, reverse=True)
+    wrote(write_all(writers if plot is None else {**writers, plot: draw})[::-1])
 
 
 def write_signal(table: dict, output, quiet: bool, summary: str) -> None:

@@ -1,7 +1,5 @@
-"""``hystcomp compare``: the paper's experiment (Section V) on the simulated axis.
-
-The work is :func:`hystcomp.workflows.compare.compare_on_twin`.
-"""
+"""``hystcomp compare``: the paper's experiment (Section V) on the simulated axis
+(:func:`hystcomp.workflows.compare.compare_on_twin`)."""
 
 from __future__ import annotations
 

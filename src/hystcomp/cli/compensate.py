@@ -1,8 +1,5 @@
-"""``hystcomp compensate``: the feedforward voltage for a reference displacement.
-
-The work is :func:`hystcomp.workflows.compensate.compensate_reference`; this module parses
-the options, reads the reference, prints the warnings and writes the voltage.
-"""
+"""``hystcomp compensate``: the feedforward voltage for a reference displacement
+(:func:`hystcomp.workflows.compensate.compensate_reference`)."""
 
 from __future__ import annotations
 
@@ -11,7 +8,7 @@ import click
 from hystcomp.cli import _options as opts
 from hystcomp.cli import command
 from hystcomp.io.multiaxis import axis_table
-from hystcomp.io.records import write_table
+from hystcomp.io.records import check_data_output, write_table
 from hystcomp.models.multiaxis import MultiAxisModel
 from hystcomp.workflows.compensate import compensate_reference, load_compensation
 
@@ -29,7 +26,7 @@ from hystcomp.workflows.compensate import compensate_reference, load_compensatio
 def compensate(model_file, reference_file, output, dynamics_file, **o):
     """``hystcomp compensate``: parse, compensate (:mod:`hystcomp.workflows`), print, write."""
     inputs = (model_file, reference_file) + ((dynamics_file,) if dynamics_file else ())
-    opts.check_data_output(output, inputs=inputs, what="voltage file")
+    check_data_output(output, inputs=inputs, what="voltage file")
     model, dynamics = load_compensation(model_file, dynamics_file)
     multi = isinstance(model, MultiAxisModel)  # t, x1..xN -> t, v1..vN, x1_ref..xN_ref
     table = opts.read_input(reference_file, ("x",), o, multi=multi)

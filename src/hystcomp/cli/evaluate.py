@@ -1,7 +1,5 @@
-"""``hystcomp evaluate``: how a measured run tracked its reference.
-
-The work is :func:`hystcomp.workflows.evaluate.evaluate`, whose result words itself.
-"""
+"""``hystcomp evaluate``: how a measured run tracked its reference
+(:func:`hystcomp.workflows.evaluate.evaluate`, whose result words itself)."""
 
 from __future__ import annotations
 

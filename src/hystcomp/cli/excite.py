@@ -9,6 +9,7 @@ from hystcomp.cli import _options as opts
 from hystcomp.cli import command
 from hystcomp.identify.excitation import DEFAULT_SAMPLE_RATE, SIGNAL_KINDS, excitation_signal
 from hystcomp.io.multiaxis import axis_table
+from hystcomp.io.records import check_data_output
 
 HZ = {"type": float, "show_default": True, "metavar": "HZ", "callback": opts.positive("Hz")}
 
@@ -36,7 +37,7 @@ def excite(model, output, axes, quiet, **signal):
             "--axes N goes with 'excite multiaxis' (and only with it): give both or neither."
         )
     if output is not None:
-        opts.check_data_output(output, what="signal file")
+        check_data_output(output, what="signal file")
     if model == "multiaxis":
         from hystcomp.identify.multiaxis_excitation import multiaxis_sequence
 

@@ -1,7 +1,5 @@
-"""``hystcomp export-c``: a model file's compensator as C99 code for an embedded controller.
-
-The work is :func:`hystcomp.workflows.compensate.export_compensator`.
-"""
+"""``hystcomp export-c``: a model file's compensator as C99 code for an embedded controller
+(:func:`hystcomp.workflows.compensate.export_compensator`)."""
 
 from __future__ import annotations
 

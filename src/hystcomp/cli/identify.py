@@ -1,9 +1,6 @@
-"""``hystcomp identify``: a model from a measured record, with an optional hold-out test.
-
-The work is :mod:`hystcomp.workflows` (:func:`~hystcomp.workflows.identify.identify_record`,
-``auto``, ``pair``, ``multiaxis``); this module parses the options, prints the result and
-writes the files.
-"""
+"""``hystcomp identify``: a model from a measured record, with an optional hold-out test
+(:func:`hystcomp.workflows.record.identify_model`, or N axes'
+:func:`hystcomp.workflows.multiaxis.identify_axes`)."""
 
 from __future__ import annotations
 
@@ -100,9 +97,9 @@ def identify(data, kind, output, plot, dynamics_record, holdout, voltage_range, 
     _check_options(kind, options)
     if plot is not None:
         opts.check_plot(plot, inputs=inputs, output=output)
-    given = {k: v for k, v in options.items() if v is not None}
-    fitting = {"allow_extrapolation": o["allow_extrapolation"], "transient": o["transient"]}
-    fitting["unit_check"] = False  # checked here before the fit, and silenced by --quiet
+    fitting = {k: v for k, v in options.items() if v is not None}
+    fitting.update(voltage_range=voltage_range, allow_extrapolation=o["allow_extrapolation"])
+    fitting.update(transient=o["transient"], unit_check=False)  # checked here, before the fit
 
     def ticking(what: str):
         return opts.progress(f"identifying {what}", o["quiet"]).ticking()
@@ -111,17 +108,10 @@ def identify(data, kind, output, plot, dynamics_record, holdout, voltage_range, 
         from hystcomp.workflows.multiaxis import identify_axes
 
         table = opts.read_input(data, ("v", "x"), o, multi=True)
-        with ticking(f"{table['v'].shape[1]} axes"):
+        t, v, x = table["t"], table["v"], table["x"]
+        with ticking(f"{v.shape[1]} axes"):
             axes = identify_axes(
-                table["t"],
-                table["v"],
-                table["x"],
-                kind=kind,
-                n_jobs=o["n_jobs"],
-                source=str(data),
-                voltage_range=voltage_range,
-                **fitting,
-                **given,
+                t, v, x, kind=kind, n_jobs=o["n_jobs"], source=str(data), **fitting
             )
         opts.report(axes)
         return opts.write_model(axes.model, output)
@@ -129,24 +119,19 @@ def identify(data, kind, output, plot, dynamics_record, holdout, voltage_range, 
     rec = read_record(data, **(plain if kind == "dynamics" else opts.read_options(o, data)))
     if kind != "dynamics":
         opts.warn_x_unit(rec.x, data, o)
-    dyn = None if dynamics_record is None else read_record(dynamics_record, **plain)
     found = identify_model(
         rec,
         kind,
-        dynamics_record=dyn,
+        dynamics_record=None if dynamics_record is None else read_record(dynamics_record, **plain),
         holdout=holdout,
         progress=lambda k: ticking(f"the {LABELS[k]} model"),
-        **({} if kind == "dynamics" else {"voltage_range": voltage_range, **fitting, **given}),
+        **({} if kind == "dynamics" else fitting),
     )
     opts.report(found)
 
     def draw(path):  # the fitted part and the hold-out as the model predicts it, or a Bode plot
-        from hystcomp.experiment.fig_identification import plot_identification_result
+        from hystcomp.experiment.fig_identification import plot_identified
 
-        if found.hysteresis is None:
-            from hystcomp.experiment.fig_dynamics import plot_bode
-
-            return plot_bode(found.model, path)
-        plot_identification_result(rec, found.hysteresis, path)
+        plot_identified(rec, found, path)
 
     opts.write_model(found.model, output, plot, draw)

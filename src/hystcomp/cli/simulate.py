@@ -1,7 +1,5 @@
-"""``hystcomp simulate``: a model's displacement for a voltage input.
-
-The work is :func:`hystcomp.workflows.simulate.simulate_voltage`.
-"""
+"""``hystcomp simulate``: a model's displacement for a voltage input
+(:func:`hystcomp.workflows.simulate.simulate_voltage`)."""
 
 from __future__ import annotations
 
@@ -11,6 +9,7 @@ from hystcomp.cli import _options as opts
 from hystcomp.cli import command
 from hystcomp.io.models import load_model
 from hystcomp.io.multiaxis import axis_table
+from hystcomp.io.records import check_data_output
 from hystcomp.models.multiaxis import MultiAxisModel
 from hystcomp.workflows.simulate import simulate_voltage
 
@@ -22,7 +21,7 @@ from hystcomp.workflows.simulate import simulate_voltage
 @opts.reading
 def simulate(model_file, input_file, output, **o):
     """``hystcomp simulate``: parse, simulate (:mod:`hystcomp.workflows`), print, write."""
-    opts.check_data_output(output, inputs=(model_file, input_file), what="result file")
+    check_data_output(output, inputs=(model_file, input_file), what="result file")
     model = load_model(model_file)
     multi = isinstance(model, MultiAxisModel)  # N coupled axes: t, v1..vN -> x1..xN
     optional = () if multi else ("x",)  # a measured displacement to validate against

@@ -277,3 +277,25 @@ def plot_identification_result(record, result, path) -> None:
         t=record.t[kept],
         fit_end=result.n_fit - result.start if result.n_fit < len(record) else None,
     )
+
+
+def plot_identified(record, found, path) -> None:
+    """The figure of ``hystcomp identify --plot`` for what
+    :func:`~hystcomp.workflows.record.identify_model` found: the hysteresis model's
+    (:func:`plot_identification_result`), or the Bode plot of linear dynamics alone
+    (:func:`~hystcomp.experiment.fig_dynamics.plot_bode`).
+
+    Parameters
+    ----------
+    record : Record
+        The record identified.
+    found : ModelResult
+        What the identification found.
+    path : str or pathlib.Path
+        The figure's file.
+    """
+    if found.hysteresis is None:
+        from hystcomp.experiment.fig_dynamics import plot_bode
+
+        return plot_bode(found.model, path)
+    plot_identification_result(record, found.hysteresis, path)
