@@ -88,24 +88,14 @@ def command(name: str) -> Callable[[Callable], click.Command]:
     return register
 
 
-def say(text: str) -> str:
-    """A library sentence in the command line's words, on one line.
-
-    Parameters
-    ----------
-    text : str or hystcomp._notice.Notice
-        The sentence; a notice's remedies are named as words.toml's ``[remedies]`` say.
-
-    Returns
-    -------
-    str
-    """
+def _say(text: str) -> str:
+    """A library sentence in the command line's words (words.toml's remedies), on one line."""
     return _one_line(worded(text, TEXT["remedies"]))
 
 
 def _said(exc: BaseException) -> str:
     """An error's message in the command line's words (a notice's remedies as options)."""
-    return say(exc.args[0] if len(exc.args) == 1 else str(exc))
+    return _say(exc.args[0] if len(exc.args) == 1 else str(exc))
 
 
 class _Command(click.Command):

@@ -19,7 +19,7 @@ from hystcomp._hyperparameters import MAX_OPERATORS
 from hystcomp._notice import worded
 from hystcomp._progress import Progress
 from hystcomp._validation import MAX_MAGNITUDE
-from hystcomp.cli import TEXT, say
+from hystcomp.cli import TEXT, _say
 from hystcomp.errors import InvalidParameterError, OutputPathError
 from hystcomp.io.records import X_UNITS, format_csv  # light: no compiled code until used
 
@@ -110,7 +110,7 @@ def report(*results, lines: bool = True, warnings: bool = True) -> None:
     for line in (x for r in results if lines for x in getattr(r, "lines", ())):
         click.echo(worded(line, TEXT["remedies"]))
     for warning in (x for r in results if warnings for x in getattr(r, "warnings", ())):
-        click.echo(f"hystcomp: warning: {say(warning)}", err=True)
+        click.echo(f"hystcomp: warning: {_say(warning)}", err=True)
 
 
 def refuse(given: dict, why: str) -> None:

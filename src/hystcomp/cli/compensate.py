@@ -10,7 +10,11 @@ from hystcomp.cli import command
 from hystcomp.io.multiaxis import axis_table
 from hystcomp.io.records import check_data_output, write_table
 from hystcomp.models.multiaxis import MultiAxisModel
-from hystcomp.workflows.compensate import compensate_reference, load_compensation
+from hystcomp.workflows.compensate import (
+    compensate_reference,
+    load_compensation,
+    voltage_summary,
+)
 
 
 @command("compensate")
@@ -44,19 +48,9 @@ def compensate(model_file, reference_file, output, dynamics_file, **o):
         progress=opts.progress("computing the voltage" + "s" * multi, o["quiet"]).ticking(),
     )
     opts.report(result)
-    v, x = result.v, table["x"]
-    if multi:
-        ranges = ", ".join(f"v{i + 1} {c.min():.4g} .. {c.max():.4g} V" for i, c in enumerate(v.T))
-        summary = f"{len(v)} samples of {v.shape[1]} axes ({ranges}; {sum(result.clamped)} clamped)"
-    else:
-        lo, hi = result.compensator.voltage_range
-        summary = (
-            f"{v.size} samples, v from {v.min():.4g} to {v.max():.4g} V (range {lo:.4g} .. "
-            f"{hi:.4g} V, {result.clamped} clamped)"
-        )
     written = opts.progress(f"writing {output}", o["quiet"])
-    write_table(output, axis_table(table["t"], v=v, x_ref=x), progress=written)
-    click.echo(f"wrote {output}: {summary}")
+    write_table(output, axis_table(table["t"], v=result.v, x_ref=table["x"]), progress=written)
+    click.echo(f"wrote {output}: {voltage_summary(result)}")
     if result.preview is not None:
         click.echo(
             f"  with the inverse of the dynamics of {dynamics_file or model_file}: "

@@ -49,6 +49,7 @@ __all__ = [
     "reach",
     "refuse_dynamics_as_model",
     "slew_sample_rate",
+    "voltage_summary",
 ]
 
 #: A step of the reference's time column shorter than this share of its median step is a
@@ -620,3 +621,28 @@ def load_compensation(path, dynamics=None) -> tuple[Any, LinearDynamics | None]:
     model = load_model(path)
     refuse_dynamics_as_model(model, path)
     return model, None if dynamics is None else load_dynamics(dynamics)
+
+
+def voltage_summary(result: CompensationResult) -> str:
+    """The voltage :func:`compensate_reference` computed, in one line: its samples, its
+    range and how many were clamped (each axis's range for an N-axis model).
+
+    Parameters
+    ----------
+    result : CompensationResult
+        The compensation.
+
+    Returns
+    -------
+    str
+        E.g. ``"4000 samples, v from 2.1 to 118 V (range 0 .. 120 V, 0 clamped)"``.
+    """
+    v = result.v
+    if v.ndim == 2:  # one column per axis
+        ranges = ", ".join(f"v{i + 1} {c.min():.4g} .. {c.max():.4g} V" for i, c in enumerate(v.T))
+        return f"{len(v)} samples of {v.shape[1]} axes ({ranges}; {sum(result.clamped)} clamped)"
+    lo, hi = result.compensator.voltage_range
+    return (
+        f"{v.size} samples, v from {v.min():.4g} to {v.max():.4g} V (range {lo:.4g} .. "
+        f"{hi:.4g} V, {result.clamped} clamped)"
+    )
