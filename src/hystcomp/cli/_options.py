@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import math
 import sys
-from pathlib import Path
 
 import click
 
@@ -176,16 +175,10 @@ def warn_x_unit(x, source, given: dict) -> None:
 
 
 def check_plot(plot, *, inputs=(), output=None) -> None:
-    """Refuse, before any work, a figure of an unknown format, or one that would overwrite
-    an input or the command's other output."""
-    from hystcomp.experiment.fig_identification import FORMATS  # no matplotlib yet
-    from hystcomp.io.atomic import check_output_path
+    """Refuse, before any work, a figure the command cannot write (without matplotlib yet)."""
+    from hystcomp.experiment.fig_identification import check_figure_output
 
-    if Path(plot).suffix.lower() not in FORMATS:
-        raise click.BadParameter(f"must end in {', '.join(FORMATS)}.", param_hint="--plot")
-    check_output_path(plot, inputs=inputs, what="figure")
-    if output is not None and Path(plot).resolve() == Path(output).resolve():
-        raise click.BadParameter("names the same file as -o.", param_hint="--plot")
+    check_figure_output(plot, inputs=inputs, output=output)
 
 
 def wrote(paths) -> None:
