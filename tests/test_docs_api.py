@@ -36,12 +36,6 @@ NOT_IN_API = ("hystcomp.cli", "hystcomp.data")
 #: Modules left out of the docstring checks: the deprecated alias.
 NOT_CHECKED = ("hystcomp.data",)
 
-#: Modules whose docstrings are being rewritten with the application layer (the CLI's
-#: adapters and hystcomp.workflows): left out of the section checks until they comply.
-#: Remove an entry as soon as its module passes: test_modules_pending_still_need_the_exemption
-#: fails while an entry is no longer needed.
-SECTIONS_PENDING = ("hystcomp.cli",)
-
 #: A numpydoc section header: a title, then a line of dashes.
 SECTION = re.compile(r"^([A-Z][A-Za-z ]+)\n-{3,}[ \t]*$", re.MULTILINE)
 
@@ -216,29 +210,10 @@ def test_every_public_name_has_a_docstring():
     assert [path for path, obj in public_callables().items() if not inspect.getdoc(obj)] == []
 
 
-def _checked(path: str) -> bool:
-    return _outside(path, SECTIONS_PENDING)
-
-
 @pytest.mark.parametrize("section", ["Parameters", "Returns"])
 def test_every_public_callable_has_the_numpydoc_section(section):
-    lacking = [
-        path
-        for path, obj in public_callables().items()
-        if _checked(path) and section in missing_sections(obj)
-    ]
+    lacking = [path for path, obj in public_callables().items() if section in missing_sections(obj)]
     assert lacking == [], f"{len(lacking)} public callables lack a {section} section"
-
-
-def test_modules_pending_still_need_the_exemption():
-    # an exemption that is no longer needed hides nothing: drop it, so the module stays checked
-    needed = {
-        pending
-        for pending in SECTIONS_PENDING
-        for path, obj in public_callables().items()
-        if not _outside(path, (pending,)) and missing_sections(obj)
-    }
-    assert set(SECTIONS_PENDING) == needed
 
 
 def test_documented_parameters_are_the_signatures():
@@ -275,14 +250,12 @@ RATIO = re.compile(r"\b\d+(\.\d+)?x\b")
 def test_docstrings_hold_no_benchmark_ratios():
     # docstrings say what the code does; how well it does it is measured and kept in the docs
     found = [
-        path
-        for path, obj in public_callables().items()
-        if _checked(path) and RATIO.search(inspect.getdoc(obj) or "")
+        path for path, obj in public_callables().items() if RATIO.search(inspect.getdoc(obj) or "")
     ]
     found += [
         name
         for name in public_modules(NOT_CHECKED)
-        if _checked(name) and RATIO.search(importlib.import_module(name).__doc__ or "")
+        if RATIO.search(importlib.import_module(name).__doc__ or "")
     ]
     assert found == [], "move the figures to docs/benchmarks.md"
 

@@ -18,6 +18,7 @@ import re
 import signal
 import sys
 import tomllib
+from collections.abc import Callable
 from pathlib import Path
 
 import click
@@ -30,7 +31,7 @@ EXIT_BAD_INPUT, EXIT_INTERNAL = 2, 1
 EXIT_BROKEN_PIPE = 141  # 128 + SIGPIPE, as a shell reports a command killed by it
 
 
-def remove_pending() -> None:
+def _remove_pending() -> None:
     """Remove the temporary outputs of a failed write (none if no file module ran)."""
     atomic = sys.modules.get("hystcomp.io.atomic")  # not imported here if no file was written
     if atomic is not None:
@@ -61,35 +62,40 @@ _PARAMETER = re.compile(
 )
 
 
-def command(name: str):
-    """``main.command(name)``, with its help from words.toml."""
-    return main.command(name, help=TEXT[name]["help"])
+def command(name: str) -> Callable[[Callable], click.Command]:
+    """Register a function as the subcommand ``name`` of :data:`main`, worded by words.toml.
+
+    Parameters
+    ----------
+    name : str
+        The subcommand, whose table in words.toml holds its help and its options' (an
+        option that the table does not word has the help of ``[options]``).
+
+    Returns
+    -------
+    callable
+        The decorator: it takes the function, with its click options, and returns the command.
+    """
+    words = {**TEXT["options"], **TEXT[name]}
+
+    def register(function: Callable) -> click.Command:
+        for param in getattr(function, "__click_params__", ()):
+            flag = next((o[2:] for o in param.opts if o.startswith("--")), "")
+            if isinstance(param, click.Option) and param.help is None:
+                param.help = words.get(flag)
+        return main.command(name, help=TEXT[name]["help"])(function)
+
+    return register
 
 
-def option(command: str, *decls: str, **attrs):
-    """``click.option``, with its help from words.toml: the command's own, else the shared."""
-    flag = next(d for d in decls if d.startswith("--"))[2:]
-    return click.option(*decls, help=TEXT[command].get(flag, TEXT["options"].get(flag)), **attrs)
-
-
-def say(text) -> str:
-    """A library sentence (a :class:`~hystcomp._notice.Notice` or text) in the command's words."""
+def _say(text: str) -> str:
+    """A library sentence in the command line's words (words.toml's remedies), on one line."""
     return _one_line(worded(text, TEXT["remedies"]))
 
 
-def report(*results, lines: bool = True, warnings: bool = True) -> None:
-    """Print the workflow results' report lines, then their warnings on standard error."""
-    for line in (x for r in results if lines for x in getattr(r, "lines", ())):
-        click.echo(worded(line, TEXT["remedies"]))
-    for warning in (x for r in results if warnings for x in getattr(r, "warnings", ())):
-        click.echo(f"hystcomp: warning: {say(warning)}", err=True)
-
-
-def refuse(given: dict, why: str) -> None:
-    """Refuse, in the command's words, the first option given that ``why`` does not take."""
-    for option, value in given.items():
-        if value is not None and value is not False:
-            raise click.UsageError(f"{option} does not apply to {why}.")
+def _said(exc: BaseException) -> str:
+    """An error's message in the command line's words (a notice's remedies as options)."""
+    return _say(exc.args[0] if len(exc.args) == 1 else str(exc))
 
 
 class _Command(click.Command):
@@ -99,7 +105,7 @@ class _Command(click.Command):
         try:
             return super().invoke(ctx)
         except InvalidParameterError as exc:
-            found = _PARAMETER.fullmatch(say(exc.args[0] if len(exc.args) == 1 else exc))
+            found = _PARAMETER.fullmatch(_said(exc))
             if found is None:
                 raise
             name = OPTIONS.get(found["name"], "--" + found["name"].replace("_", "-"))
@@ -112,8 +118,8 @@ class _Command(click.Command):
 class _Group(click.Group):
     """A click group that turns bad usage and hystcomp's errors into one line and exit 2.
 
-    Its subcommands are imported lazily from :data:`COMMANDS`; each module registers its
-    command on :data:`main` when imported.
+    Its subcommands are imported lazily from :data:`COMMANDS`, when one runs; each module
+    registers its command on :data:`main` when imported. Until then, a stand-in lists it.
     """
 
     command_class = _Command
@@ -121,38 +127,15 @@ class _Group(click.Group):
     def list_commands(self, ctx):
         return sorted({*COMMANDS, *self.commands})
 
-    def get_command(self, ctx, cmd_name):
-        if cmd_name not in self.commands and cmd_name in COMMANDS:
-            importlib.import_module(COMMANDS[cmd_name][0])
-        return self.commands.get(cmd_name)
+    def get_command(self, ctx, cmd_name):  # not loaded yet: a stand-in with its help line
+        if cmd_name in self.commands or cmd_name not in COMMANDS:
+            return self.commands.get(cmd_name)
+        return click.Command(cmd_name, help=COMMANDS[cmd_name][1])
 
-    def _short_helps(self, limit: int) -> list[tuple[str, str]]:
-        """(name, short help) of every command, importing none that is not loaded yet."""
-        out = []
-        for name in self.list_commands(None):
-            command = self.commands.get(name)
-            if command is None:
-                stand_in = click.Command(name, help=COMMANDS[name][1])  # shortened as click does
-                out.append((name, stand_in.get_short_help_str(limit)))
-            elif not command.hidden:
-                out.append((name, command.get_short_help_str(limit)))
-        return out
-
-    def format_commands(self, ctx, formatter):
-        rows = self._short_helps(formatter.width - 6 - max(map(len, self.list_commands(ctx))))
-        if rows:
-            with formatter.section("Commands"):
-                formatter.write_dl(rows)
-
-    def shell_complete(self, ctx, incomplete):
-        from click.shell_completion import CompletionItem
-
-        items = [
-            CompletionItem(name, help=text)
-            for name, text in self._short_helps(45)
-            if name.startswith(incomplete)
-        ]
-        return items + click.Command.shell_complete(self, ctx, incomplete)
+    def resolve_command(self, ctx, args):  # the command to run (or complete): loaded now
+        if args and args[0] in COMMANDS:
+            importlib.import_module(COMMANDS[args[0]][0])
+        return super().resolve_command(ctx, args)
 
     def main(self, args=None, prog_name=None, complete_var=None, standalone_mode=True, **extra):
         try:
@@ -170,15 +153,19 @@ class _Group(click.Group):
 
 def _failure(exc: BaseException) -> tuple[int, str | None]:
     """The exit status of a command that raised ``exc``, and the line that says why."""
+    if isinstance(exc, click.exceptions.Abort) and isinstance(exc.__cause__, KeyboardInterrupt):
+        exc = exc.__cause__  # Ctrl-C at a prompt of click's
+    if isinstance(exc, KeyboardInterrupt):
+        exc = _signals.Interrupted(signal.SIGINT)
     if isinstance(exc, _signals.Interrupted):  # its temporaries are removed by then
         return _signals.finish(exc), None
-    abort = isinstance(exc, click.exceptions.Abort)
-    if isinstance(exc, KeyboardInterrupt) or (
-        abort and isinstance(exc.__cause__, KeyboardInterrupt)
-    ):
-        return _signals.finish(_signals.Interrupted(signal.SIGINT)), None  # Ctrl-C, or click's
-    if abort:
-        remove_pending()
+    if isinstance(exc, BrokenPipeError):  # the reader of standard output went away (| head)
+        with contextlib.suppress(OSError, ValueError):  # no flush error at exit either
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return EXIT_BROKEN_PIPE, None
+    if isinstance(exc, click.exceptions.Abort | OSError):
+        _remove_pending()
+    if isinstance(exc, click.exceptions.Abort):
         return EXIT_INTERNAL, "hystcomp: aborted"
     if isinstance(exc, click.UsageError):
         hint = f" (see '{exc.ctx.command_path} --help')" if exc.ctx is not None else ""
@@ -186,24 +173,16 @@ def _failure(exc: BaseException) -> tuple[int, str | None]:
     if isinstance(exc, click.ClickException):
         return exc.exit_code, f"hystcomp: error: {_one_line(exc.format_message())}"
     if isinstance(exc, HystcompError):
-        return EXIT_BAD_INPUT, f"hystcomp: error: {say(exc.args[0] if len(exc.args) == 1 else exc)}"
+        return EXIT_BAD_INPUT, f"hystcomp: error: {_said(exc)}"
     if isinstance(exc, MemoryError):
         return EXIT_BAD_INPUT, (
             "hystcomp: error: not enough memory for this input; use a shorter record, fewer "
             "operators or a lower sample rate."
         )
-    if isinstance(exc, BrokenPipeError):  # the reader of standard output went away (| head)
-        with contextlib.suppress(OSError, ValueError):  # no flush error at exit either
-            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
-        return EXIT_BROKEN_PIPE, None
     if isinstance(exc, OSError):  # the system refused a path or a write: bad input, no fault
-        remove_pending()
-        where = f" {os.fsdecode(exc.filename)[:120]!r}" if exc.filename else ""
-        return EXIT_BAD_INPUT, (
-            f"hystcomp: error: cannot use{where}: {exc.strerror or exc}. Check the path (the "
-            "length of its names, that its folders exist and are folders), its permissions "
-            "and the free space."
-        )
+        from hystcomp.io.atomic import refusal
+
+        return EXIT_BAD_INPUT, f"hystcomp: error: {refusal(exc)}"
     return EXIT_INTERNAL, (  # an internal fault: say so, briefly
         f"hystcomp: internal error: {type(exc).__name__}: {_one_line(exc)} (please report it "
         "with the command you ran)"

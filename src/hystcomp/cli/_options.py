@@ -1,5 +1,5 @@
-"""Options shared by several subcommands, the checks every option value goes through, and the
-steps every command shares: read a file, show progress, write the outputs.
+"""What the commands share: the checks on option values, the shared options, reading a file,
+progress, and writing the outputs.
 
 Every value is checked when click parses it (a callback), so that a bad option is refused
 before any file is read or any work is done, with one line naming the option and the fix.
@@ -11,14 +11,14 @@ from __future__ import annotations
 
 import math
 import sys
-from pathlib import Path
 
 import click
 
 from hystcomp._hyperparameters import MAX_OPERATORS
+from hystcomp._notice import worded
 from hystcomp._progress import Progress
 from hystcomp._validation import MAX_MAGNITUDE
-from hystcomp.cli import TEXT
+from hystcomp.cli import TEXT, _say
 from hystcomp.errors import InvalidParameterError, OutputPathError
 from hystcomp.io.records import X_UNITS, format_csv  # light: no compiled code until used
 
@@ -32,74 +32,57 @@ def _finite(value: float, param) -> float:
     return value
 
 
-def positive(unit: str, strict: bool = True):
-    """A callback: the value, if given, must be a finite number > 0 (>= 0 unless ``strict``)
-    in ``unit``."""
+def check(test, words: str):
+    """A callback: a value given must pass ``test(value, param)``, else ``words`` (formatted
+    with it as ``v``) say what it must be."""
 
-    def check(ctx, param, value):
-        if value is not None and not (_finite(value, param) > 0 or (not strict and value == 0)):
-            sign = ">" if strict else ">="
-            raise click.BadParameter(
-                f"must be a number {sign} 0 ({unit}); got {value!r}.", param=param
-            )
+    def callback(ctx, param, value):
+        if value is not None and not test(value, param):
+            raise click.BadParameter(words.format(v=value), param=param)
         return value
 
-    return check
+    return callback
 
 
-def fraction(ctx, param, value):
-    """A callback: the value, if given, must lie strictly between 0 and 1."""
-    if value is not None and not 0.0 < value < 1.0:
-        raise click.BadParameter(
-            f"must be between 0 and 1 (exclusive); got {value!r}.", param=param
-        )
-    return value
+def positive(unit: str, strict: bool = True):
+    """A callback: a finite number > 0 (>= 0 unless ``strict``) in ``unit``."""
+    return check(
+        lambda v, param: _finite(v, param) > 0 or (not strict and v == 0),
+        f"must be a number {'>' if strict else '>='} 0 ({unit}); got {{v!r}}.",
+    )
 
 
-def count(ctx, param, value):
-    """A callback: an operator count between 1 and ``MAX_OPERATORS``."""
-    if value is not None and not 1 <= value <= MAX_OPERATORS:
-        raise click.BadParameter(
-            f"must be between 1 and {MAX_OPERATORS} (the paper uses 16; the fit grows as the "
-            f"cube of the count); got {value}.",
-            param=param,
-        )
-    return value
+fraction = check(lambda v, _: 0.0 < v < 1.0, "must be between 0 and 1 (exclusive); got {v!r}.")
+count = check(
+    lambda v, _: 1 <= v <= MAX_OPERATORS,
+    f"must be between 1 and {MAX_OPERATORS} (the paper uses 16; the fit grows as the cube of "
+    "the count); got {v}.",
+)
+voltage_range = check(  # LO HI in V
+    lambda v, param: _finite(v[0], param) < _finite(v[1], param),
+    "must be LO HI with LO < HI (V); got {v[0]:g} {v[1]:g}.",
+)
 
 
-def voltage_range(ctx, param, value):
-    """A callback: ``LO HI`` in V, finite, with ``LO < HI``."""
-    if value is None:
-        return None
-    lo, hi = (_finite(v, param) for v in value)
-    if not lo < hi:
-        raise click.BadParameter(f"must be LO HI with LO < HI (V); got {lo:g} {hi:g}.", param=param)
-    return (lo, hi)
+class Alias(click.Option):
+    """An option with a second name (the Python face's): its errors name only the first."""
+
+    def get_error_hint(self, ctx) -> str:
+        return f"'{self.opts[0]}'"
 
 
-def columns(ctx, param, value):
+def _columns(ctx, param, value):
     """A callback: a column mapping such as ``v=1,x=5``, or ``v1=2,...`` of an N-axis file."""
-    from hystcomp.io.multiaxis import parse_axis_columns
-    from hystcomp.io.records import parse_columns
+    from hystcomp.io.multiaxis import parse_any_columns
 
     try:
-        return parse_columns(value)
+        return parse_any_columns(value)
     except InvalidParameterError as exc:
-        try:
-            if value is None or not any(c.isdigit() for c in value.split("=")[0]):
-                raise exc from None
-            return parse_axis_columns(value)
-        except InvalidParameterError as error:
-            raise click.BadParameter(str(error), param=param) from None
-
-
-def _shared(*decls: str, **attrs):
-    flag = next(d for d in decls if d.startswith("--"))[2:]
-    return click.option(*decls, help=TEXT["options"][flag], **attrs)
+        raise click.BadParameter(str(exc), param=param) from None
 
 
 #: ``--voltage-range LO HI`` of compensate and export-c: a clamp inside the model's range.
-narrow_range = _shared(
+narrow_range = click.option(
     "--voltage-range", "narrow_range", nargs=2, type=float, metavar="LO HI", callback=voltage_range
 )
 
@@ -108,21 +91,32 @@ def method_option(f):
     """``--method``: the Preisach inverse's method (its choices from the Preisach model)."""
     from hystcomp.models.preisach import INVERSE_METHODS
 
-    return _shared("--method", type=click.Choice(INVERSE_METHODS))(f)
+    return click.option("--method", type=click.Choice(INVERSE_METHODS))(f)
+
+
+quiet = click.option("--quiet", "-q", is_flag=True)
 
 
 def reading(f):
     """The options of a command that reads a data file: --columns, --fs, --x-unit, --quiet."""
-    for decorate in reversed(
-        [
-            _shared("--columns", metavar="SPEC", callback=columns),
-            _shared("--fs", "sample_rate", type=float, metavar="HZ", callback=positive("Hz")),
-            _shared("--x-unit", type=click.Choice(X_UNITS)),
-            _shared("--quiet", "-q", is_flag=True),
-        ]
-    ):
-        f = decorate(f)
-    return f
+    f = click.option("--x-unit", type=click.Choice(X_UNITS))(quiet(f))
+    f = click.option("--fs", "sample_rate", type=float, metavar="HZ", callback=positive("Hz"))(f)
+    return click.option("--columns", metavar="SPEC", callback=_columns)(f)
+
+
+def report(*results, lines: bool = True, warnings: bool = True) -> None:
+    """Print the workflow results' report lines, then their warnings on standard error."""
+    for line in (x for r in results if lines for x in getattr(r, "lines", ())):
+        click.echo(worded(line, TEXT["remedies"]))
+    for warning in (x for r in results if warnings for x in getattr(r, "warnings", ())):
+        click.echo(f"hystcomp: warning: {_say(warning)}", err=True)
+
+
+def refuse(given: dict, why: str) -> None:
+    """Refuse, in the command's words, the first option given that ``why`` does not take."""
+    for option, value in given.items():
+        if value is not None and value is not False:
+            raise click.UsageError(f"{option} does not apply to {why}.")
 
 
 def read_options(given: dict, path="", *, reads: tuple[str, ...] | None = ("v", "x")) -> dict:
@@ -151,6 +145,21 @@ def read_options(given: dict, path="", *, reads: tuple[str, ...] | None = ("v", 
     return options
 
 
+def read_input(path, keys: tuple[str, ...], given: dict, *, multi: bool, optional=()) -> dict:
+    """The columns t and ``keys`` (one per axis if ``multi``) of the file at ``path``, read
+    with the shared options, and ``optional`` ones that it has (one axis)."""
+    from hystcomp.io.multiaxis import read_axes
+    from hystcomp.io.records import read_table
+
+    options = read_options(given, path, reads=None if multi else (*keys, *optional))
+    if multi:
+        return read_axes(path, keys, **options)
+    table = read_table(path, keys, optional=optional, **options)
+    if "x" in table:  # a displacement, in µm like the model
+        warn_x_unit(table["x"], path, given)
+    return table
+
+
 def progress(label: str, quiet: bool):
     """A progress line for a step (see :mod:`hystcomp._progress`); silent with --quiet."""
     return Progress(label, enabled=False if quiet else None)
@@ -165,49 +174,27 @@ def warn_x_unit(x, source, given: dict) -> None:
         click.echo(f"hystcomp: warning: {message}", err=True)
 
 
-def check_data_output(path, *, inputs=(), what: str = "output"):
-    """Refuse, before any work, a data output that cannot be written or would overwrite an input."""
-    from hystcomp.io.atomic import check_output_path
-    from hystcomp.io.records import check_writable
-
-    check_output_path(path, inputs=inputs, what=what)
-    return check_writable(path)
-
-
 def check_plot(plot, *, inputs=(), output=None) -> None:
-    """Refuse, before any work, a figure of an unknown format, or one that would overwrite
-    an input or the command's other output."""
-    from hystcomp.experiment.fig_identification import FORMATS  # no matplotlib yet
-    from hystcomp.io.atomic import check_output_path
+    """Refuse, before any work, a figure the command cannot write (without matplotlib yet)."""
+    from hystcomp.experiment.fig_identification import check_figure_output
 
-    if Path(plot).suffix.lower() not in FORMATS:
-        raise click.BadParameter(f"must end in {', '.join(FORMATS)}.", param_hint="--plot")
-    check_output_path(plot, inputs=inputs, what="figure")
-    if output is not None and Path(plot).resolve() == Path(output).resolve():
-        raise click.BadParameter("names the same file as -o.", param_hint="--plot")
+    check_figure_output(plot, inputs=inputs, output=output)
 
 
-def write_files(writers: dict, *, reverse: bool = False) -> None:
-    """Write every output at once (a failure writes none of them), then say so.
-
-    ``writers`` maps each path to a function that writes a temporary file given to it.
-    """
-    from hystcomp.io.atomic import atomic_paths
-
-    with atomic_paths(*writers) as temporaries:
-        for write, tmp in zip(writers.values(), temporaries, strict=True):
-            write(tmp)
-    for path in list(writers)[:: -1 if reverse else 1]:
+def wrote(paths) -> None:
+    """Say that each of ``paths`` was written."""
+    for path in paths:
         click.echo(f"  wrote {path}")
 
 
 def write_model(model, output, plot=None, draw=None) -> None:
     """Write ``model`` to ``output`` and, with ``plot``, the figure ``draw(path)`` makes."""
+    from hystcomp.io.atomic import write_all
     from hystcomp.io.models import model_text
 
     text = model_text(model)
     writers = {output: lambda tmp: tmp.write_text(text, encoding="utf-8")}
-    write_files(writers if plot is None else {**writers, plot: draw}, reverse=True)
+    wrote(write_all(writers if plot is None else {**writers, plot: draw})[::-1])
 
 
 def write_signal(table: dict, output, quiet: bool, summary: str) -> None:

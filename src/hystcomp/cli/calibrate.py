@@ -4,11 +4,11 @@ from __future__ import annotations
 
 import click
 
-from hystcomp.cli import command, option
+from hystcomp.cli import command
 
 
 @command("calibrate")
-@option("calibrate", "--refit", is_flag=True)
+@click.option("--refit", is_flag=True)
 def calibrate(refit: bool) -> None:
     """``hystcomp calibrate``: the report of :mod:`hystcomp.experiment.calibration`."""
     from hystcomp.experiment.calibration import calibration_report, fit_twin_hysteresis

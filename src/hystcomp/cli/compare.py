@@ -1,7 +1,5 @@
-"""``hystcomp compare``: the paper's experiment (Section V) on the simulated axis.
-
-The work is :func:`hystcomp.workflows.compare.compare_on_twin`.
-"""
+"""``hystcomp compare``: the paper's experiment (Section V) on the simulated axis
+(:func:`hystcomp.workflows.compare.compare_on_twin`)."""
 
 from __future__ import annotations
 
@@ -10,15 +8,15 @@ from typing import Any
 
 import click
 
-from hystcomp.cli import command, option
+from hystcomp.cli import command
 
 
 @command("compare")
-@option("compare", "--out", "out_dir", default="compare-out", show_default=True, type=click.Path())
-@option("compare", "--seed", default=0, show_default=True, type=click.IntRange(min=0))
-@option("compare", "--periods", type=click.IntRange(min=2))
-@option("compare", "--quick", is_flag=True)
-@option("compare", "--quiet", "-q", is_flag=True)
+@click.option("--out", "out_dir", default="compare-out", show_default=True, type=click.Path())
+@click.option("--seed", default=0, show_default=True, type=click.IntRange(min=0))
+@click.option("--periods", type=click.IntRange(min=2))
+@click.option("--quick", is_flag=True)
+@click.option("--quiet", "-q", is_flag=True)
 def compare(out_dir: str, seed: int, periods: int | None, quick: bool, quiet: bool) -> None:
     """``hystcomp compare``: parse, run the experiment (:mod:`hystcomp.workflows`), print."""
     from hystcomp.experiment.compare import CompareConfig

@@ -1,53 +1,39 @@
-"""``hystcomp compensate``: the feedforward voltage for a reference displacement.
-
-The work is :func:`hystcomp.workflows.compensate.compensate_reference`; this module parses
-the options, reads the reference, prints the warnings and writes the voltage.
-"""
+"""``hystcomp compensate``: the feedforward voltage for a reference displacement
+(:func:`hystcomp.workflows.compensate.compensate_reference`)."""
 
 from __future__ import annotations
-
-import functools
 
 import click
 
 from hystcomp.cli import _options as opts
-from hystcomp.cli import command, report
-from hystcomp.cli import option as cli_option
-from hystcomp.io.models import load_model
-from hystcomp.io.multiaxis import axis_table, read_axes
-from hystcomp.io.records import read_table, write_table
+from hystcomp.cli import command
+from hystcomp.io.multiaxis import axis_table
+from hystcomp.io.records import check_data_output, write_table
 from hystcomp.models.multiaxis import MultiAxisModel
 from hystcomp.workflows.compensate import (
     compensate_reference,
-    load_dynamics,
-    refuse_dynamics_as_model,
+    load_compensation,
+    voltage_summary,
 )
-
-option = functools.partial(cli_option, "compensate")
 
 
 @command("compensate")
 @click.argument("model_file", metavar="MODEL.json")
 @click.argument("reference_file", metavar="REFERENCE")
-@option("-o", "--output", required=True, metavar="FILE")
+@click.option("-o", "--output", required=True, metavar="FILE")
 @opts.reading
-@option("--slew-rate", type=float, metavar="V/S", callback=opts.positive("V/s"))
+@click.option("--slew-rate", type=float, metavar="V/S", callback=opts.positive("V/s"))
 @opts.narrow_range
 @opts.method_option
-@option("--dynamics", "dynamics_file", metavar="DYN.json")
-@option("--strict", is_flag=True)
+@click.option("--dynamics", "dynamics_file", metavar="DYN.json")
+@click.option("--strict", is_flag=True)
 def compensate(model_file, reference_file, output, dynamics_file, **o):
     """``hystcomp compensate``: parse, compensate (:mod:`hystcomp.workflows`), print, write."""
     inputs = (model_file, reference_file) + ((dynamics_file,) if dynamics_file else ())
-    opts.check_data_output(output, inputs=inputs, what="voltage file")
-    model = load_model(model_file)
-    refuse_dynamics_as_model(model, model_file)
+    check_data_output(output, inputs=inputs, what="voltage file")
+    model, dynamics = load_compensation(model_file, dynamics_file)
     multi = isinstance(model, MultiAxisModel)  # t, x1..xN -> t, v1..vN, x1_ref..xN_ref
-    dynamics = None if dynamics_file is None else load_dynamics(dynamics_file)
-    options = opts.read_options(o, reference_file, reads=None if multi else ("x",))
-    table = (read_axes if multi else read_table)(reference_file, ("x",), **options)
-    if not multi:
-        opts.warn_x_unit(table["x"], reference_file, o)
+    table = opts.read_input(reference_file, ("x",), o, multi=multi)
     result = compensate_reference(
         model,
         table["t"],
@@ -61,20 +47,10 @@ def compensate(model_file, reference_file, output, dynamics_file, **o):
         strict=o["strict"],
         progress=opts.progress("computing the voltage" + "s" * multi, o["quiet"]).ticking(),
     )
-    report(result)
-    v, x = result.v, table["x"]
-    if multi:
-        ranges = ", ".join(f"v{i + 1} {c.min():.4g} .. {c.max():.4g} V" for i, c in enumerate(v.T))
-        summary = f"{len(v)} samples of {v.shape[1]} axes ({ranges}; {sum(result.clamped)} clamped)"
-    else:
-        lo, hi = result.compensator.voltage_range
-        summary = (
-            f"{v.size} samples, v from {v.min():.4g} to {v.max():.4g} V (range {lo:.4g} .. "
-            f"{hi:.4g} V, {result.clamped} clamped)"
-        )
+    opts.report(result)
     written = opts.progress(f"writing {output}", o["quiet"])
-    write_table(output, axis_table(table["t"], v=v, x_ref=x), progress=written)
-    click.echo(f"wrote {output}: {summary}")
+    write_table(output, axis_table(table["t"], v=result.v, x_ref=table["x"]), progress=written)
+    click.echo(f"wrote {output}: {voltage_summary(result)}")
     if result.preview is not None:
         click.echo(
             f"  with the inverse of the dynamics of {dynamics_file or model_file}: "

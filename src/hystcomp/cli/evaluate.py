@@ -1,7 +1,5 @@
-"""``hystcomp evaluate``: how a measured run tracked its reference.
-
-The work is :func:`hystcomp.workflows.evaluate.evaluate`, whose result words itself.
-"""
+"""``hystcomp evaluate``: how a measured run tracked its reference
+(:func:`hystcomp.workflows.evaluate.evaluate`, whose result words itself)."""
 
 from __future__ import annotations
 
@@ -10,17 +8,15 @@ import json
 import click
 
 from hystcomp.cli import _options as opts
-from hystcomp.cli import command, option, report
+from hystcomp.cli import command
 
 
 @command("evaluate")
 @click.argument("reference", metavar="REFERENCE")
 @click.argument("measured", metavar="MEASURED")
-@option("evaluate", "--json", "as_json", is_flag=True)
-@option("evaluate", "--plot", metavar="FILE")
-@option(
-    "evaluate", "--skip", type=float, default=0.0, metavar="S", callback=opts.positive("s", False)
-)
+@click.option("--json", "as_json", is_flag=True)
+@click.option("--plot", metavar="FILE")
+@click.option("--skip", type=float, default=0.0, metavar="S", callback=opts.positive("s", False))
 @opts.reading
 def evaluate(reference, measured, as_json, plot, skip, **o):
     """``hystcomp evaluate``: parse, evaluate (:mod:`hystcomp.workflows`), print."""
@@ -31,7 +27,7 @@ def evaluate(reference, measured, as_json, plot, skip, **o):
     reading = opts.read_options(o, measured, reads=("v", "x"))
     result = run_evaluation(reference, measured, skip=skip, **reading)
     opts.warn_x_unit(result.x, measured, o)
-    report(result, lines=False)
+    opts.report(result, lines=False)
     if plot is not None:
         from hystcomp.experiment.fig_evaluate import plot_evaluation
 
@@ -39,6 +35,6 @@ def evaluate(reference, measured, as_json, plot, skip, **o):
     if as_json:
         out = result.to_dict()
         return click.echo(json.dumps(out if plot is None else {**out, "plot": str(plot)}))
-    report(result, warnings=False)
+    opts.report(result, warnings=False)
     if plot is not None:
         click.echo(f"  wrote {plot}")

@@ -2,33 +2,23 @@
 
 from __future__ import annotations
 
-import functools
-
 import click
 
 from hystcomp import paper
 from hystcomp.cli import _options as opts
 from hystcomp.cli import command
-from hystcomp.cli import option as cli_option
 from hystcomp.identify.excitation import DEFAULT_SAMPLE_RATE, SIGNAL_KINDS, excitation_signal
 from hystcomp.io.multiaxis import axis_table
+from hystcomp.io.records import check_data_output
 
-option = functools.partial(cli_option, "excite")
+HZ = {"type": float, "show_default": True, "metavar": "HZ", "callback": opts.positive("Hz")}
 
 
 @command("excite")
 @click.argument("model", type=click.Choice((*SIGNAL_KINDS, "multiaxis")))
-@option("-o", "--output", metavar="FILE")
-@option(
-    "--fs",
-    "sample_rate",
-    type=float,
-    default=DEFAULT_SAMPLE_RATE,
-    show_default=True,
-    metavar="HZ",
-    callback=opts.positive("Hz"),
-)
-@option(
+@click.option("-o", "--output", metavar="FILE")
+@click.option("--fs", "sample_rate", default=DEFAULT_SAMPLE_RATE, **HZ)
+@click.option(
     "--voltage-range",
     nargs=2,
     type=float,
@@ -37,16 +27,9 @@ option = functools.partial(cli_option, "excite")
     metavar="LO HI",
     callback=opts.voltage_range,
 )
-@option(
-    "--frequency",
-    type=float,
-    default=1.0,
-    show_default=True,
-    metavar="HZ",
-    callback=opts.positive("Hz"),
-)
-@option("--axes", type=click.IntRange(1, 16))
-@opts._shared("--quiet", "-q", is_flag=True)
+@click.option("--frequency", default=1.0, **HZ)
+@click.option("--axes", type=click.IntRange(1, 16))
+@opts.quiet
 def excite(model, output, axes, quiet, **signal):
     """``hystcomp excite``: parse, make the signal, write it (or print it as CSV)."""
     if (model == "multiaxis") != (axes is not None):
@@ -54,7 +37,7 @@ def excite(model, output, axes, quiet, **signal):
             "--axes N goes with 'excite multiaxis' (and only with it): give both or neither."
         )
     if output is not None:
-        opts.check_data_output(output, what="signal file")
+        check_data_output(output, what="signal file")
     if model == "multiaxis":
         from hystcomp.identify.multiaxis_excitation import multiaxis_sequence
 

@@ -1,37 +1,26 @@
-"""``hystcomp export-c``: a model file's compensator as C99 code for an embedded controller.
-
-The work is :func:`hystcomp.workflows.compensate.export_compensator`.
-"""
+"""``hystcomp export-c``: a model file's compensator as C99 code for an embedded controller
+(:func:`hystcomp.workflows.compensate.export_compensator`)."""
 
 from __future__ import annotations
 
-import functools
 from pathlib import Path
 
 import click
 
 from hystcomp import paper
 from hystcomp.cli import _options as opts
-from hystcomp.cli import command, report
-from hystcomp.cli import option as cli_option
+from hystcomp.cli import command
 from hystcomp.codegen import DEFAULT_PREFIX, check_prefix
 from hystcomp.io.atomic import check_output_path
-from hystcomp.io.models import load_model
-from hystcomp.workflows.compensate import (
-    export_compensator,
-    load_dynamics,
-    refuse_dynamics_as_model,
-)
-
-option = functools.partial(cli_option, "export-c")
+from hystcomp.workflows.compensate import export_compensator, load_compensation
 
 
 @command("export-c")
 @click.argument("model_file", type=click.Path(path_type=Path))
-@option("-o", "--output", "directory", required=True, type=click.Path(path_type=Path))
-@option("--prefix", default=DEFAULT_PREFIX, show_default=True)
-@option("--slew-rate", type=float, metavar="V_PER_S", callback=opts.positive("V/s"))
-@option(
+@click.option("-o", "--output", "directory", required=True, type=click.Path(path_type=Path))
+@click.option("--prefix", default=DEFAULT_PREFIX, show_default=True)
+@click.option("--slew-rate", type=float, metavar="V_PER_S", callback=opts.positive("V/s"))
+@click.option(
     "--fs",
     "sample_rate",
     type=float,
@@ -42,14 +31,13 @@ option = functools.partial(cli_option, "export-c")
 )
 @opts.narrow_range
 @opts.method_option
-@option("--dynamics", "dynamics_file", metavar="DYN.json")
+@click.option("--dynamics", "dynamics_file", metavar="DYN.json")
 def export_c_command(model_file, directory, prefix, dynamics_file, **o):
     """``hystcomp export-c``: parse, export (:mod:`hystcomp.workflows`), print."""
     check_prefix(prefix)
     for suffix in (".h", ".c") if directory.is_dir() else ():  # never overwrite the model
         check_output_path(directory / f"{prefix}{suffix}", inputs=(model_file,))
-    model = load_model(model_file)
-    refuse_dynamics_as_model(model, model_file)
+    model, dynamics = load_compensation(model_file, dynamics_file)
     result = export_compensator(
         model,
         directory,
@@ -59,9 +47,9 @@ def export_c_command(model_file, directory, prefix, dynamics_file, **o):
         slew_rate=o["slew_rate"],
         voltage_range=o["narrow_range"],
         method=o["method"],
-        dynamics=None if dynamics_file is None else load_dynamics(dynamics_file),
+        dynamics=dynamics,
         inputs=(model_file,),
     )
-    report(result)
+    opts.report(result)
     paths = [str(p) for p in result.paths]
     click.echo(f"wrote {' and '.join(paths) if len(paths) == 2 else ', '.join(paths)}")

@@ -1,56 +1,33 @@
-"""``hystcomp raster``: an AFM raster on the simulated scanner, three ways.
-
-The work is :func:`hystcomp.experiment.raster.raster_experiment`.
-"""
+"""``hystcomp raster``: an AFM raster on the simulated scanner, three ways
+(:mod:`hystcomp.experiment.raster`)."""
 
 from __future__ import annotations
-
-import functools
-from pathlib import Path
 
 import click
 
 from hystcomp.cli import _options as opts
 from hystcomp.cli import command
-from hystcomp.cli import option as cli_option
 
-option = functools.partial(cli_option, "raster")
+FAMILIES = click.Choice(["auto", "pi", "mpi", "preisach"])
 
 
 @command("raster")
-@option("--axes", "n_axes", type=click.IntRange(2, 3), default=2, show_default=True)
-@option(
-    "--model",
-    "family",
-    type=click.Choice(["auto", "pi", "mpi", "preisach"]),
-    default="auto",
-    show_default=True,
-)
-@option("--lines", type=click.IntRange(4, 1024), default=64, show_default=True)
-@option("--out", "out_dir", metavar="DIR")
-@option("--jobs", "n_jobs", type=int)
-@opts._shared("--quiet", "-q", is_flag=True)
+@click.option("--axes", "n_axes", type=click.IntRange(2, 3), default=2, show_default=True)
+@click.option("--model", "family", type=FAMILIES, default="auto", show_default=True)
+@click.option("--lines", type=click.IntRange(4, 1024), default=64, show_default=True)
+@click.option("--out", "out_dir", metavar="DIR")
+@click.option("--jobs", "n_jobs", type=int)
+@opts.quiet
 def raster(out_dir, quiet, **experiment):
     """``hystcomp raster``: parse, run the experiment, print, write."""
-    from hystcomp.experiment.raster import plot_raster, raster_experiment
-    from hystcomp.io.atomic import check_output_path
+    from hystcomp.experiment.raster import check_raster_folder, raster_experiment, write_raster
 
-    folder = Path(out_dir or ".")
-    if out_dir is not None and folder.exists() and not folder.is_dir():
-        raise click.BadParameter("exists and is not a folder.", param_hint="--out")
-    if out_dir is not None and not folder.parent.is_dir():
-        raise click.BadParameter("has no existing parent folder.", param_hint="--out")
-    for path in (
-        (folder / "raster.csv", folder / "raster.png") if out_dir and folder.is_dir() else ()
-    ):
-        check_output_path(path)
+    if out_dir is not None:
+        check_raster_folder(out_dir)
     label = f"identifying the {experiment['n_axes']}-axis scanner and scanning"
     with opts.progress(label, quiet).ticking():
         result = raster_experiment(**experiment)
     for line in result.table():
         click.echo(line)
     if out_dir is not None:
-        folder.mkdir(exist_ok=True)
-        text = result.csv_text()
-        writers = {folder / "raster.csv": lambda tmp: tmp.write_text(text, encoding="utf-8")}
-        opts.write_files({**writers, folder / "raster.png": lambda tmp: plot_raster(result, tmp)})
+        opts.wrote(write_raster(result, out_dir))

@@ -255,3 +255,60 @@ def plot_identification_result(record, result, path) -> None:
         t=record.t[kept],
         fit_end=result.n_fit - result.start if result.n_fit < len(record) else None,
     )
+
+
+def plot_identified(record, found, path) -> None:
+    """The figure of ``hystcomp identify --plot`` for what
+    :func:`~hystcomp.workflows.record.identify_model` found: the hysteresis model's
+    (:func:`plot_identification_result`), or the Bode plot of linear dynamics alone
+    (:func:`~hystcomp.experiment.fig_dynamics.plot_bode`).
+
+    Parameters
+    ----------
+    record : Record
+        The record identified.
+    found : ModelResult
+        What the identification found.
+    path : str or pathlib.Path
+        The figure's file.
+    """
+    if found.hysteresis is None:
+        from hystcomp.experiment.fig_dynamics import plot_bode
+
+        return plot_bode(found.model, path)
+    plot_identification_result(record, found.hysteresis, path)
+
+
+def check_figure_output(plot, *, inputs=(), output=None) -> Path:
+    """Refuse, before any work, a figure of an unknown format (:data:`FORMATS`), one that
+    would overwrite an input, or one at the path of the command's other output.
+
+    Parameters
+    ----------
+    plot : str or os.PathLike
+        The figure's file.
+    inputs : sequence of str or os.PathLike
+        Files the same command reads (:func:`hystcomp.io.atomic.check_output_path`).
+    output : str or os.PathLike, optional
+        The command's other output, written beside the figure.
+
+    Returns
+    -------
+    pathlib.Path
+        ``plot``, checked.
+    """
+    from hystcomp.io.atomic import check_output_path
+
+    path = Path(os.fspath(plot))
+    if path.suffix.lower() not in FORMATS:
+        raise InvalidParameterError(
+            f"The 'plot' argument of check_figure_output must end in {', '.join(FORMATS)}; "
+            f"got {str(path)!r}."
+        )
+    check_output_path(path, inputs=inputs, what="figure")
+    if output is not None and path.resolve() == Path(output).resolve():
+        raise InvalidParameterError(
+            f"The 'plot' argument of check_figure_output must not be the other output, "
+            f"{str(output)!r}; name another file."
+        )
+    return path

@@ -34,7 +34,15 @@ from hystcomp.identify.multiaxis_excitation import multiaxis_sequence
 from hystcomp.models.multiaxis import MultiAxisModel
 from hystcomp.plant.scanner import Scanner, raster_scanner
 
-__all__ = ["METHODS", "RasterResult", "plot_raster", "raster_experiment", "raster_reference"]
+__all__ = [
+    "METHODS",
+    "RasterResult",
+    "check_raster_folder",
+    "plot_raster",
+    "raster_experiment",
+    "raster_reference",
+    "write_raster",
+]
 
 #: The three ways to drive the raster, in the table's order.
 METHODS = ("uncompensated", "per-axis", "coupled")
@@ -317,3 +325,70 @@ def plot_raster(result: RasterResult, path: str | Path) -> None:
         fontsize=10,
     )
     save_figure(fig, path, dpi=110)
+
+
+def check_raster_folder(out_dir: str | Path) -> tuple[Path, Path]:
+    """The table and the image :func:`write_raster` writes into ``out_dir``, checked before
+    the run.
+
+    Parameters
+    ----------
+    out_dir : str or pathlib.Path
+        A folder, or a new one in an existing folder (made by :func:`write_raster`).
+
+    Returns
+    -------
+    (pathlib.Path, pathlib.Path)
+        ``raster.csv`` and ``raster.png`` in the folder.
+
+    Raises
+    ------
+    InvalidParameterError
+        ``out_dir`` is a file, or its parent folder does not exist.
+    OutputPathError
+        A file of the two exists and cannot be replaced
+        (:func:`hystcomp.io.atomic.check_output_path`).
+    """
+    from hystcomp.errors import InvalidParameterError
+    from hystcomp.io.atomic import check_output_path
+
+    folder = Path(out_dir)
+    if folder.exists() and not folder.is_dir():
+        raise InvalidParameterError(
+            f"The 'out_dir' argument of check_raster_folder must be a folder or a new name; "
+            f"{str(folder)!r} is a file."
+        )
+    if not folder.parent.is_dir():
+        raise InvalidParameterError(
+            f"The 'out_dir' argument of check_raster_folder must be in an existing folder; "
+            f"{str(folder.parent)!r} does not exist."
+        )
+    files = (folder / "raster.csv", folder / "raster.png")
+    for path in files if folder.is_dir() else ():
+        check_output_path(path)
+    return files
+
+
+def write_raster(result: RasterResult, out_dir: str | Path) -> list[Path]:
+    """Write the table (``raster.csv``) and the image (``raster.png``) into ``out_dir``,
+    both or neither.
+
+    Parameters
+    ----------
+    result : RasterResult
+        The raster run.
+    out_dir : str or pathlib.Path
+        The folder, made if it is missing (:func:`check_raster_folder`).
+
+    Returns
+    -------
+    list of pathlib.Path
+        The files written.
+    """
+    from hystcomp.io.atomic import write_all
+
+    table, image = check_raster_folder(out_dir)
+    table.parent.mkdir(exist_ok=True)
+    text = result.csv_text()
+    writers = {table: lambda tmp: tmp.write_text(text, encoding="utf-8")}
+    return write_all({**writers, image: lambda tmp: plot_raster(result, tmp)})

@@ -398,3 +398,43 @@ def atomic_path(path: str | os.PathLike):
     """
     with atomic_paths(path) as (tmp,):
         yield tmp
+
+
+def write_all(writers: dict) -> list[Path]:
+    """Write several outputs at once: all of them, or none if one write fails.
+
+    Parameters
+    ----------
+    writers : dict of path to callable
+        Each output path, with a function that writes its contents to the temporary path it
+        is given (renamed onto the output once every write has succeeded).
+
+    Returns
+    -------
+    list of pathlib.Path
+        The outputs written, in the order given.
+    """
+    with atomic_paths(*writers) as temporaries:
+        for write, tmp in zip(writers.values(), temporaries, strict=True):
+            write(tmp)
+    return [Path(path) for path in writers]
+
+
+def refusal(exc: OSError) -> str:
+    """Why the system refused a path or a write, and what to check, as one sentence.
+
+    Parameters
+    ----------
+    exc : OSError
+        The refusal, with the path it names if any (``filename``).
+
+    Returns
+    -------
+    str
+        E.g. ``"cannot use 'out.csv': Permission denied. Check the path ..."``.
+    """
+    where = f" {os.fsdecode(exc.filename)[:120]!r}" if exc.filename else ""
+    return (
+        f"cannot use{where}: {exc.strerror or exc}. Check the path (the length of its names, "
+        "that its folders exist and are folders), its permissions and the free space."
+    )

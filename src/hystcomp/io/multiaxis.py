@@ -22,9 +22,18 @@ from hystcomp._notice import Notice
 from hystcomp._validation import as_path, check_real
 from hystcomp.errors import DataFileError, InvalidParameterError
 from hystcomp.io._formats import read_raw
-from hystcomp.io.records import MEANINGS, X_UNITS, _as_column, _find, _Raw, _time, _units
+from hystcomp.io.records import (
+    MEANINGS,
+    X_UNITS,
+    _as_column,
+    _find,
+    _Raw,
+    _time,
+    _units,
+    parse_columns,
+)
 
-__all__ = ["axis_key", "is_multiaxis", "parse_axis_columns", "read_axes"]
+__all__ = ["axis_key", "is_multiaxis", "parse_any_columns", "parse_axis_columns", "read_axes"]
 
 _KEY = re.compile(r"^([vx])([1-9][0-9]*)$", re.IGNORECASE)
 #: Most axes of a file.
@@ -292,3 +301,35 @@ def axis_table(t, **signals) -> dict:
         else:
             out.update({f"{name[0]}{i + 1}{name[1:]}": s[:, i] for i in range(s.shape[1])})
     return out
+
+
+def parse_any_columns(text: str | None) -> dict[str, int | str] | None:
+    """Parse a column mapping of one axis (``v=1,x=5``) or of N axes (``v1=2,x1=4,...``).
+
+    Parameters
+    ----------
+    text : str or None
+        ``key=column`` pairs separated by commas (None for no mapping).
+
+    Returns
+    -------
+    dict or None
+        As :func:`hystcomp.io.records.parse_columns` returns it, or, where its first key
+        names an axis (a digit in it), as :func:`parse_axis_columns` does.
+
+    Raises
+    ------
+    InvalidParameterError
+        The one-axis reason, or the N-axis one where the first key names an axis.
+
+    Examples
+    --------
+    >>> parse_any_columns("v=1,x=5"), parse_any_columns("v1=2,x1=volts")
+    ({'v': 1, 'x': 5}, {'v1': 2, 'x1': 'volts'})
+    """
+    try:
+        return parse_columns(text)
+    except InvalidParameterError:
+        if text is None or not any(c.isdigit() for c in str(text).split("=")[0]):
+            raise
+    return parse_axis_columns(text)

@@ -41,7 +41,7 @@ from hystcomp._validation import MAX_MAGNITUDE, as_path, as_signal, check_int, c
 from hystcomp.errors import DataFileError, InvalidParameterError, InvalidSignalError
 from hystcomp.io._formats import read_raw
 from hystcomp.io._text import UNITS, write_csv
-from hystcomp.io.atomic import atomic_path
+from hystcomp.io.atomic import atomic_path, check_output_path
 
 #: What each column holds, for messages.
 MEANINGS = {"t": "time in s", "v": "voltage in V", "x": "displacement in µm"}
@@ -843,3 +843,25 @@ def write_table(path, table: dict, *, progress=None) -> None:
             import scipy.io  # only MAT output needs it
 
             scipy.io.savemat(file, {k: v.reshape(-1, 1) for k, v in cols.items()})
+
+
+def check_data_output(path, *, inputs=(), what: str = "output") -> Path:
+    """Refuse, before any work, a data output that :func:`write_table` cannot write or that
+    would overwrite an input.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The output file.
+    inputs : sequence of str or os.PathLike
+        Files the same command reads (:func:`hystcomp.io.atomic.check_output_path`).
+    what : str
+        What the file is, for messages (e.g. ``"voltage file"``).
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``, checked.
+    """
+    check_output_path(path, inputs=inputs, what=what)
+    return check_writable(path)

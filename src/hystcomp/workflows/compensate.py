@@ -43,11 +43,13 @@ __all__ = [
     "compensate_reference",
     "export_compensator",
     "inverse_for",
+    "load_compensation",
     "load_dynamics",
     "own_turns",
     "reach",
     "refuse_dynamics_as_model",
     "slew_sample_rate",
+    "voltage_summary",
 ]
 
 #: A step of the reference's time column shorter than this share of its median step is a
@@ -599,3 +601,53 @@ def export_compensator(
     options = {"prefix": prefix, "source": source, "sample_rate": sample_rate, "inputs": inputs}
     paths = list(write(compensator, directory, **options))
     return ExportResult(paths, [APART] if dynamics is not None else [])
+
+
+def load_compensation(path, dynamics=None) -> tuple[Any, LinearDynamics | None]:
+    """The model of a model file to invert, and the linear dynamics of a second one if given.
+
+    Parameters
+    ----------
+    path : str or path-like
+        A model file: a hysteresis model, a pair or an N-axis model, not linear dynamics
+        alone (:func:`refuse_dynamics_as_model`).
+    dynamics : str or path-like, optional
+        A model file of linear dynamics (:func:`load_dynamics`), inverted in series.
+
+    Returns
+    -------
+    model : object
+        The model of ``path``.
+    dynamics : LinearDynamics or None
+        The linear dynamics of ``dynamics``, if given.
+    """
+    from hystcomp.io.models import load_model
+
+    model = load_model(path)
+    refuse_dynamics_as_model(model, path)
+    return model, None if dynamics is None else load_dynamics(dynamics)
+
+
+def voltage_summary(result: CompensationResult) -> str:
+    """The voltage :func:`compensate_reference` computed, in one line: its samples, its
+    range and how many were clamped (each axis's range for an N-axis model).
+
+    Parameters
+    ----------
+    result : CompensationResult
+        The compensation.
+
+    Returns
+    -------
+    str
+        E.g. ``"4000 samples, v from 2.1 to 118 V (range 0 .. 120 V, 0 clamped)"``.
+    """
+    v = result.v
+    if v.ndim == 2:  # one column per axis
+        ranges = ", ".join(f"v{i + 1} {c.min():.4g} .. {c.max():.4g} V" for i, c in enumerate(v.T))
+        return f"{len(v)} samples of {v.shape[1]} axes ({ranges}; {sum(result.clamped)} clamped)"
+    lo, hi = result.compensator.voltage_range
+    return (
+        f"{v.size} samples, v from {v.min():.4g} to {v.max():.4g} V (range {lo:.4g} .. "
+        f"{hi:.4g} V, {result.clamped} clamped)"
+    )
