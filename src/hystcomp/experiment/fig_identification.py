@@ -10,10 +10,12 @@ largest value), the hold-out in its own colour and the excerpts shaded.
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import numpy as np
 
+from hystcomp.errors import InvalidParameterError
 from hystcomp.experiment._layout import (
     DPI,
     FORMATS,
@@ -27,7 +29,14 @@ from hystcomp.experiment._layout import (
     thin_slice,
 )
 
-__all__ = ["FORMATS", "plot_identification", "plot_identification_result", "turning_points"]
+__all__ = [
+    "FORMATS",
+    "check_figure_output",
+    "plot_identification",
+    "plot_identification_result",
+    "plot_identified",
+    "turning_points",
+]
 
 #: Turning points of the input above which a record is drawn as excerpts (about 6 loops).
 LONG_TURNS = 12
