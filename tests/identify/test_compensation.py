@@ -232,3 +232,21 @@ def test_the_estimate_does_not_depend_on_how_long_the_record_dwells_at_its_turns
         plain.append(float(np.sqrt(np.mean((model.simulate(v) - x)[mask] ** 2))))
     assert estimates[1] == pytest.approx(estimates[0], rel=0.002)
     assert abs(plain[1] / plain[0] - 1.0) > 0.01
+
+
+def test_the_estimate_counts_nothing_where_the_stage_does_not_move():
+    """A reference visits only what the stage travels: where the stage stands still (here
+    held at a floor below 30 V, as a stage below its remanence) and the model moves, the
+    model's error is no tracking error, and the estimate leaves it out."""
+    from hystcomp.identify.compensation import tracking_estimate
+
+    model = presets.paper_mpi()
+    n = 20_000
+    phase = np.arange(3 * n) % n / n
+    v = 120.0 * (1.0 - np.abs(1.0 - 2.0 * phase))
+    exact = model.simulate(v)
+    floor = float(exact[n + n // 8])  # the rising branch at 30 V
+    x = np.maximum(exact, floor)  # the stage's output: the model's above the floor
+    assert np.sqrt(np.mean((exact - x) ** 2)) > 0.1  # the model errs below it
+    est = tracking_estimate(model, v, x, start=n)
+    assert est["swing_rms_um"] < 0.02 * np.sqrt(np.mean((exact - x)[n:] ** 2))

@@ -285,6 +285,28 @@ def swing_mask(v, start: int = 0, share: float = SWING) -> np.ndarray:
     return mask
 
 
+#: The measured displacement is smoothed over this share of the input span of travel.
+TRAVEL_SMOOTHING = 0.005
+
+
+def _travel(v: np.ndarray, x: np.ndarray, fitted: np.ndarray) -> np.ndarray:
+    """The displacement a reference at constant speed covers at each sample of a record:
+    the smaller of the stage's (``x`` smoothed over :data:`TRAVEL_SMOOTHING` of the input
+    span, against its noise) and the model's (``fitted``). A reference visits only what
+    the stage travels, and a compensator walks the model's curve at the reference's speed:
+    the record's dwell (a sinusoid's at its turns) counts for nothing."""
+    if v.size < 2:
+        return np.ones(v.size)
+    steps = np.abs(np.diff(v))
+    moving = steps[steps > 0.0]
+    if moving.size == 0:
+        return np.ones(v.size)
+    half = int(min(max(1.0, TRAVEL_SMOOTHING * np.ptp(v) / np.median(moving)), v.size // 4))
+    kernel = np.ones(2 * half + 1) / (2 * half + 1)
+    smooth = np.convolve(np.pad(x, half, mode="edge"), kernel, mode="valid")
+    return np.minimum(np.abs(np.gradient(smooth)), np.abs(np.gradient(fitted)))
+
+
 def _weighted_rms(error: np.ndarray, weight: np.ndarray) -> float:
     return float(np.sqrt(np.sum(weight * error**2) / np.sum(weight)))
 
@@ -299,9 +321,10 @@ def tracking_estimate(model, v, x, *, start: int = 0) -> dict:
 
     * ``e_swing``: the model's error against the record on its swings over at least half
       the input range (:func:`swing_mask`), where a reference over the range drives the
-      stage; each sample weighted by the displacement the model travels there, as a
-      reference at constant speed spends equal time on each micrometre (a sinusoid's record
-      dwells at its turns, a triangle's does not);
+      stage; each sample weighted by the displacement travelled there, the stage's or the
+      model's, whichever is smaller (:func:`_travel`), as a reference at constant speed
+      spends equal time on each micrometre the stage travels (a sinusoid's record dwells at
+      its turns, a triangle's does not);
     * ``e_inverse``: the compensator's error on its own model for a triangle over 5-90 %
       of the model's reach, with :data:`REFERENCE_PERIOD` samples a period: the one-sample
       lag of eq. 10, and any part out of reach.
@@ -337,9 +360,7 @@ def tracking_estimate(model, v, x, *, start: int = 0) -> dict:
     if not mask.any():  # no swing over half the range: the whole record
         mask[start:] = True
     fitted = np.asarray(model.simulate(v), dtype=np.float64)
-    # a reference at constant speed spends equal time on every micrometre: weight each
-    # sample by the displacement the model travels there, not by the record's dwell
-    weight = np.abs(np.gradient(fitted)) * mask if v.size > 1 else mask.astype(np.float64)
+    weight = _travel(v, x, fitted) * mask
     if not weight.sum() > 0.0:
         weight = mask.astype(np.float64)
     swing = _weighted_rms(fitted - x, weight)
