@@ -188,26 +188,6 @@ def run_dynamics(twin, compensators, amplitude, *, periods, frequencies, identif
     return DynamicsComparison(record, pairs, results, step, step_error, step_drift)
 
 
-def dynamics_rows(dc: DynamicsComparison) -> list[dict]:
-    """CSV rows: frequency, method, rms and max error (µm).
-
-    Parameters
-    ----------
-    dc : DynamicsComparison
-        The dynamics part's results.
-
-    Returns
-    -------
-    list of dict
-        One row per frequency and method.
-    """
-    return [
-        {"frequency_hz": f, "method": label, "rms_um": r.rms, "max_um": r.max}
-        for f, row in dc.results.items()
-        for label, r in row.items()
-    ]
-
-
 def dynamics_markdown(dc: DynamicsComparison, table1: dict) -> list[str]:
     """The report's section on the dynamics: the pairs, the table, the step.
 

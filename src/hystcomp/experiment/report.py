@@ -35,10 +35,12 @@ from hystcomp.paper import LABELS, METHODS
 def table1_rows(comparison) -> list[dict]:
     """Table I: one row per frequency and method (rms and max tracking error, µm).
 
+    The dynamics part's CSV has the same columns, so this writes it too.
+
     Parameters
     ----------
-    comparison : Comparison
-        The comparison's results.
+    comparison : Comparison or DynamicsComparison
+        Either part's results: ``results[frequency][method]`` has ``rms`` and ``max``.
 
     Returns
     -------
@@ -58,12 +60,12 @@ def hysteresis_rows(comparison) -> list[dict]:
     Parameters
     ----------
     comparison : Comparison
-        The comparison's results.
+        The comparison; only its lowest frequency's results are read.
 
     Returns
     -------
     list of dict
-        One row per method.
+        ``method``, ``hysteresis_pct`` and ``saturation_zone_pct``, a row per method.
     """
     low = min(comparison.results)
     return [
@@ -216,10 +218,10 @@ def write_outputs(comparison, out_dir, *, figures=None) -> list[Path]:
         _write_text(stage / "hysteresis.csv", _csv_text(hysteresis_rows(comparison)))
         dc = getattr(comparison, "dynamics", None)
         if dc is not None:  # beyond the paper; drawn first, while the figures process ends
-            from hystcomp.experiment.compare_dynamics import dynamics_markdown, dynamics_rows
+            from hystcomp.experiment.compare_dynamics import dynamics_markdown
             from hystcomp.experiment.fig_dynamics import plot_step
 
-            _write_text(stage / "dynamics.csv", _csv_text(dynamics_rows(dc)))
+            _write_text(stage / "dynamics.csv", _csv_text(table1_rows(dc)))
             t, x_ref = next(iter(dc.step.values()))[:2]
             plot_step(t, x_ref, {k: run[2] for k, run in dc.step.items()}, stage / "step_creep.png")
         notes = _figures(comparison, stage, figures)
