@@ -14,6 +14,7 @@
 from __future__ import annotations
 
 import dataclasses
+import warnings
 
 import numpy as np
 
@@ -186,6 +187,29 @@ def run_dynamics(twin, compensators, amplitude, *, periods, frequencies, identif
             step_error[label] = float(np.mean(np.abs(e)))
             step_drift[label] = float(np.mean(e[-ten_ms:]) - np.mean(e[:ten_ms]))
     return DynamicsComparison(record, pairs, results, step, step_error, step_drift)
+
+
+def dynamics_rows(dc: DynamicsComparison) -> list[dict]:
+    """Deprecated: :func:`hystcomp.experiment.report.table1_rows` writes this CSV too.
+
+    Parameters
+    ----------
+    dc : DynamicsComparison
+        The dynamics part's results.
+
+    Returns
+    -------
+    list of dict
+        A row per frequency and method: rms and max error, µm.
+    """
+    from hystcomp.experiment.report import table1_rows
+
+    warnings.warn(
+        "dynamics_rows is deprecated; use hystcomp.experiment.report.table1_rows.",
+        DeprecationWarning,
+        stacklevel=2,
+    )
+    return table1_rows(dc)
 
 
 def dynamics_markdown(dc: DynamicsComparison, table1: dict) -> list[str]:
