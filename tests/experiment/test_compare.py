@@ -212,15 +212,15 @@ def test_command_refuses_before_any_work(tmp_path, monkeypatch, args, message):
     assert sorted(p.name for p in tmp_path.iterdir()) == []  # nothing created
 
 
-def test_dynamics_rows_is_a_deprecated_alias_of_table1_rows():
+def test_dynamics_rows_is_a_deprecated_alias_of_error_rows():
     from types import SimpleNamespace
 
     from hystcomp.experiment import compare_dynamics
-    from hystcomp.experiment.report import table1_rows
+    from hystcomp.experiment.tracking import error_rows
 
     run = SimpleNamespace(rms=1.5, max=3.0)
     dc = SimpleNamespace(results={10.0: {"pi+dyn": run}})
-    with pytest.warns(DeprecationWarning, match="table1_rows"):
+    with pytest.warns(DeprecationWarning, match="error_rows"):
         rows = compare_dynamics.dynamics_rows(dc)
-    assert rows == table1_rows(dc)
+    assert rows == error_rows(dc)
     assert rows == [{"frequency_hz": 10.0, "method": "pi+dyn", "rms_um": 1.5, "max_um": 3.0}]

@@ -19,7 +19,7 @@ import warnings
 import numpy as np
 
 from hystcomp.experiment.references import triangle_reference
-from hystcomp.experiment.tracking import TrackingResult, run_tracking
+from hystcomp.experiment.tracking import TrackingResult, error_rows, run_tracking
 from hystcomp.identify.dynamics import dynamics_excitation
 from hystcomp.io.records import Record
 from hystcomp.models.hammerstein import fit_pair
@@ -190,7 +190,7 @@ def run_dynamics(twin, compensators, amplitude, *, periods, frequencies, identif
 
 
 def dynamics_rows(dc: DynamicsComparison) -> list[dict]:
-    """Deprecated: :func:`hystcomp.experiment.report.table1_rows` writes this CSV too.
+    """Deprecated: :func:`hystcomp.experiment.tracking.error_rows` writes this CSV too.
 
     Parameters
     ----------
@@ -202,14 +202,12 @@ def dynamics_rows(dc: DynamicsComparison) -> list[dict]:
     list of dict
         A row per frequency and method: rms and max error, µm.
     """
-    from hystcomp.experiment.report import table1_rows
-
     warnings.warn(
-        "dynamics_rows is deprecated; use hystcomp.experiment.report.table1_rows.",
+        "dynamics_rows is deprecated; use hystcomp.experiment.tracking.error_rows.",
         DeprecationWarning,
         stacklevel=2,
     )
-    return table1_rows(dc)
+    return error_rows(dc)
 
 
 def dynamics_markdown(dc: DynamicsComparison, table1: dict) -> list[str]:

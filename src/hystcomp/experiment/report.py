@@ -22,6 +22,7 @@ from hystcomp import paper
 from hystcomp.errors import InvalidParameterError
 from hystcomp.experiment.figures import BACKGROUND_FIGURES, FIGURES, write_figures
 from hystcomp.experiment.metrics import SATURATION_ZONE
+from hystcomp.experiment.tracking import error_rows as table1_rows
 from hystcomp.io.atomic import (
     atomic_path,
     check_output_path,
@@ -30,28 +31,6 @@ from hystcomp.io.atomic import (
     write_target,
 )
 from hystcomp.paper import LABELS, METHODS
-
-
-def table1_rows(comparison) -> list[dict]:
-    """Table I: one row per frequency and method (rms and max tracking error, µm).
-
-    The dynamics part's CSV has the same columns, so this writes it too.
-
-    Parameters
-    ----------
-    comparison : Comparison or DynamicsComparison
-        Either part's results: ``results[frequency][method]`` has ``rms`` and ``max``.
-
-    Returns
-    -------
-    list of dict
-        One row per frequency and method.
-    """
-    return [
-        {"frequency_hz": f, "method": m, "rms_um": r.rms, "max_um": r.max}
-        for f, by_method in comparison.results.items()
-        for m, r in by_method.items()
-    ]
 
 
 def hysteresis_rows(comparison) -> list[dict]:
