@@ -132,8 +132,7 @@ def as_vector(value, name: str, owner: str, *, length: int | None = None) -> np.
             f"The {name!r} parameter of {owner} must have {length} entries, one per operator. "
             f"Got {arr.size} instead."
         )
-    bad = _first_out_of_bounds(arr)
-    if bad is not None:
+    if (bad := _first_out_of_bounds(arr)) is not None:
         value = float(arr[bad])
         need = f"be at most {MAX_MAGNITUDE:g} in size" if np.isfinite(value) else "be finite"
         raise InvalidParameterError(
@@ -220,8 +219,7 @@ def as_signal(value, name: str, *, min_samples: int = 1) -> np.ndarray:
             f"{name!r} must have at least {min_samples} sample{'' if min_samples == 1 else 's'}. "
             f"Got {arr.size}."
         )
-    bad = _first_out_of_bounds(arr)
-    if bad is not None:
+    if (bad := _first_out_of_bounds(arr)) is not None:
         value = float(arr[bad])
         if np.isfinite(value):
             raise InvalidSignalError(
@@ -237,14 +235,22 @@ def as_signal(value, name: str, *, min_samples: int = 1) -> np.ndarray:
     return arr
 
 
-def as_signal_pair(a, b, names: tuple[str, str], owner: str, *, min_samples: int = 1):
-    """Two signals (see :func:`as_signal`) with one sample each per instant."""
+def as_signal_pair(a, b, names: tuple[str, str], owner: str, *, min_samples: int = 1, kinds=None):
+    """Two signals (see :func:`as_signal`) with one sample each per instant.
+
+    ``kinds`` (for example ``("voltage", "displacement")``) names what the two counts in the
+    message are of.
+    """
     a = as_signal(a, names[0], min_samples=min_samples)
     b = as_signal(b, names[1], min_samples=min_samples)
     if a.size != b.size:
+        if kinds is None:
+            got = f"{a.size} and {b.size}"
+        else:
+            got = f"{a.size} {kinds[0]} samples and {b.size} {kinds[1]}"
         raise InvalidSignalError(
             f"{owner}: {names[0]!r} and {names[1]!r} must have one sample each per instant. "
-            f"Got {a.size} and {b.size} samples."
+            f"Got {got} samples."
         )
     return a, b
 

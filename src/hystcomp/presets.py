@@ -112,7 +112,7 @@ def paper_mpi() -> ModifiedPrandtlIshlinskii:
     Returns
     -------
     ModifiedPrandtlIshlinskii
-        The model of eqs. (21)-(22).
+        The paper's fitted MPI model, eqs. (21)-(22), as printed.
 
     Examples
     --------

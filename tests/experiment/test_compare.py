@@ -21,7 +21,7 @@ from hystcomp.paper import METHODS
 PNG = b"\x89PNG\r\n\x1a\n"
 
 
-def stand_in_models(record_pi, record_preisach, config=None):
+def stand_in_models(record_pi, record_preisach, config=None, *, as_printed=False):
     """The paper's identified models in place of identification (tests of the plumbing only)."""
     return {"preisach": presets.paper_mpi(), "pi": presets.paper_pi(), "mpi": presets.paper_mpi()}
 
@@ -149,9 +149,21 @@ def test_real_quick_comparison():
             assert rms["mpi"] < rms["pi"]
     # Table I's Preisach fit holds X(v, v) = 0 (eq. 2); the report's "as printed" one does not
     assert set(c.paper_fit) == {"preisach", "pi", "mpi"}
-    printed = compare_module.paper_fits(c.record_pi, c.record_preisach, c.config)["preisach"]
+    printed = compare_module.identify_models(
+        c.record_pi, c.record_preisach, c.config, as_printed=True
+    )["preisach"]
     assert c.models["preisach"].fit_report_["diagonal_max_um"] < 1e-9
     assert printed.fit_report_["diagonal_max_um"] > 1e-3
+
+
+def test_paper_fits_is_a_deprecated_alias(monkeypatch):
+    calls = []
+    monkeypatch.setattr(
+        compare_module, "identify_models", lambda *a, **k: calls.append((a, k)) or "fits"
+    )
+    with pytest.warns(DeprecationWarning, match="as_printed=True"):
+        assert compare_module.paper_fits("pi", "preisach", "config") == "fits"
+    assert calls == [(("pi", "preisach", "config"), {"as_printed": True})]
 
 
 def test_command_writes_the_files_and_prints_the_table(tmp_path, monkeypatch):
@@ -198,3 +210,17 @@ def test_command_refuses_before_any_work(tmp_path, monkeypatch, args, message):
     assert result.exit_code == 2, result.output
     assert message.replace("{tmp}", str(tmp_path)) in result.stderr
     assert sorted(p.name for p in tmp_path.iterdir()) == []  # nothing created
+
+
+def test_dynamics_rows_is_a_deprecated_alias_of_error_rows():
+    from types import SimpleNamespace
+
+    from hystcomp.experiment import compare_dynamics
+    from hystcomp.experiment.tracking import error_rows
+
+    run = SimpleNamespace(rms=1.5, max=3.0)
+    dc = SimpleNamespace(results={10.0: {"pi+dyn": run}})
+    with pytest.warns(DeprecationWarning, match="error_rows"):
+        rows = compare_dynamics.dynamics_rows(dc)
+    assert rows == error_rows(dc)
+    assert rows == [{"frequency_hz": 10.0, "method": "pi+dyn", "rms_um": 1.5, "max_um": 3.0}]

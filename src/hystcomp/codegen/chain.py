@@ -18,7 +18,7 @@ def chain_template(compensator) -> CTemplate:
     Parameters
     ----------
     compensator : Compensator
-        The inverse of a PI or MPI model.
+        A PI or MPI model's ``inverse()``: plays, and for MPI the dead-zones of ``S^-1``.
 
     Returns
     -------

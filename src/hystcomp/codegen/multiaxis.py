@@ -156,10 +156,8 @@ def export_multiaxis_c(
         The output folder.
     prefix : str
         NAME, a C identifier.
-    source : str, optional
-        The model file, named in the comments.
-    sample_rate : float, optional
-        Hz at which ``NAME_step`` is called, for the comments.
+    source, sample_rate : str and float, optional
+        The model file and the rate (Hz) at which ``NAME_step`` runs, for the comments.
     inputs : sequence of path, optional
         Files the caller read: refused as outputs.
 

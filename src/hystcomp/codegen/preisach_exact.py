@@ -22,10 +22,8 @@ def exact_functions(v_min: float, v_max: float) -> list[str]:
 
     Parameters
     ----------
-    v_min : float
-        The lower end of the Preisach plane, V.
-    v_max : float
-        The upper end, V.
+    v_min, v_max : float
+        The ends of the Preisach plane, V, written into the C as ``V_MIN`` and ``V_MAX``.
 
     Returns
     -------

@@ -84,7 +84,7 @@ class LinearCompensator:
         Parameters
         ----------
         x_ref : array_like
-            The reference, µm.
+            The reference displacement, µm; each sample is inverted on its own.
 
         Returns
         -------

@@ -211,7 +211,7 @@ def paper_loop_difference(twin: Twin) -> float:
     Parameters
     ----------
     twin : Twin
-        The twin.
+        The twin whose quasi-static ``hysteresis`` is compared, on the paper's fit cycles.
 
     Returns
     -------

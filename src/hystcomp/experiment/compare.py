@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import dataclasses
 import time
+import warnings
 from collections.abc import Callable
 
 import numpy as np
@@ -154,8 +155,8 @@ class Comparison:
         inverse multiplicative structure (empty if the Preisach model has no exact inverse).
     paper_fit : dict
         ``paper_fit[kind]`` for each model kind: the lowest frequency tracked with the
-        paper's own fit (:func:`paper_fits`), for the report (empty with a custom
-        ``identify``).
+        paper's own fit (:func:`identify_models` ``as_printed``), for the report (empty with
+        a custom ``identify``).
     seconds : float
         Wall-clock time of the run.
     """
@@ -176,7 +177,11 @@ class Comparison:
 
 
 def identify_models(
-    record_pi: Record, record_preisach: Record, config: CompareConfig | None = None
+    record_pi: Record,
+    record_preisach: Record,
+    config: CompareConfig | None = None,
+    *,
+    as_printed: bool = False,
 ) -> dict:
     """Identify the paper's three models from the twin's records.
 
@@ -187,7 +192,11 @@ def identify_models(
     compensator is predicted to track best (:mod:`hystcomp.identify.compensation`);
     The Preisach fit is the paper's with ``X(v, v) = 0`` imposed, as eq. 2 implies (fitted
     free, the cubic's ``X(v, v)`` makes the output step at every reversal).
-    :func:`paper_fits` gives eqs. 5, 12 and 19 as printed for the report.
+
+    With ``as_printed`` the three are fitted exactly as printed, for the report: eq. 5
+    fitted free to the reversal curves (``zero_diagonal=False``); eq. 12 and eq. 19 with the
+    partial-sum constraints only, no regularisation (``constraints="paper"``,
+    ``regularization=0``).
 
     Parameters
     ----------
@@ -197,6 +206,8 @@ def identify_models(
         The twin's answer to the sinusoids.
     config : CompareConfig, optional
         The comparison's settings (the defaults if None).
+    as_printed : bool, optional
+        Fit eqs. 5, 12 and 19 as printed instead of with the library's defaults.
 
     Returns
     -------
@@ -204,11 +215,19 @@ def identify_models(
         ``{"preisach": ..., "pi": ..., "mpi": ...}``, the fitted models.
     """
     config = CompareConfig() if config is None else config
-    pi = PrandtlIshlinskii(n_operators=config.n_operators)
-    mpi = ModifiedPrandtlIshlinskii(n_operators=config.n_operators, n_deadzones=config.n_deadzones)
-    # the paper's fit (Section III-A), not the library's default, with X(v, v) = 0 (eq. 2)
+    paper: dict = {"constraints": "paper"} if as_printed else {}
+    unregularized: dict = {"regularization": 0.0} if as_printed else {}
+    pi = PrandtlIshlinskii(n_operators=config.n_operators, **paper)
+    mpi = ModifiedPrandtlIshlinskii(
+        n_operators=config.n_operators, n_deadzones=config.n_deadzones, **paper, **unregularized
+    )
+    # the paper's fit (Section III-A), not the library's default; X(v, v) = 0 (eq. 2) unless
+    # as printed
     preisach = Preisach(
-        degree=config.preisach_degree, everett="polynomial", fit_method="reversal-curves"
+        degree=config.preisach_degree,
+        everett="polynomial",
+        fit_method="reversal-curves",
+        zero_diagonal=not as_printed,
     )
     return {
         "preisach": preisach.fit(record_preisach.v, record_preisach.x),
@@ -218,41 +237,26 @@ def identify_models(
 
 
 def paper_fits(record_pi: Record, record_preisach: Record, config: CompareConfig) -> dict:
-    """The three models fitted exactly as printed: eq. 5 fitted free to the reversal curves
-    (``zero_diagonal=False``); eq. 12 and eq. 19 with the partial-sum constraints only, no
-    regularisation (``constraints="paper"``, ``regularization=0``).
+    """Deprecated: ``identify_models(..., as_printed=True)``.
 
     Parameters
     ----------
-    record_pi : Record
-        The twin's answer to the triangles.
-    record_preisach : Record
-        The twin's answer to the sinusoids.
+    record_pi, record_preisach : Record
+        The triangle and sinusoid records.
     config : CompareConfig
-        The comparison's settings.
+        The settings.
 
     Returns
     -------
     dict
-        ``{"preisach": ..., "pi": ..., "mpi": ...}``, the models fitted as printed.
+        The models fitted as printed, by kind.
     """
-    return {
-        "preisach": Preisach(
-            degree=config.preisach_degree,
-            everett="polynomial",
-            fit_method="reversal-curves",
-            zero_diagonal=False,
-        ).fit(record_preisach.v, record_preisach.x),
-        "pi": PrandtlIshlinskii(n_operators=config.n_operators, constraints="paper").fit(
-            record_pi.v, record_pi.x
-        ),
-        "mpi": ModifiedPrandtlIshlinskii(
-            n_operators=config.n_operators,
-            n_deadzones=config.n_deadzones,
-            constraints="paper",
-            regularization=0.0,
-        ).fit(record_pi.v, record_pi.x),
-    }
+    warnings.warn(
+        "paper_fits is deprecated; use identify_models(..., as_printed=True).",
+        DeprecationWarning,
+        stacklevel=2,
+    )
+    return identify_models(record_pi, record_preisach, config, as_printed=True)
 
 
 def run_comparison(
@@ -368,7 +372,9 @@ def run_comparison(
     if identify is identify_models:
         low = min(config.frequencies)
         _, x_ref = triangle_reference(amplitude, low, periods=config.periods, sample_rate=fs)
-        for kind, model in paper_fits(record_pi, record_preisach, config).items():
+        for kind, model in identify_models(
+            record_pi, record_preisach, config, as_printed=True
+        ).items():
             paper_fit[kind] = run_tracking(
                 model.inverse(), twin, x_ref, frequency=low, method=f"{kind} (paper's fit)"
             )

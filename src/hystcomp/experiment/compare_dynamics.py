@@ -14,11 +14,12 @@
 from __future__ import annotations
 
 import dataclasses
+import warnings
 
 import numpy as np
 
 from hystcomp.experiment.references import triangle_reference
-from hystcomp.experiment.tracking import TrackingResult, run_tracking
+from hystcomp.experiment.tracking import TrackingResult, error_rows, run_tracking
 from hystcomp.identify.dynamics import dynamics_excitation
 from hystcomp.io.records import Record
 from hystcomp.models.hammerstein import fit_pair
@@ -189,7 +190,7 @@ def run_dynamics(twin, compensators, amplitude, *, periods, frequencies, identif
 
 
 def dynamics_rows(dc: DynamicsComparison) -> list[dict]:
-    """CSV rows: frequency, method, rms and max error (µm).
+    """Deprecated: :func:`hystcomp.experiment.tracking.error_rows` writes this CSV too.
 
     Parameters
     ----------
@@ -199,13 +200,14 @@ def dynamics_rows(dc: DynamicsComparison) -> list[dict]:
     Returns
     -------
     list of dict
-        One row per frequency and method.
+        A row per frequency and method: rms and max error, µm.
     """
-    return [
-        {"frequency_hz": f, "method": label, "rms_um": r.rms, "max_um": r.max}
-        for f, row in dc.results.items()
-        for label, r in row.items()
-    ]
+    warnings.warn(
+        "dynamics_rows is deprecated; use hystcomp.experiment.tracking.error_rows.",
+        DeprecationWarning,
+        stacklevel=2,
+    )
+    return error_rows(dc)
 
 
 def dynamics_markdown(dc: DynamicsComparison, table1: dict) -> list[str]:

@@ -22,6 +22,7 @@ from hystcomp import paper
 from hystcomp.errors import InvalidParameterError
 from hystcomp.experiment.figures import BACKGROUND_FIGURES, FIGURES, write_figures
 from hystcomp.experiment.metrics import SATURATION_ZONE
+from hystcomp.experiment.tracking import error_rows as table1_rows
 from hystcomp.io.atomic import (
     atomic_path,
     check_output_path,
@@ -32,38 +33,18 @@ from hystcomp.io.atomic import (
 from hystcomp.paper import LABELS, METHODS
 
 
-def table1_rows(comparison) -> list[dict]:
-    """Table I: one row per frequency and method (rms and max tracking error, µm).
-
-    Parameters
-    ----------
-    comparison : Comparison
-        The comparison's results.
-
-    Returns
-    -------
-    list of dict
-        One row per frequency and method.
-    """
-    return [
-        {"frequency_hz": f, "method": m, "rms_um": r.rms, "max_um": r.max}
-        for f, by_method in comparison.results.items()
-        for m, r in by_method.items()
-    ]
-
-
 def hysteresis_rows(comparison) -> list[dict]:
     """Hysteresis % at the lowest frequency, whole loop and saturation zone, per method.
 
     Parameters
     ----------
     comparison : Comparison
-        The comparison's results.
+        The comparison; only its lowest frequency's results are read.
 
     Returns
     -------
     list of dict
-        One row per method.
+        ``method``, ``hysteresis_pct`` and ``saturation_zone_pct``, a row per method.
     """
     low = min(comparison.results)
     return [
@@ -216,10 +197,10 @@ def write_outputs(comparison, out_dir, *, figures=None) -> list[Path]:
         _write_text(stage / "hysteresis.csv", _csv_text(hysteresis_rows(comparison)))
         dc = getattr(comparison, "dynamics", None)
         if dc is not None:  # beyond the paper; drawn first, while the figures process ends
-            from hystcomp.experiment.compare_dynamics import dynamics_markdown, dynamics_rows
+            from hystcomp.experiment.compare_dynamics import dynamics_markdown
             from hystcomp.experiment.fig_dynamics import plot_step
 
-            _write_text(stage / "dynamics.csv", _csv_text(dynamics_rows(dc)))
+            _write_text(stage / "dynamics.csv", _csv_text(table1_rows(dc)))
             t, x_ref = next(iter(dc.step.values()))[:2]
             plot_step(t, x_ref, {k: run[2] for k, run in dc.step.items()}, stage / "step_creep.png")
         notes = _figures(comparison, stage, figures)

@@ -156,3 +156,23 @@ def _voltage(compensator, x_ref: np.ndarray) -> np.ndarray:
             f"{lo:g}..{hi:g} V; a compensator must clamp its output to protect the piezo."
         )
     return v
+
+
+def error_rows(comparison) -> list[dict]:
+    """The rows of Table I's CSV, and of the dynamics part's: rms and max tracking error, µm.
+
+    Parameters
+    ----------
+    comparison : Comparison or DynamicsComparison
+        Either part's results: ``results[frequency][method]`` has ``rms`` and ``max``.
+
+    Returns
+    -------
+    list of dict
+        One row per frequency and method.
+    """
+    return [
+        {"frequency_hz": f, "method": m, "rms_um": r.rms, "max_um": r.max}
+        for f, by_method in comparison.results.items()
+        for m, r in by_method.items()
+    ]

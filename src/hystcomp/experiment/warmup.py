@@ -104,7 +104,8 @@ def start(config) -> BackgroundJob | None:
     Parameters
     ----------
     config : CompareConfig
-        The comparison's settings.
+        The comparison whose dynamics part the job prepares (no job if ``config.dynamics``
+        is off).
 
     Returns
     -------

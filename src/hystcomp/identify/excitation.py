@@ -328,12 +328,10 @@ def rich_sequence(
         The ramps' slope, V/s.
     sample_rate : float, optional
         Samples per second, Hz.
-    v_min : float, optional
-        The lower end of the range, V.
-    v_max : float, optional
-        The upper end of the range, V.
+    v_min, v_max : float, optional
+        The voltage range the ramps span, V.
     seed : int, optional
-        The seed of the random turning points.
+        Passed to :func:`rich_turning_points`, which draws the last 32 turns from it.
 
     Returns
     -------

@@ -48,6 +48,9 @@ def multiaxis_sequence(
 ) -> tuple[np.ndarray, np.ndarray]:
     """An input that identifies N coupled axes (module notes).
 
+    Axis ``i`` ramps through :func:`rich_turning_points` of seed ``i``, its sweeps rotated by
+    ``i``; a faster axis goes on through random turning points until the slowest ends.
+
     Parameters
     ----------
     n_axes : int

@@ -59,8 +59,8 @@ from hystcomp._hyperparameters import (
     Integer,
     validate_parameters,
 )
-from hystcomp._validation import as_signal, check_int, check_real
-from hystcomp.errors import IdentificationError, InvalidParameterError, InvalidSignalError
+from hystcomp._validation import as_signal_pair, check_int, check_real
+from hystcomp.errors import IdentificationError, InvalidParameterError
 from hystcomp.identify import scoring
 from hystcomp.identify.lsq import constrained_lsq, held_out_fits, normal_equations
 from hystcomp.identify.outliers import check_isolated
@@ -264,13 +264,7 @@ def prepare_record(
     PreparedRecord
         The record, ready for the fit.
     """
-    v = as_signal(v, "v", min_samples=2)
-    x = as_signal(x, "x", min_samples=2)
-    if v.size != x.size:
-        raise InvalidSignalError(
-            f"{owner}: 'v' and 'x' must have one sample each per instant. Got {v.size} "
-            f"voltage samples and {x.size} displacement samples."
-        )
+    v, x = as_signal_pair(v, x, ("v", "x"), owner, min_samples=2, kinds=("voltage", "displacement"))
     check_isolated(v, owner)  # one glitch would set the range and the transient's end
     start = check_transient(transient, v, owner, min_used=2 * n_weights)
     keep = thin(v, start, scoring.MAX_SAMPLES)

@@ -297,8 +297,8 @@ def fit_everett_table(alpha, beta, value, *, grid_size: int, voltage_range) -> n
     Parameters
     ----------
     alpha, beta, value : array_like
-        The samples of eq. (2): upper and lower switching voltages (V) and
-        ``X(alpha, beta)`` (µm), e.g. from :func:`everett_samples`.
+        Where the Everett function was sampled, ``alpha >= beta`` (V), and its values there
+        (µm), as :func:`everett_samples` gives them.
     grid_size : int
         Nodes per axis.
     voltage_range : tuple of (float, float)

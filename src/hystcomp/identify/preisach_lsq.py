@@ -187,9 +187,9 @@ class EverettBasis:
         Parameters
         ----------
         v, x : array_like
-            The record: voltage (V) and displacement (µm), one sample each.
+            The record whose :meth:`rows` are summed: voltage (V) and displacement (µm).
         start, stride : int, optional
-            The rows taken: samples ``start, start + stride, ...``.
+            Only the rows of samples ``start, start + stride, ...`` enter the sums.
         folds : array_like of int, optional
             The fold of every sample (-1 for none).
         n_folds : int, optional

@@ -144,7 +144,7 @@ def default_tolerance(v: np.ndarray) -> float:
     Parameters
     ----------
     v : numpy.ndarray
-        The record's voltage, V.
+        The voltage whose span and :func:`input_noise` set the band, V.
 
     Returns
     -------

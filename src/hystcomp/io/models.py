@@ -81,7 +81,7 @@ def model_text(model: Model) -> str:
     Parameters
     ----------
     model : model
-        A fitted model of a kind that :data:`MODEL_KINDS` lists.
+        The fitted model to write: its :func:`model_to_dict`, as indented JSON.
 
     Returns
     -------

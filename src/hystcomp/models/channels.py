@@ -145,6 +145,8 @@ class ChannelBank:
     def stepper(self) -> BankStepper:
         """A streaming bank: ``step(row) -> row`` (C values each), from the initial state.
 
+        A sample takes :attr:`n_groups` kernel calls, one per distinct structure.
+
         Returns
         -------
         BankStepper

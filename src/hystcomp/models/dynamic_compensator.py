@@ -306,7 +306,7 @@ class DynamicsInverseStepper(Rebound):
         Parameters
         ----------
         x_ref : array_like
-            Reference samples, µm.
+            The block, µm; the filter's state advances past it as in :meth:`step_block`.
 
         Returns
         -------
@@ -448,7 +448,7 @@ class DynamicCompensator:
         Parameters
         ----------
         x_ref : array_like
-            The reference displacement, µm, one sample per period of :attr:`sample_rate`.
+            The reference, µm, run from the initial state through a new :meth:`stepper`.
 
         Returns
         -------

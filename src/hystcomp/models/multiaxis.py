@@ -453,12 +453,12 @@ class MultiAxisModel(Estimator):
         Parameters
         ----------
         V : array_like
-            The voltages, V, shape ``(n, N)``.
+            A voltage row per sample and a column per axis, V.
 
         Returns
         -------
         numpy.ndarray
-            The displacements, µm, shape ``(n, N)``.
+            ``simulate(V)``: a displacement row per sample, µm.
         """
         return self.simulate(V)
 

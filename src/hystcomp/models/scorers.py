@@ -53,7 +53,7 @@ def tracking_score(estimator, X, y) -> float:
     >>> from hystcomp import presets
     >>> from hystcomp.identify.excitation import triangle_sequence
     >>> model = presets.paper_mpi()
-    >>> _, v = triangle_sequence(sample_rate=500)
+    >>> v = triangle_sequence(sample_rate=500)[1]  # the voltage of (t, v)
     >>> bool(-1e-6 < tracking_score(model, v[:, None], model.simulate(v)) <= 0.0)
     True
     """

@@ -45,7 +45,7 @@ from hystcomp._validation import check_range, check_real
 from hystcomp.errors import InvalidParameterError
 from hystcomp.models.multiaxis import as_axes
 from hystcomp.plant.parameters import TwinParameters
-from hystcomp.plant.twin import Twin
+from hystcomp.plant.twin import SampleClock, Twin
 
 __all__ = ["KINDS", "Scanner", "ScannerAxis", "raster_scanner"]
 
@@ -133,7 +133,7 @@ def _raw_hysteresis(kind: str, u: np.ndarray) -> np.ndarray:
 
 
 @dataclass(frozen=True)
-class Scanner:
+class Scanner(SampleClock):
     """A multi-axis piezo scanner: voltages (V, (n, N)) in, sensor readings (µm) out.
 
     Parameters
@@ -218,7 +218,7 @@ class Scanner:
         Parameters
         ----------
         V : array_like
-            The voltages, V, shape ``(n, N)``.
+            One voltage column per axis, V, from rest; each is clipped to its axis's range.
 
         Returns
         -------
@@ -253,21 +253,6 @@ class Scanner:
         X = self.run_noiseless(V)
         rng = np.random.default_rng(self.seed if seed is None else seed)
         return X + self.noise_um * rng.standard_normal(X.shape)
-
-    def time(self, n_samples: int) -> np.ndarray:
-        """Times of ``n_samples`` samples from 0, s.
-
-        Parameters
-        ----------
-        n_samples : int
-            The number of samples.
-
-        Returns
-        -------
-        numpy.ndarray
-            ``arange(n_samples) / sample_rate``, s.
-        """
-        return np.arange(int(n_samples)) / self.sample_rate
 
 
 #: The couplings of :func:`raster_scanner` (``M - I``), percent: X into Y 4 %, Y into X

@@ -43,7 +43,32 @@ def _pack(params: TwinParameters) -> np.ndarray:
     return packed
 
 
-class Twin:
+class SampleClock:
+    """What a plant at a fixed ``sample_rate`` (Hz) shares: the times of its samples."""
+
+    @property
+    def sample_rate(self) -> float:
+        """The sample rate, Hz (each plant says its own)."""
+        raise NotImplementedError
+
+    def time(self, n_samples: int) -> np.ndarray:
+        """Time of ``n_samples`` samples from 0, in s.
+
+        Parameters
+        ----------
+        n_samples : int
+            The number of samples.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``arange(n_samples) / sample_rate``, s.
+        """
+        n = check_int(n_samples, "n_samples", f"{type(self).__name__}.time", minimum=0)
+        return np.arange(n) / self.sample_rate
+
+
+class Twin(SampleClock):
     """The simulated piezo axis: command voltage (V) in, measured displacement (µm) out.
 
     Parameters
@@ -92,22 +117,6 @@ class Twin:
         """The amplifier's rails in V."""
         return self.params.voltage_range
 
-    def time(self, n_samples: int) -> np.ndarray:
-        """Time of ``n_samples`` samples from 0, in s.
-
-        Parameters
-        ----------
-        n_samples : int
-            The number of samples.
-
-        Returns
-        -------
-        numpy.ndarray
-            The times, s, at the twin's sample rate.
-        """
-        n = check_int(n_samples, "n_samples", "Twin.time", minimum=0)
-        return np.arange(n) / self.sample_rate
-
     def run_noiseless(self, v) -> np.ndarray:
         """Displacement in µm for the command ``v`` in V, from rest, without sensor noise.
 
@@ -134,7 +143,7 @@ class Twin:
         Parameters
         ----------
         v : array_like
-            The command, V, at the twin's sample rate.
+            The voltage command, V, one sample per ``1 / sample_rate`` s.
 
         Returns
         -------

@@ -214,6 +214,8 @@ def inverse_for(
 ):
     """The compensator of ``model`` for the options of ``compensate`` and ``export-c``.
 
+    The options go to ``model.inverse``, but ``sample_rate`` for a pair (it runs at its own).
+
     Parameters
     ----------
     model : HysteresisModel, HammersteinModel or MultiAxisModel

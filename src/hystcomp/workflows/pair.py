@@ -51,6 +51,8 @@ WORSE = 1.1
 class PairResult:
     """What :func:`identify_pair_record` found.
 
+    The hysteresis model's own result stays apart from the pair's, with its lines first.
+
     Attributes
     ----------
     model : HammersteinModel

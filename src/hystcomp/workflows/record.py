@@ -26,6 +26,8 @@ __all__ = ["ModelResult", "identify_model"]
 class ModelResult:
     """What :func:`identify_model` found.
 
+    Its ``lines`` and ``warnings`` gather those of every step, in order.
+
     Attributes
     ----------
     model : object
