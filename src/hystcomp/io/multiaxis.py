@@ -309,7 +309,7 @@ def parse_any_columns(text: str | None) -> dict[str, int | str] | None:
     Parameters
     ----------
     text : str or None
-        ``key=column`` pairs separated by commas (None for no mapping).
+        The mapping as a user writes it, for one axis or for N; None when there is none.
 
     Returns
     -------
