@@ -10,6 +10,7 @@ largest value), the hold-out in its own colour and the excerpts shaded.
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import numpy as np
