@@ -15,6 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
+from hystcomp.errors import InvalidParameterError
 from hystcomp.experiment._layout import (
     DPI,
     FORMATS,
