@@ -24,7 +24,7 @@ from pathlib import Path
 import click
 
 from hystcomp import _signals
-from hystcomp._notice import worded
+from hystcomp._notice import Notice, worded
 from hystcomp.errors import HystcompError, InvalidParameterError
 
 EXIT_BAD_INPUT, EXIT_INTERNAL = 2, 1
@@ -54,8 +54,6 @@ COMMANDS = {
     for name in TEXT
     if name not in ("remedies", "options")
 }
-#: A library parameter's option where its name is not the option's.
-OPTIONS = {"sample_rate": "--fs", "out_dir": "--out"}
 #: "The 'name' parameter of owner rest": a refused parameter, said as its option's value.
 _PARAMETER = re.compile(
     r"The '(?P<name>\w+)' (?:parameter|argument) of [\w.]+,? (?P<rest>[a-z0-9'].*)"
@@ -108,7 +106,7 @@ class _Command(click.Command):
             found = _PARAMETER.fullmatch(_said(exc))
             if found is None:
                 raise
-            name = OPTIONS.get(found["name"], "--" + found["name"].replace("_", "-"))
+            name = _say(Notice(f"{{arg_{found['name']}}}"))  # its option (words.toml)
             option = next((p for p in self.params if name in p.opts), None)
             if option is not None and ctx.params.get(option.name) is not None:  # given
                 raise click.BadParameter(found["rest"], ctx, param_hint=f"'{name}'") from None

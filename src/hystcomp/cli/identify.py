@@ -7,7 +7,6 @@ from __future__ import annotations
 import click
 
 from hystcomp._hyperparameters import EVERETT_KINDS, MAX_DEGREE
-from hystcomp._validation import MAX_MAGNITUDE
 from hystcomp.cli import _options as opts
 from hystcomp.cli import command
 from hystcomp.identify.preisach import FIT_METHODS
@@ -15,44 +14,8 @@ from hystcomp.identify.preisach_lsq import MAX_LSQ_GRID
 from hystcomp.io.atomic import check_output_path
 from hystcomp.io.multiaxis import is_multiaxis
 from hystcomp.io.records import read_record
-from hystcomp.workflows.identify import LABELS, SIZE_OPTIONS
-from hystcomp.workflows.record import identify_model
-
-#: The options that size or shape the hysteresis model, of every family.
-FAMILY = list(dict.fromkeys(name for names in SIZE_OPTIONS.values() for name in names))
-
-
-def _flags(options: dict) -> dict:
-    return {f"--{name.replace('_', '-')}": value for name, value in options.items()}
-
-
-def _check_options(kind: str, given: dict) -> None:
-    """Refuse, in the command's words, an option that --model (or --everett) does not take."""
-    if kind != "auto":
-        others = {k: v for k, v in given.items() if k not in SIZE_OPTIONS[kind]}
-        opts.refuse(_flags(others), f"--model {kind}")
-    if given["everett"] == "table" and given["degree"] is not None:
-        raise click.UsageError("--degree applies to --everett polynomial; a table has --grid.")
-    if given["grid"] is not None and given["everett"] == "polynomial":
-        raise click.UsageError("--grid applies to --everett table.")
-    if given["grid"] is not None and given["degree"] is not None:
-        raise click.UsageError(
-            "--grid and --degree exclude each other: --degree fits the polynomial of eq. 5, "
-            "--grid a table; give one of them."
-        )
-
-
-def _regularization(ctx, param, value):
-    """``--regularization``: ``auto`` or a number >= 0."""
-    try:
-        number = float(value) if value not in (None, "auto") else 0.0
-    except ValueError:
-        number = float("nan")
-    if not 0 <= number <= MAX_MAGNITUDE:
-        raise click.BadParameter(
-            f"must be 'auto' or a number from 0 to {MAX_MAGNITUDE:g}; got {value!r}.", param=param
-        )
-    return value if value in (None, "auto") else number
+from hystcomp.workflows.identify import LABELS
+from hystcomp.workflows.record import check_identification, identify_model
 
 
 @command("identify")
@@ -66,7 +29,7 @@ def _regularization(ctx, param, value):
 @click.option("--fit", "--fit-method", cls=opts.Alias, type=click.Choice(FIT_METHODS))
 @click.option("--everett", type=click.Choice(EVERETT_KINDS))
 @click.option("--grid", type=click.IntRange(2, MAX_LSQ_GRID))
-@click.option("--regularization", metavar="LAMBDA|auto", callback=_regularization)
+@click.option("--regularization", metavar="LAMBDA|auto")
 @click.option("--constraints", type=click.Choice(["physical", "paper"]))
 @click.option("--initial-memory", type=click.Choice(["auto", "virgin", "descended"]))
 @opts.reading
@@ -78,27 +41,16 @@ def _regularization(ctx, param, value):
 @click.option("--jobs", "n_jobs", type=int)
 @click.option("--plot", metavar="FILE")
 @click.option("-o", "--output", required=True, metavar="MODEL.json")
-def identify(data, kind, output, plot, dynamics_record, holdout, voltage_range, **o):
+def identify(data, kind, output, plot, dynamics_record, holdout, **o):
     """``hystcomp identify``: parse, identify (:mod:`hystcomp.workflows`), print, write."""
     inputs = (data,) if dynamics_record is None else (data, dynamics_record)
     check_output_path(output, inputs=inputs, what="model file")
-    options = {name: o[name] for name in FAMILY}
     multi = is_multiaxis(data, o["columns"])
-    if multi:  # N coupled axes: each axis's model and the coupling
-        given = {"--model dynamics": kind == "dynamics" or None, "--holdout": holdout}
-        given.update({"--dynamics-record": dynamics_record, "--plot": plot})
-        opts.refuse(given, "an N-axis record")
-    elif kind == "dynamics":  # linear dynamics: a record of 'hystcomp excite dynamics'
-        given = {**_flags(options), "--transient": o["transient"], "--voltage-range": voltage_range}
-        given.update({"--holdout": holdout, "--dynamics-record": dynamics_record})
-        opts.refuse(given, "--model dynamics")
-    elif o["n_jobs"] is not None:
-        raise click.UsageError("--jobs applies to N-axis records (columns v1..vN, x1..xN).")
-    _check_options(kind, options)
+    given = {"holdout": holdout, "dynamics_record": dynamics_record, "plot": plot, **o}
+    fitting = check_identification(kind, axes=multi, **given)  # before any record is read
     if plot is not None:
         opts.check_plot(plot, inputs=inputs, output=output)
-    fitting = {k: v for k, v in options.items() if v is not None}
-    fitting.update(voltage_range=voltage_range, allow_extrapolation=o["allow_extrapolation"])
+    fitting.update(voltage_range=o["voltage_range"], allow_extrapolation=o["allow_extrapolation"])
     fitting.update(transient=o["transient"], unit_check=False)  # checked here, before the fit
 
     def ticking(what: str):
