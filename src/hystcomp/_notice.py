@@ -56,6 +56,8 @@ PYTHON = {
     "rate_name": "sample_rate",
     "saved_by": "hystcomp.save_model",
     "export_model": "generate_c(model.inverse(), ...)",
+    "not_read": "which is not read",
+    "to_file": "Write it to a file",
     # an argument, ``{arg_NAME}`` (where the vocabulary has no ``arg_NAME`` of its own),
     # and the argument given the notice's ``value``, ``{set_NAME}``
     "arg_": "'{name}'",

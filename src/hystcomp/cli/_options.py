@@ -10,7 +10,6 @@ command that needs no kernel (``excite``) then loads neither numba nor SciPy's s
 from __future__ import annotations
 
 import math
-import sys
 
 import click
 
@@ -19,8 +18,8 @@ from hystcomp._notice import worded
 from hystcomp._progress import Progress
 from hystcomp._validation import MAX_MAGNITUDE
 from hystcomp.cli import TEXT, _say
-from hystcomp.errors import InvalidParameterError, OutputPathError
-from hystcomp.io.records import X_UNITS, format_csv  # light: no compiled code until used
+from hystcomp.errors import InvalidParameterError
+from hystcomp.io.records import X_UNITS  # light: no compiled code until used
 
 
 def _finite(value: float, param) -> float:
@@ -112,13 +111,6 @@ def report(*results, lines: bool = True, warnings: bool = True) -> None:
         click.echo(f"hystcomp: warning: {_say(warning)}", err=True)
 
 
-def refuse(given: dict, why: str) -> None:
-    """Refuse, in the command's words, the first option given that ``why`` does not take."""
-    for option, value in given.items():
-        if value is not None and value is not False:
-            raise click.UsageError(f"{option} does not apply to {why}.")
-
-
 def read_options(given: dict, path="", *, reads: tuple[str, ...] | None = ("v", "x")) -> dict:
     """Keyword arguments for :func:`hystcomp.io.records.read_table` from the shared options.
 
@@ -126,19 +118,10 @@ def read_options(given: dict, path="", *, reads: tuple[str, ...] | None = ("v", 
     another one is refused (it would be ignored, and was most likely meant for one read).
     None (an N-axis file) checks nothing.
     """
-    from hystcomp.io.records import MEANINGS
+    from hystcomp.io.records import check_columns_read
 
-    named = given.get("columns") or {}
-    unused = [key for key in named if reads is not None and key not in ("t", *reads)]
-    if reads is not None and unused:
-        key, spec = unused[0], named[unused[0]]
-        meant = next((k for k in reads if k not in named), reads[0])
-        raise click.BadParameter(
-            f"{key}={spec} names a column of {MEANINGS[key].split(' in ')[0]}, which this "
-            f"command does not read (it reads t and {' and '.join(reads)}); name the column "
-            f"of {MEANINGS[meant].split(' in ')[0]} instead, e.g. --columns {meant}={spec}.",
-            param_hint="'--columns'",
-        )
+    if reads is not None:
+        check_columns_read(given.get("columns"), reads)
     options = {k: given.get(k) for k in ("columns", "sample_rate", "x_unit")}
     if not given.get("quiet"):
         options["progress"] = Progress(f"reading {click.format_filename(str(path))}")
@@ -199,18 +182,9 @@ def write_model(model, output, plot=None, draw=None) -> None:
 
 def write_signal(table: dict, output, quiet: bool, summary: str) -> None:
     """Write ``table`` to ``output`` and say ``summary``, or print it as CSV without one."""
-    from hystcomp.io.records import write_table
+    from hystcomp.io.records import print_table, write_table
 
-    if output is not None:
-        write_table(output, table, progress=progress(f"writing {output}", quiet))
-        return click.echo(f"wrote {output}: {summary}")
-    try:
-        click.echo(format_csv(table), nl=False)
-        sys.stdout.flush()
-    except BrokenPipeError:
-        raise  # the reader went away (| head): not an error
-    except OSError as exc:
-        raise OutputPathError(
-            f"Cannot write the signal to standard output: {exc.strerror or exc}. Give a "
-            "file with -o, or check where standard output goes."
-        ) from None
+    if output is None:
+        return print_table(table)
+    write_table(output, table, progress=progress(f"writing {output}", quiet))
+    click.echo(f"wrote {output}: {summary}")
