@@ -31,17 +31,6 @@ EXIT_BAD_INPUT, EXIT_INTERNAL = 2, 1
 EXIT_BROKEN_PIPE = 141  # 128 + SIGPIPE, as a shell reports a command killed by it
 
 
-def _remove_pending() -> None:
-    """Remove the temporary outputs of a failed write (none if no file module ran)."""
-    atomic = sys.modules.get("hystcomp.io.atomic")  # not imported here if no file was written
-    if atomic is not None:
-        atomic.remove_pending()
-
-
-def _one_line(text: object) -> str:
-    return " ".join(str(text).split())
-
-
 #: The command line's words (words.toml): each command's and option's help, and the remedies
 #: that the library's sentences name (:class:`hystcomp._notice.Notice`).
 TEXT = tomllib.loads((Path(__file__).parent / "words.toml").read_text(encoding="utf-8"))
@@ -88,7 +77,7 @@ def command(name: str) -> Callable[[Callable], click.Command]:
 
 def _say(text: str) -> str:
     """A library sentence in the command line's words (words.toml's remedies), on one line."""
-    return _one_line(worded(text, TEXT["remedies"]))
+    return " ".join(worded(text, TEXT["remedies"]).split())
 
 
 def _said(exc: BaseException) -> str:
@@ -149,6 +138,27 @@ class _Group(click.Group):
             sys.exit(status)
 
 
+def _refusal(exc: OSError) -> str:
+    from hystcomp.io.atomic import refusal
+
+    return refusal(exc)
+
+
+#: What stops a command, first match: (its kind, the exit status (None: its own), the line).
+_FAILURES: tuple = (
+    (click.exceptions.Abort, EXIT_INTERNAL, lambda e: "aborted"),
+    (click.UsageError, EXIT_BAD_INPUT, lambda e: f"error: {_say(e.format_message())}"
+     + (f" (see '{e.ctx.command_path} --help')" if e.ctx is not None else "")),
+    (click.ClickException, None, lambda e: f"error: {_say(e.format_message())}"),
+    (HystcompError, EXIT_BAD_INPUT, lambda e: f"error: {_said(e)}"),
+    (MemoryError, EXIT_BAD_INPUT, lambda e: "error: not enough memory for this input; use a "
+     "shorter record, fewer operators or a lower sample rate."),
+    (OSError, EXIT_BAD_INPUT, lambda e: f"error: {_refusal(e)}"),  # a path or write refused
+    (BaseException, EXIT_INTERNAL, lambda e: f"internal error: {type(e).__name__}: "
+     f"{_say(str(e))} (please report it with the command you ran)"),
+)  # fmt: skip
+
+
 def _failure(exc: BaseException) -> tuple[int, str | None]:
     """The exit status of a command that raised ``exc``, and the line that says why."""
     if isinstance(exc, click.exceptions.Abort) and isinstance(exc.__cause__, KeyboardInterrupt):
@@ -161,30 +171,11 @@ def _failure(exc: BaseException) -> tuple[int, str | None]:
         with contextlib.suppress(OSError, ValueError):  # no flush error at exit either
             os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return EXIT_BROKEN_PIPE, None
-    if isinstance(exc, click.exceptions.Abort | OSError):
-        _remove_pending()
-    if isinstance(exc, click.exceptions.Abort):
-        return EXIT_INTERNAL, "hystcomp: aborted"
-    if isinstance(exc, click.UsageError):
-        hint = f" (see '{exc.ctx.command_path} --help')" if exc.ctx is not None else ""
-        return EXIT_BAD_INPUT, f"hystcomp: error: {_one_line(exc.format_message())}{hint}"
-    if isinstance(exc, click.ClickException):
-        return exc.exit_code, f"hystcomp: error: {_one_line(exc.format_message())}"
-    if isinstance(exc, HystcompError):
-        return EXIT_BAD_INPUT, f"hystcomp: error: {_said(exc)}"
-    if isinstance(exc, MemoryError):
-        return EXIT_BAD_INPUT, (
-            "hystcomp: error: not enough memory for this input; use a shorter record, fewer "
-            "operators or a lower sample rate."
-        )
-    if isinstance(exc, OSError):  # the system refused a path or a write: bad input, no fault
-        from hystcomp.io.atomic import refusal
-
-        return EXIT_BAD_INPUT, f"hystcomp: error: {refusal(exc)}"
-    return EXIT_INTERNAL, (  # an internal fault: say so, briefly
-        f"hystcomp: internal error: {type(exc).__name__}: {_one_line(exc)} (please report it "
-        "with the command you ran)"
-    )
+    atomic = sys.modules.get("hystcomp.io.atomic")  # not imported if no file was written
+    if isinstance(exc, click.exceptions.Abort | OSError) and atomic is not None:
+        atomic.remove_pending()  # the temporary outputs of a failed write
+    _, status, say = next(f for f in _FAILURES if isinstance(exc, f[0]))
+    return status or getattr(exc, "exit_code", EXIT_INTERNAL), f"hystcomp: {say(exc)}"
 
 
 @click.group(cls=_Group, context_settings={"help_option_names": ["-h", "--help"]})
