@@ -1,10 +1,6 @@
-"""What the commands share: the checks on option values, the shared options, reading a file,
-progress, and writing the outputs.
-
-Every value is checked when click parses it (a callback), so that a bad option is refused
-before any file is read or any work is done, with one line naming the option and the fix.
-hystcomp.io.records's readers, hystcomp.io.models and the models are imported where used: a
-command that needs no kernel (``excite``) then loads neither numba nor SciPy's sparse solvers.
+"""What the commands share: checks on option values, made when click parses them (before any
+file is read or any work done), the shared options, reading, progress and writing. Readers,
+models and figures are imported where used: ``excite`` loads neither numba nor SciPy's solvers.
 """
 
 from __future__ import annotations
@@ -22,21 +18,18 @@ from hystcomp.errors import InvalidParameterError
 from hystcomp.io.records import X_UNITS  # light: no compiled code until used
 
 
-def _finite(value: float, param) -> float:
-    if not (math.isfinite(value) and abs(value) <= MAX_MAGNITUDE):
-        raise click.BadParameter(
-            f"must be a finite number of size at most {MAX_MAGNITUDE:g}; got {value!r}.",
-            param=param,
-        )
-    return value
-
-
-def check(test, words: str):
-    """A callback: a value given must pass ``test(value, param)``, else ``words`` (formatted
-    with it as ``v``) say what it must be."""
+def check(test, words: str, finite: bool = False):
+    """A callback: a value given must pass ``test(value)``, else ``words`` (formatted with it
+    as ``v``) say what it must be; with ``finite``, each of its numbers must be finite first."""
 
     def callback(ctx, param, value):
-        if value is not None and not test(value, param):
+        for number in (value if isinstance(value, tuple) else (value,)) if finite else ():
+            if number is not None and not (math.isfinite(number) and abs(number) <= MAX_MAGNITUDE):
+                raise click.BadParameter(
+                    f"must be a finite number of size at most {MAX_MAGNITUDE:g}; got {number!r}.",
+                    param=param,
+                )
+        if value is not None and not test(value):
             raise click.BadParameter(words.format(v=value), param=param)
         return value
 
@@ -45,21 +38,18 @@ def check(test, words: str):
 
 def positive(unit: str, strict: bool = True):
     """A callback: a finite number > 0 (>= 0 unless ``strict``) in ``unit``."""
-    return check(
-        lambda v, param: _finite(v, param) > 0 or (not strict and v == 0),
-        f"must be a number {'>' if strict else '>='} 0 ({unit}); got {{v!r}}.",
-    )
+    words = f"must be a number {'>' if strict else '>='} 0 ({unit}); got {{v!r}}."
+    return check(lambda v: v > 0 or (not strict and v == 0), words, finite=True)
 
 
-fraction = check(lambda v, _: 0.0 < v < 1.0, "must be between 0 and 1 (exclusive); got {v!r}.")
+fraction = check(lambda v: 0.0 < v < 1.0, "must be between 0 and 1 (exclusive); got {v!r}.")
 count = check(
-    lambda v, _: 1 <= v <= MAX_OPERATORS,
+    lambda v: 1 <= v <= MAX_OPERATORS,
     f"must be between 1 and {MAX_OPERATORS} (the paper uses 16; the fit grows as the cube of "
     "the count); got {v}.",
 )
 voltage_range = check(  # LO HI in V
-    lambda v, param: _finite(v[0], param) < _finite(v[1], param),
-    "must be LO HI with LO < HI (V); got {v[0]:g} {v[1]:g}.",
+    lambda v: v[0] < v[1], "must be LO HI with LO < HI (V); got {v[0]:g} {v[1]:g}.", finite=True
 )
 
 
@@ -112,12 +102,8 @@ def report(*results, lines: bool = True, warnings: bool = True) -> None:
 
 
 def read_options(given: dict, path="", *, reads: tuple[str, ...] | None = ("v", "x")) -> dict:
-    """Keyword arguments for :func:`hystcomp.io.records.read_table` from the shared options.
-
-    ``reads`` are the columns the command reads besides t: a ``--columns`` entry for
-    another one is refused (it would be ignored, and was most likely meant for one read).
-    None (an N-axis file) checks nothing.
-    """
+    """Keyword arguments for :func:`hystcomp.io.records.read_table` from the shared options;
+    a ``--columns`` entry for a column but t and ``reads`` is refused (none: N axes)."""
     from hystcomp.io.records import check_columns_read
 
     if reads is not None:
@@ -155,13 +141,6 @@ def warn_x_unit(x, source, given: dict) -> None:
     message = x_unit_warning(x, str(source), given.get("x_unit"))
     if message and not given.get("quiet"):
         click.echo(f"hystcomp: warning: {message}", err=True)
-
-
-def check_plot(plot, *, inputs=(), output=None) -> None:
-    """Refuse, before any work, a figure the command cannot write (without matplotlib yet)."""
-    from hystcomp.experiment.fig_identification import check_figure_output
-
-    check_figure_output(plot, inputs=inputs, output=output)
 
 
 def wrote(paths) -> None:

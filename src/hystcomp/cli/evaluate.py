@@ -22,8 +22,10 @@ def evaluate(reference, measured, as_json, plot, skip, **o):
     """``hystcomp evaluate``: parse, evaluate (:mod:`hystcomp.workflows`), print."""
     from hystcomp.workflows.evaluate import evaluate as run_evaluation
 
-    if plot is not None:
-        opts.check_plot(plot, inputs=(reference, measured))
+    if plot is not None:  # refused before any work
+        from hystcomp.experiment.fig_identification import check_figure_output
+
+        check_figure_output(plot, inputs=(reference, measured))
     reading = opts.read_options(o, measured, reads=("v", "x"))
     result = run_evaluation(reference, measured, skip=skip, **reading)
     opts.warn_x_unit(result.x, measured, o)

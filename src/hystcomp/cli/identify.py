@@ -48,8 +48,10 @@ def identify(data, kind, output, plot, dynamics_record, holdout, **o):
     multi = is_multiaxis(data, o["columns"])
     given = {"holdout": holdout, "dynamics_record": dynamics_record, "plot": plot, **o}
     fitting = check_identification(kind, axes=multi, **given)  # before any record is read
-    if plot is not None:
-        opts.check_plot(plot, inputs=inputs, output=output)
+    if plot is not None:  # refused before any work
+        from hystcomp.experiment.fig_identification import check_figure_output
+
+        check_figure_output(plot, inputs=inputs, output=output)
     fitting.update(voltage_range=o["voltage_range"], allow_extrapolation=o["allow_extrapolation"])
     fitting.update(transient=o["transient"], unit_check=False)  # checked here, before the fit
 
