@@ -1,12 +1,9 @@
-"""The ``hystcomp`` command.
+"""The ``hystcomp`` command: each subcommand in a module of its own, registered on :data:`main`.
 
-Each subcommand lives in its own module of this package and registers itself on
-:data:`main`. Exit status: 0 on success, 2 on bad usage or bad input (one line on
-standard error that names the problem and the fix, no traceback), 1 on an internal fault,
-141 when standard output is closed early (``| head``), 130 on Ctrl-C (SIGINT), 143 on
-SIGTERM and 129 on SIGHUP (the terminal closed); an interrupted command removes its
-temporary files and leaves its outputs as they were (:mod:`hystcomp._signals`).
-``hystcomp`` alone prints its usage and commands on standard error (exit 2).
+Exit status: 0 on success, 2 on bad usage or input (one line on standard error naming the
+problem and the fix), 1 on an internal fault, 141 when standard output is closed early
+(``| head``), 130, 143 and 129 on SIGINT, SIGTERM and SIGHUP (temporary files removed, outputs
+left as they were: :mod:`hystcomp._signals`). ``hystcomp`` alone prints its usage (exit 2).
 """
 
 from __future__ import annotations
@@ -34,10 +31,8 @@ EXIT_BROKEN_PIPE = 141  # 128 + SIGPIPE, as a shell reports a command killed by 
 #: The command line's words (words.toml): each command's and option's help, and the remedies
 #: that the library's sentences name (:class:`hystcomp._notice.Notice`).
 TEXT = tomllib.loads((Path(__file__).parent / "words.toml").read_text(encoding="utf-8"))
-#: Subcommand -> (its module, the first line of its help). A module is imported only when its
-#: command runs or shows its own help, so that ``hystcomp --help``, a mistyped command and
-#: shell completion load neither numba nor SciPy (tests/cli/test_cli_lazy.py checks that this
-#: table matches the commands).
+#: Subcommand -> (its module, its help's first line). A module is imported only when its command
+#: runs or shows its help: ``hystcomp --help`` and completion load neither numba nor SciPy.
 COMMANDS = {
     name: (f"hystcomp.cli.{name.replace('-', '_')}", TEXT[name]["help"].split("\n")[0])
     for name in TEXT
@@ -55,13 +50,13 @@ def command(name: str) -> Callable[[Callable], click.Command]:
     Parameters
     ----------
     name : str
-        The subcommand, whose table in words.toml holds its help and its options' (an
-        option that the table does not word has the help of ``[options]``).
+        The subcommand, whose table in words.toml holds its help and its options' (else
+        ``[options]``'s).
 
     Returns
     -------
     callable
-        The decorator: it takes the function, with its click options, and returns the command.
+        The decorator, from the function with its click options to the command.
     """
     words = {**TEXT["options"], **TEXT[name]}
 
@@ -75,14 +70,11 @@ def command(name: str) -> Callable[[Callable], click.Command]:
     return register
 
 
-def _say(text: str) -> str:
-    """A library sentence in the command line's words (words.toml's remedies), on one line."""
+def _say(text) -> str:
+    """A library sentence, or an error's, in the command line's words (words.toml's remedies)."""
+    if isinstance(text, BaseException):
+        text = text.args[0] if len(text.args) == 1 else str(text)
     return " ".join(worded(text, TEXT["remedies"]).split())
-
-
-def _said(exc: BaseException) -> str:
-    """An error's message in the command line's words (a notice's remedies as options)."""
-    return _say(exc.args[0] if len(exc.args) == 1 else str(exc))
 
 
 class _Command(click.Command):
@@ -92,7 +84,7 @@ class _Command(click.Command):
         try:
             return super().invoke(ctx)
         except InvalidParameterError as exc:
-            found = _PARAMETER.fullmatch(_said(exc))
+            found = _PARAMETER.fullmatch(_say(exc))
             if found is None:
                 raise
             name = _say(Notice(f"{{arg_{found['name']}}}"))  # its option (words.toml)
@@ -103,11 +95,8 @@ class _Command(click.Command):
 
 
 class _Group(click.Group):
-    """A click group that turns bad usage and hystcomp's errors into one line and exit 2.
-
-    Its subcommands are imported lazily from :data:`COMMANDS`, when one runs; each module
-    registers its command on :data:`main` when imported. Until then, a stand-in lists it.
-    """
+    """Bad usage and hystcomp's errors as one line and exit 2; the subcommands imported from
+    :data:`COMMANDS` when one runs (each registers itself), a stand-in listing it until then."""
 
     command_class = _Command
 
@@ -138,22 +127,17 @@ class _Group(click.Group):
             sys.exit(status)
 
 
-def _refusal(exc: OSError) -> str:
-    from hystcomp.io.atomic import refusal
-
-    return refusal(exc)
-
-
 #: What stops a command, first match: (its kind, the exit status (None: its own), the line).
 _FAILURES: tuple = (
     (click.exceptions.Abort, EXIT_INTERNAL, lambda e: "aborted"),
     (click.UsageError, EXIT_BAD_INPUT, lambda e: f"error: {_say(e.format_message())}"
      + (f" (see '{e.ctx.command_path} --help')" if e.ctx is not None else "")),
     (click.ClickException, None, lambda e: f"error: {_say(e.format_message())}"),
-    (HystcompError, EXIT_BAD_INPUT, lambda e: f"error: {_said(e)}"),
+    (HystcompError, EXIT_BAD_INPUT, lambda e: f"error: {_say(e)}"),
     (MemoryError, EXIT_BAD_INPUT, lambda e: "error: not enough memory for this input; use a "
      "shorter record, fewer operators or a lower sample rate."),
-    (OSError, EXIT_BAD_INPUT, lambda e: f"error: {_refusal(e)}"),  # a path or write refused
+    (OSError, EXIT_BAD_INPUT, lambda e: "error: "  # the system refused a path or a write
+     + importlib.import_module("hystcomp.io.atomic").refusal(e)),
     (BaseException, EXIT_INTERNAL, lambda e: f"internal error: {type(e).__name__}: "
      f"{_say(str(e))} (please report it with the command you ran)"),
 )  # fmt: skip
