@@ -72,7 +72,7 @@ def _columns(ctx, param, value):
 
 #: ``--voltage-range LO HI`` of compensate and export-c: a clamp inside the model's range.
 narrow_range = click.option(
-    "--voltage-range", "narrow_range", nargs=2, type=float, metavar="LO HI", callback=voltage_range
+    "--voltage-range", nargs=2, type=float, metavar="LO HI", callback=voltage_range
 )
 
 

@@ -34,19 +34,10 @@ def compensate(model_file, reference_file, output, dynamics_file, **o):
     model, dynamics = load_compensation(model_file, dynamics_file)
     multi = isinstance(model, MultiAxisModel)  # t, x1..xN -> t, v1..vN, x1_ref..xN_ref
     table = opts.read_input(reference_file, ("x",), o, multi=multi)
-    result = compensate_reference(
-        model,
-        table["t"],
-        table["x"],
-        source=str(model_file),
-        reference=str(reference_file),
-        voltage_range=o["narrow_range"],
-        method=o["method"],
-        slew_rate=o["slew_rate"],
-        dynamics=dynamics,
-        strict=o["strict"],
-        progress=opts.progress("computing the voltage" + "s" * multi, o["quiet"]).ticking(),
-    )
+    given = {k: o[k] for k in ("voltage_range", "method", "slew_rate", "strict")}
+    given.update(source=str(model_file), reference=str(reference_file), dynamics=dynamics)
+    ticking = opts.progress("computing the voltage" + "s" * multi, o["quiet"]).ticking()
+    result = compensate_reference(model, table["t"], table["x"], progress=ticking, **given)
     opts.report(result)
     written = opts.progress(f"writing {output}", o["quiet"])
     write_table(output, axis_table(table["t"], v=result.v, x_ref=table["x"]), progress=written)

@@ -38,18 +38,8 @@ def export_c_command(model_file, directory, prefix, dynamics_file, **o):
     for suffix in (".h", ".c") if directory.is_dir() else ():  # never overwrite the model
         check_output_path(directory / f"{prefix}{suffix}", inputs=(model_file,))
     model, dynamics = load_compensation(model_file, dynamics_file)
-    result = export_compensator(
-        model,
-        directory,
-        prefix=prefix,
-        source=str(model_file),
-        sample_rate=o["sample_rate"],
-        slew_rate=o["slew_rate"],
-        voltage_range=o["narrow_range"],
-        method=o["method"],
-        dynamics=dynamics,
-        inputs=(model_file,),
-    )
+    given = dict(o, prefix=prefix, source=str(model_file), dynamics=dynamics)
+    result = export_compensator(model, directory, inputs=(model_file,), **given)
     opts.report(result)
     paths = [str(p) for p in result.paths]
     click.echo(f"wrote {' and '.join(paths) if len(paths) == 2 else ', '.join(paths)}")

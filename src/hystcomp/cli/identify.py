@@ -49,11 +49,11 @@ def identify(data, kind, output, plot, dynamics_record, holdout, **o):
     given = {"holdout": holdout, "dynamics_record": dynamics_record, "plot": plot, **o}
     fitting = check_identification(kind, axes=multi, **given)  # before any record is read
     if plot is not None:  # refused before any work
-        from hystcomp.experiment.fig_identification import check_figure_output
+        from hystcomp.experiment.fig_identification import check_figure_output, plot_identified
 
         check_figure_output(plot, inputs=inputs, output=output)
-    fitting.update(voltage_range=o["voltage_range"], allow_extrapolation=o["allow_extrapolation"])
-    fitting.update(transient=o["transient"], unit_check=False)  # checked here, before the fit
+    fitting.update({k: o[k] for k in ("voltage_range", "allow_extrapolation", "transient")})
+    fitting.update(unit_check=False, holdout=holdout)  # the unit checked here, before the fit
 
     def ticking(what: str):
         return opts.progress(f"identifying {what}", o["quiet"]).ticking()
@@ -61,8 +61,7 @@ def identify(data, kind, output, plot, dynamics_record, holdout, **o):
     if multi:
         from hystcomp.workflows.multiaxis import identify_axes
 
-        table = opts.read_input(data, ("v", "x"), o, multi=True)
-        t, v, x = table["t"], table["v"], table["x"]
+        t, v, x = (opts.read_input(data, ("v", "x"), o, multi=True)[k] for k in "tvx")
         with ticking(f"{v.shape[1]} axes"):
             axes = identify_axes(
                 t, v, x, kind=kind, n_jobs=o["n_jobs"], source=str(data), **fitting
@@ -73,19 +72,8 @@ def identify(data, kind, output, plot, dynamics_record, holdout, **o):
     rec = read_record(data, **(plain if kind == "dynamics" else opts.read_options(o, data)))
     if kind != "dynamics":
         opts.warn_x_unit(rec.x, data, o)
-    found = identify_model(
-        rec,
-        kind,
-        dynamics_record=None if dynamics_record is None else read_record(dynamics_record, **plain),
-        holdout=holdout,
-        progress=lambda k: ticking(f"the {LABELS[k]} model"),
-        **({} if kind == "dynamics" else fitting),
-    )
-    opts.report(found)
-
-    def draw(path):  # the fitted part and the hold-out as the model predicts it, or a Bode plot
-        from hystcomp.experiment.fig_identification import plot_identified
-
-        plot_identified(rec, found, path)
-
-    opts.write_model(found.model, output, plot, draw)
+    dyn = None if dynamics_record is None else read_record(dynamics_record, **plain)
+    progress = lambda k: ticking(f"the {LABELS[k]} model")
+    found = identify_model(rec, kind, dynamics_record=dyn, progress=progress, **fitting)
+    opts.report(found)  # a figure of the fit and the hold-out as predicted, or a Bode plot
+    opts.write_model(found.model, output, plot, lambda path: plot_identified(rec, found, path))
