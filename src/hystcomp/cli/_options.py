@@ -70,10 +70,10 @@ def _columns(ctx, param, value):
         raise click.BadParameter(str(exc), param=param) from None
 
 
-#: ``--voltage-range LO HI`` of compensate and export-c: a clamp inside the model's range.
-narrow_range = click.option(
-    "--voltage-range", nargs=2, type=float, metavar="LO HI", callback=voltage_range
-)
+#: ``--voltage-range LO HI`` (V): identify's and excite's range, compensate's and export-c's clamp.
+RANGE = {"nargs": 2, "type": float, "metavar": "LO HI", "callback": voltage_range}
+#: A rate in Hz (--fs, --frequency).
+HZ = {"type": float, "metavar": "HZ", "callback": positive("Hz")}
 
 
 def method_option(f):
@@ -89,7 +89,7 @@ quiet = click.option("--quiet", "-q", is_flag=True)
 def reading(f):
     """The options of a command that reads a data file: --columns, --fs, --x-unit, --quiet."""
     f = click.option("--x-unit", type=click.Choice(X_UNITS))(quiet(f))
-    f = click.option("--fs", "sample_rate", type=float, metavar="HZ", callback=positive("Hz"))(f)
+    f = click.option("--fs", "sample_rate", **HZ)(f)
     return click.option("--columns", metavar="SPEC", callback=_columns)(f)
 
 

@@ -23,7 +23,7 @@ from hystcomp.workflows.compensate import (
 @click.option("-o", "--output", required=True, metavar="FILE")
 @opts.reading
 @click.option("--slew-rate", type=float, metavar="V/S", callback=opts.positive("V/s"))
-@opts.narrow_range
+@click.option("--voltage-range", **opts.RANGE)
 @opts.method_option
 @click.option("--dynamics", "dynamics_file", metavar="DYN.json")
 @click.option("--strict", is_flag=True)

@@ -14,22 +14,16 @@ from hystcomp.codegen import DEFAULT_PREFIX, check_prefix
 from hystcomp.io.atomic import check_output_path
 from hystcomp.workflows.compensate import export_compensator, load_compensation
 
+STEP_HZ = {**opts.HZ, "callback": opts.positive("Hz, the rate at which NAME_step is called")}
+
 
 @command("export-c")
 @click.argument("model_file", type=click.Path(path_type=Path))
 @click.option("-o", "--output", "directory", required=True, type=click.Path(path_type=Path))
 @click.option("--prefix", default=DEFAULT_PREFIX, show_default=True)
 @click.option("--slew-rate", type=float, metavar="V_PER_S", callback=opts.positive("V/s"))
-@click.option(
-    "--fs",
-    "sample_rate",
-    type=float,
-    default=paper.SAMPLE_RATE,
-    show_default=True,
-    metavar="HZ",
-    callback=opts.positive("Hz, the rate at which NAME_step is called"),
-)
-@opts.narrow_range
+@click.option("--fs", "sample_rate", default=paper.SAMPLE_RATE, show_default=True, **STEP_HZ)
+@click.option("--voltage-range", **opts.RANGE)
 @opts.method_option
 @click.option("--dynamics", "dynamics_file", metavar="DYN.json")
 def export_c_command(model_file, directory, prefix, dynamics_file, **o):

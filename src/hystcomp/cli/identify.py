@@ -34,7 +34,7 @@ from hystcomp.workflows.record import check_identification, identify_model
 @click.option("--initial-memory", type=click.Choice(["auto", "virgin", "descended"]))
 @opts.reading
 @click.option("--transient", type=float, metavar="SECONDS", callback=opts.positive("s", False))
-@click.option("--voltage-range", nargs=2, type=float, metavar="LO HI", callback=opts.voltage_range)
+@click.option("--voltage-range", **opts.RANGE)
 @click.option("--allow-extrapolation", is_flag=True)
 @click.option("--holdout", type=float, metavar="FRACTION", callback=opts.fraction)
 @click.option("--dynamics-record", metavar="DYN")
