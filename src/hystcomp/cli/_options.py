@@ -115,16 +115,13 @@ def read_options(given: dict, path="", *, reads: tuple[str, ...] | None = ("v", 
 
 
 def read_input(path, keys: tuple[str, ...], given: dict, *, multi: bool, optional=()) -> dict:
-    """The columns t and ``keys`` (one per axis if ``multi``) of the file at ``path``, read
-    with the shared options, and ``optional`` ones that it has (one axis)."""
-    from hystcomp.io.multiaxis import read_axes
-    from hystcomp.io.records import read_table
+    """:func:`hystcomp.io.multiaxis.read_columns` with the shared options; a displacement
+    read (one axis) is checked for its unit."""
+    from hystcomp.io.multiaxis import read_columns
 
-    options = read_options(given, path, reads=None if multi else (*keys, *optional))
-    if multi:
-        return read_axes(path, keys, **options)
-    table = read_table(path, keys, optional=optional, **options)
-    if "x" in table:  # a displacement, in µm like the model
+    options = read_options(given, path, reads=None)
+    table = read_columns(path, keys, axes=multi, optional=optional, **options)
+    if "x" in table and not multi:  # a displacement, in µm like the model
         warn_x_unit(table["x"], path, given)
     return table
 

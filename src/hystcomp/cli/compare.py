@@ -24,10 +24,8 @@ def compare(out_dir: str, seed: int, periods: int | None, quick: bool, quiet: bo
     from hystcomp.workflows.compare import compare_on_twin
 
     start = time.perf_counter()
-    changes: dict[str, Any] = {"seed": seed}
-    if periods is not None:
-        changes["periods"] = periods
-    config = CompareConfig.quick(**changes) if quick else CompareConfig(**changes)
+    changes: dict[str, Any] = {"seed": seed} | ({} if periods is None else {"periods": periods})
+    config = (CompareConfig.quick if quick else CompareConfig)(**changes)
 
     def progress(line: str) -> None:
         if not quiet:

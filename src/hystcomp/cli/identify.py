@@ -54,10 +54,7 @@ def identify(data, kind, output, plot, dynamics_record, holdout, **o):
         check_figure_output(plot, inputs=inputs, output=output)
     fitting.update({k: o[k] for k in ("voltage_range", "allow_extrapolation", "transient")})
     fitting.update(unit_check=False, holdout=holdout)  # the unit checked here, before the fit
-
-    def ticking(what: str):
-        return opts.progress(f"identifying {what}", o["quiet"]).ticking()
-
+    ticking = lambda what: opts.progress(f"identifying {what}", o["quiet"]).ticking()
     if multi:
         from hystcomp.workflows.multiaxis import identify_axes
 
