@@ -1,5 +1,4 @@
-"""``hystcomp compensate``: the feedforward voltage for a reference displacement
-(:func:`hystcomp.workflows.compensate.compensate_reference`)."""
+"""``hystcomp compensate``: the feedforward voltage for a reference displacement."""
 
 from __future__ import annotations
 
@@ -28,7 +27,7 @@ from hystcomp.workflows.compensate import (
 @click.option("--dynamics", "dynamics_file", metavar="DYN.json")
 @click.option("--strict", is_flag=True)
 def compensate(model_file, reference_file, output, dynamics_file, **o):
-    """``hystcomp compensate``: parse, compensate (:mod:`hystcomp.workflows`), print, write."""
+    """Parse, run :func:`hystcomp.workflows.compensate.compensate_reference`, print, write."""
     inputs = (model_file, reference_file) + ((dynamics_file,) if dynamics_file else ())
     check_data_output(output, inputs=inputs, what="voltage file")
     model, dynamics = load_compensation(model_file, dynamics_file)

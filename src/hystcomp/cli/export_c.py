@@ -1,5 +1,4 @@
-"""``hystcomp export-c``: a model file's compensator as C99 code for an embedded controller
-(:func:`hystcomp.workflows.compensate.export_compensator`)."""
+"""``hystcomp export-c``: a model file's compensator as C99 code for an embedded controller."""
 
 from __future__ import annotations
 
@@ -27,7 +26,7 @@ STEP_HZ = {**opts.HZ, "callback": opts.positive("Hz, the rate at which NAME_step
 @opts.method_option
 @click.option("--dynamics", "dynamics_file", metavar="DYN.json")
 def export_c_command(model_file, directory, prefix, dynamics_file, **o):
-    """``hystcomp export-c``: parse, export (:mod:`hystcomp.workflows`), print."""
+    """Parse, run :func:`hystcomp.workflows.compensate.export_compensator`, print."""
     check_prefix(prefix)
     for suffix in (".h", ".c") if directory.is_dir() else ():  # never overwrite the model
         check_output_path(directory / f"{prefix}{suffix}", inputs=(model_file,))

@@ -1,6 +1,4 @@
-"""``hystcomp identify``: a model from a measured record, with an optional hold-out test
-(:func:`hystcomp.workflows.record.identify_model`, or N axes'
-:func:`hystcomp.workflows.multiaxis.identify_axes`)."""
+"""``hystcomp identify``: a model from a measured record, with an optional hold-out test."""
 
 from __future__ import annotations
 
@@ -42,7 +40,8 @@ from hystcomp.workflows.record import check_identification, identify_model
 @click.option("--plot", metavar="FILE")
 @click.option("-o", "--output", required=True, metavar="MODEL.json")
 def identify(data, kind, output, plot, dynamics_record, holdout, **o):
-    """``hystcomp identify``: parse, identify (:mod:`hystcomp.workflows`), print, write."""
+    """Parse, run :func:`hystcomp.workflows.record.identify_model` (N axes:
+    :func:`hystcomp.workflows.multiaxis.identify_axes`), print, write."""
     inputs = (data,) if dynamics_record is None else (data, dynamics_record)
     check_output_path(output, inputs=inputs, what="model file")
     multi = is_multiaxis(data, o["columns"])

@@ -1,5 +1,4 @@
-"""``hystcomp raster``: an AFM raster on the simulated scanner, three ways
-(:mod:`hystcomp.experiment.raster`)."""
+"""``hystcomp raster``: an AFM raster on the simulated scanner, three ways."""
 
 from __future__ import annotations
 
@@ -19,7 +18,7 @@ FAMILIES = click.Choice(["auto", "pi", "mpi", "preisach"])
 @click.option("--jobs", "n_jobs", type=int)
 @opts.quiet
 def raster(out_dir, quiet, **experiment):
-    """``hystcomp raster``: parse, run the experiment, print, write."""
+    """Parse, run :func:`hystcomp.experiment.raster.raster_experiment`, print, write."""
     from hystcomp.experiment.raster import check_raster_folder, raster_experiment, write_raster
 
     if out_dir is not None:

@@ -1,5 +1,4 @@
-"""``hystcomp simulate``: a model's displacement for a voltage input
-(:func:`hystcomp.workflows.simulate.simulate_voltage`)."""
+"""``hystcomp simulate``: a model's displacement for a voltage input."""
 
 from __future__ import annotations
 
@@ -20,7 +19,7 @@ from hystcomp.workflows.simulate import simulate_voltage
 @click.option("-o", "--output", required=True, metavar="FILE")
 @opts.reading
 def simulate(model_file, input_file, output, **o):
-    """``hystcomp simulate``: parse, simulate (:mod:`hystcomp.workflows`), print, write."""
+    """Parse, run :func:`hystcomp.workflows.simulate.simulate_voltage`, print, write."""
     check_data_output(output, inputs=(model_file, input_file), what="result file")
     model = load_model(model_file)
     multi = isinstance(model, MultiAxisModel)  # N coupled axes: t, v1..vN -> x1..xN
