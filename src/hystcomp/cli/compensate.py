@@ -7,13 +7,9 @@ import click
 from hystcomp.cli import _options as opts
 from hystcomp.cli import command
 from hystcomp.io.multiaxis import axis_table
-from hystcomp.io.records import check_data_output, write_table
+from hystcomp.io.records import check_data_output
 from hystcomp.models.multiaxis import MultiAxisModel
-from hystcomp.workflows.compensate import (
-    compensate_reference,
-    load_compensation,
-    voltage_summary,
-)
+from hystcomp.workflows.compensate import compensate_reference, load_compensation, voltage_summary
 
 
 @command("compensate")
@@ -38,9 +34,8 @@ def compensate(model_file, reference_file, output, dynamics_file, **o):
     ticking = opts.progress("computing the voltage" + "s" * multi, o["quiet"]).ticking()
     result = compensate_reference(model, table["t"], table["x"], progress=ticking, **given)
     opts.report(result)
-    written = opts.progress(f"writing {output}", o["quiet"])
-    write_table(output, axis_table(table["t"], v=result.v, x_ref=table["x"]), progress=written)
-    click.echo(f"wrote {output}: {voltage_summary(result)}")
+    out = axis_table(table["t"], v=result.v, x_ref=table["x"])
+    opts.write_signal(out, output, o["quiet"], voltage_summary(result))
     if result.preview is not None:
         click.echo(
             f"  with the inverse of the dynamics of {dynamics_file or model_file}: "

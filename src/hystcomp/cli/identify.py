@@ -59,9 +59,7 @@ def identify(data, kind, output, plot, dynamics_record, holdout, **o):
 
         t, v, x = (opts.read_input(data, ("v", "x"), o, multi=True)[k] for k in "tvx")
         with ticking(f"{v.shape[1]} axes"):
-            axes = identify_axes(
-                t, v, x, kind=kind, n_jobs=o["n_jobs"], source=str(data), **fitting
-            )
+            axes = identify_axes(t, v, x, kind=kind, n_jobs=o["n_jobs"], source=data, **fitting)
         opts.report(axes)
         return opts.write_model(axes.model, output)
     plain = opts.read_options({**o, "x_unit": None, "quiet": True})  # a dynamics record

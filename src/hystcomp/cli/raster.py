@@ -26,7 +26,6 @@ def raster(out_dir, quiet, **experiment):
     label = f"identifying the {experiment['n_axes']}-axis scanner and scanning"
     with opts.progress(label, quiet).ticking():
         result = raster_experiment(**experiment)
-    for line in result.table():
-        click.echo(line)
+    click.echo("\n".join(result.table()))
     if out_dir is not None:
         opts.wrote(write_raster(result, out_dir))
