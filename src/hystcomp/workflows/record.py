@@ -6,7 +6,9 @@
 of a second record (:func:`~hystcomp.workflows.pair.identify_pair_record`), or the dynamics
 alone (:func:`~hystcomp.workflows.pair.identify_dynamics_record`). Its :class:`ModelResult`
 holds the model to save and every step's result, whose report lines and warnings it joins
-in order.
+in order. :func:`check_identification` refuses, before any record is read, the arguments that
+a kind or an N-axis record does not take, each named as a notice's argument
+(:class:`hystcomp._notice.Notice`), which the command line says as its option.
 """
 
 from __future__ import annotations
@@ -91,7 +93,15 @@ def identify_model(
     ModelResult
         The fitted model (hysteresis, pair or dynamics), the hysteresis model's
         identification and each step's result with its report lines and warnings.
+
+    Raises
+    ------
+    InvalidParameterError
+        An argument that ``kind`` does not take (:func:`check_identification`), or
+        ``holdout`` with ``dynamics_record``.
     """
+    if isinstance(kind, str):  # an argument that the kind does not take is refused
+        check_identification(kind, holdout=holdout, dynamics_record=dynamics_record, **options)
     if dynamics_record is not None and holdout is not None:
         raise InvalidParameterError(
             "The 'holdout' argument of identify_model does not apply with a dynamics record: "
