@@ -248,7 +248,7 @@ STALLED = textwrap.dedent(
             print("writing", flush=True)
             time.sleep(60)
 
-    compensate.write_table = stalled_write
+    hystcomp.io.records.write_table = stalled_write
     _program.run()
     """
 )
@@ -275,7 +275,7 @@ def test_a_signal_pending_at_the_commit_replaces_nothing(files, sig, code, monke
     def not_the_command(signum, frame):  # the signal must not reach the test run itself
         raise RuntimeError("the signal reached the test's own handler")
 
-    monkeypatch.setattr("hystcomp.cli.compensate.write_table", signalled_write)
+    monkeypatch.setattr("hystcomp.io.records.write_table", signalled_write)
     previous = {s: signal.signal(s, not_the_command) for s in (sig, signal.SIGTERM)}
     try:
         result = run("compensate", files / "m.json", files / "ref.csv", "-o", out)

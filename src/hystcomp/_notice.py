@@ -56,6 +56,12 @@ PYTHON = {
     "rate_name": "sample_rate",
     "saved_by": "hystcomp.save_model",
     "export_model": "generate_c(model.inverse(), ...)",
+    "not_read": "which is not read",
+    "to_file": "Write it to a file",
+    # an argument, ``{arg_NAME}`` (where the vocabulary has no ``arg_NAME`` of its own),
+    # and the argument given the notice's ``value``, ``{set_NAME}``
+    "arg_": "'{name}'",
+    "set_": "{name}={value!r}",
 }
 
 
@@ -63,9 +69,22 @@ def _keys(template: str) -> set[str]:
     return {name for _, name, _, _ in string.Formatter().parse(template) if name}
 
 
+def _word(key: str, words: Mapping[str, str], data: Mapping[str, Any]) -> str:
+    if key in words:
+        return words[key].format(**data)
+    name = key[4:]  # an argument (arg_NAME), or one with its value (set_NAME)
+    arg = words.get(f"arg_{name}") or words["arg_"].format(name=name, dashed=name.replace("_", "-"))
+    return (
+        arg if key[:4] == "arg_" else words["set_"].format(arg=arg, name=name, value=data["value"])
+    )
+
+
 def _fill(template: str, words: Mapping[str, str], data: Mapping[str, Any]) -> str:
-    names = {k: words[k].format(**data) for k in _keys(template) if k in words and k not in data}
-    return template.format(**data, **names)
+    keys = [k for k in _keys(template) if k not in data and (k in words or k[:4] in _ARGS)]
+    return template.format(**data, **{k: _word(k, words, data) for k in keys})
+
+
+_ARGS = ("arg_", "set_")
 
 
 class Notice(str):
@@ -74,9 +93,10 @@ class Notice(str):
     Parameters
     ----------
     template : str
-        The sentence, with ``{key}`` where a remedy is named (a key of :data:`PYTHON`) and
-        ``{name}`` for a value of ``data`` (which a remedy of the same key gives way to);
-        no other braces.
+        The sentence, with ``{key}`` where a remedy is named (a key of :data:`PYTHON`),
+        ``{arg_NAME}`` where the argument NAME is, ``{set_NAME}`` where it is given the
+        value ``data['value']``, and ``{name}`` for a value of ``data`` (which a remedy of the same
+        key gives way to); no other braces.
     kind : str, optional
         What it is about (``'line'``, ``'coverage'``, ...), for a caller that sorts them.
     **data

@@ -206,7 +206,7 @@ def test_closed_standard_output_is_not_an_internal_error(monkeypatch):
     def closed(*args, **kwargs):
         raise BrokenPipeError
 
-    monkeypatch.setattr("hystcomp.cli._options.format_csv", closed)  # as `| head` would
+    monkeypatch.setattr("hystcomp.io.records.format_csv", closed)  # as `| head` would
     result = run("excite", "pi", "--fs", "10")
     assert result.exit_code == 141
     assert "internal error" not in result.output

@@ -110,7 +110,7 @@ def test_a_record_without_hysteresis_warns_that_a_line_does_as_well():
 @pytest.mark.parametrize(
     ("args", "options", "error", "match"),
     [
-        (("pi",), {"degree": 3}, InvalidParameterError, "'degree' option .* does not apply"),
+        (("pi",), {"degree": 3}, InvalidParameterError, "'degree' does not apply to kind='pi'"),
         (("preisach",), {"everett": "table", "degree": 3}, InvalidParameterError, "applies to"),
         (("nosuch",), {}, InvalidParameterError, "'kind' argument"),
         (("pi",), {"voltage_range": (0.0, 200.0)}, InvalidParameterError, "allow_extrapolation"),

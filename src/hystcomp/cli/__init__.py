@@ -1,12 +1,9 @@
-"""The ``hystcomp`` command.
+"""The ``hystcomp`` command: each subcommand in a module of its own, registered on :data:`main`.
 
-Each subcommand lives in its own module of this package and registers itself on
-:data:`main`. Exit status: 0 on success, 2 on bad usage or bad input (one line on
-standard error that names the problem and the fix, no traceback), 1 on an internal fault,
-141 when standard output is closed early (``| head``), 130 on Ctrl-C (SIGINT), 143 on
-SIGTERM and 129 on SIGHUP (the terminal closed); an interrupted command removes its
-temporary files and leaves its outputs as they were (:mod:`hystcomp._signals`).
-``hystcomp`` alone prints its usage and commands on standard error (exit 2).
+Exit status: 0 on success, 2 on bad usage or input (one line on standard error naming the
+problem and the fix), 1 on an internal fault, 141 when standard output is closed early
+(``| head``), 130, 143 and 129 on SIGINT, SIGTERM and SIGHUP (temporary files removed, outputs
+left as they were: :mod:`hystcomp._signals`). ``hystcomp`` alone prints its usage (exit 2).
 """
 
 from __future__ import annotations
@@ -24,38 +21,23 @@ from pathlib import Path
 import click
 
 from hystcomp import _signals
-from hystcomp._notice import worded
+from hystcomp._notice import Notice, worded
 from hystcomp.errors import HystcompError, InvalidParameterError
 
 EXIT_BAD_INPUT, EXIT_INTERNAL = 2, 1
 EXIT_BROKEN_PIPE = 141  # 128 + SIGPIPE, as a shell reports a command killed by it
 
 
-def _remove_pending() -> None:
-    """Remove the temporary outputs of a failed write (none if no file module ran)."""
-    atomic = sys.modules.get("hystcomp.io.atomic")  # not imported here if no file was written
-    if atomic is not None:
-        atomic.remove_pending()
-
-
-def _one_line(text: object) -> str:
-    return " ".join(str(text).split())
-
-
 #: The command line's words (words.toml): each command's and option's help, and the remedies
 #: that the library's sentences name (:class:`hystcomp._notice.Notice`).
 TEXT = tomllib.loads((Path(__file__).parent / "words.toml").read_text(encoding="utf-8"))
-#: Subcommand -> (its module, the first line of its help). A module is imported only when its
-#: command runs or shows its own help, so that ``hystcomp --help``, a mistyped command and
-#: shell completion load neither numba nor SciPy (tests/cli/test_cli_lazy.py checks that this
-#: table matches the commands).
+#: Subcommand -> (its module, its help's first line). A module is imported only when its command
+#: runs or shows its help: ``hystcomp --help`` and completion load neither numba nor SciPy.
 COMMANDS = {
     name: (f"hystcomp.cli.{name.replace('-', '_')}", TEXT[name]["help"].split("\n")[0])
     for name in TEXT
     if name not in ("remedies", "options")
 }
-#: A library parameter's option where its name is not the option's.
-OPTIONS = {"sample_rate": "--fs", "out_dir": "--out"}
 #: "The 'name' parameter of owner rest": a refused parameter, said as its option's value.
 _PARAMETER = re.compile(
     r"The '(?P<name>\w+)' (?:parameter|argument) of [\w.]+,? (?P<rest>[a-z0-9'].*)"
@@ -68,13 +50,13 @@ def command(name: str) -> Callable[[Callable], click.Command]:
     Parameters
     ----------
     name : str
-        The subcommand, whose table in words.toml holds its help and its options' (an
-        option that the table does not word has the help of ``[options]``).
+        The subcommand, whose table in words.toml holds its help and its options' (else
+        ``[options]``'s).
 
     Returns
     -------
     callable
-        The decorator: it takes the function, with its click options, and returns the command.
+        The decorator, from the function with its click options to the command.
     """
     words = {**TEXT["options"], **TEXT[name]}
 
@@ -88,14 +70,11 @@ def command(name: str) -> Callable[[Callable], click.Command]:
     return register
 
 
-def _say(text: str) -> str:
-    """A library sentence in the command line's words (words.toml's remedies), on one line."""
-    return _one_line(worded(text, TEXT["remedies"]))
-
-
-def _said(exc: BaseException) -> str:
-    """An error's message in the command line's words (a notice's remedies as options)."""
-    return _say(exc.args[0] if len(exc.args) == 1 else str(exc))
+def _say(text) -> str:
+    """A library sentence, or an error's, in the command line's words (words.toml's remedies)."""
+    if isinstance(text, BaseException):
+        text = text.args[0] if len(text.args) == 1 else str(text)
+    return " ".join(worded(text, TEXT["remedies"]).split())
 
 
 class _Command(click.Command):
@@ -105,10 +84,10 @@ class _Command(click.Command):
         try:
             return super().invoke(ctx)
         except InvalidParameterError as exc:
-            found = _PARAMETER.fullmatch(_said(exc))
+            found = _PARAMETER.fullmatch(_say(exc))
             if found is None:
                 raise
-            name = OPTIONS.get(found["name"], "--" + found["name"].replace("_", "-"))
+            name = _say(Notice(f"{{arg_{found['name']}}}"))  # its option (words.toml)
             option = next((p for p in self.params if name in p.opts), None)
             if option is not None and ctx.params.get(option.name) is not None:  # given
                 raise click.BadParameter(found["rest"], ctx, param_hint=f"'{name}'") from None
@@ -116,11 +95,8 @@ class _Command(click.Command):
 
 
 class _Group(click.Group):
-    """A click group that turns bad usage and hystcomp's errors into one line and exit 2.
-
-    Its subcommands are imported lazily from :data:`COMMANDS`, when one runs; each module
-    registers its command on :data:`main` when imported. Until then, a stand-in lists it.
-    """
+    """Bad usage and hystcomp's errors as one line and exit 2; the subcommands imported from
+    :data:`COMMANDS` when one runs (each registers itself), a stand-in listing it until then."""
 
     command_class = _Command
 
@@ -151,6 +127,22 @@ class _Group(click.Group):
             sys.exit(status)
 
 
+#: What stops a command, first match: (its kind, the exit status (None: its own), the line).
+_FAILURES: tuple = (
+    (click.exceptions.Abort, EXIT_INTERNAL, lambda e: "aborted"),
+    (click.UsageError, EXIT_BAD_INPUT, lambda e: f"error: {_say(e.format_message())}"
+     + (f" (see '{e.ctx.command_path} --help')" if e.ctx is not None else "")),
+    (click.ClickException, None, lambda e: f"error: {_say(e.format_message())}"),
+    (HystcompError, EXIT_BAD_INPUT, lambda e: f"error: {_say(e)}"),
+    (MemoryError, EXIT_BAD_INPUT, lambda e: "error: not enough memory for this input; use a "
+     "shorter record, fewer operators or a lower sample rate."),
+    (OSError, EXIT_BAD_INPUT, lambda e: "error: "  # the system refused a path or a write
+     + importlib.import_module("hystcomp.io.atomic").refusal(e)),
+    (BaseException, EXIT_INTERNAL, lambda e: f"internal error: {type(e).__name__}: "
+     f"{_say(str(e))} (please report it with the command you ran)"),
+)  # fmt: skip
+
+
 def _failure(exc: BaseException) -> tuple[int, str | None]:
     """The exit status of a command that raised ``exc``, and the line that says why."""
     if isinstance(exc, click.exceptions.Abort) and isinstance(exc.__cause__, KeyboardInterrupt):
@@ -163,30 +155,11 @@ def _failure(exc: BaseException) -> tuple[int, str | None]:
         with contextlib.suppress(OSError, ValueError):  # no flush error at exit either
             os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return EXIT_BROKEN_PIPE, None
-    if isinstance(exc, click.exceptions.Abort | OSError):
-        _remove_pending()
-    if isinstance(exc, click.exceptions.Abort):
-        return EXIT_INTERNAL, "hystcomp: aborted"
-    if isinstance(exc, click.UsageError):
-        hint = f" (see '{exc.ctx.command_path} --help')" if exc.ctx is not None else ""
-        return EXIT_BAD_INPUT, f"hystcomp: error: {_one_line(exc.format_message())}{hint}"
-    if isinstance(exc, click.ClickException):
-        return exc.exit_code, f"hystcomp: error: {_one_line(exc.format_message())}"
-    if isinstance(exc, HystcompError):
-        return EXIT_BAD_INPUT, f"hystcomp: error: {_said(exc)}"
-    if isinstance(exc, MemoryError):
-        return EXIT_BAD_INPUT, (
-            "hystcomp: error: not enough memory for this input; use a shorter record, fewer "
-            "operators or a lower sample rate."
-        )
-    if isinstance(exc, OSError):  # the system refused a path or a write: bad input, no fault
-        from hystcomp.io.atomic import refusal
-
-        return EXIT_BAD_INPUT, f"hystcomp: error: {refusal(exc)}"
-    return EXIT_INTERNAL, (  # an internal fault: say so, briefly
-        f"hystcomp: internal error: {type(exc).__name__}: {_one_line(exc)} (please report it "
-        "with the command you ran)"
-    )
+    atomic = sys.modules.get("hystcomp.io.atomic")  # not imported if no file was written
+    if isinstance(exc, click.exceptions.Abort | OSError) and atomic is not None:
+        atomic.remove_pending()  # the temporary outputs of a failed write
+    _, status, say = next(f for f in _FAILURES if isinstance(exc, f[0]))
+    return status or getattr(exc, "exit_code", EXIT_INTERNAL), f"hystcomp: {say(exc)}"
 
 
 @click.group(cls=_Group, context_settings={"help_option_names": ["-h", "--help"]})

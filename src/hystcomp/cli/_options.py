@@ -1,16 +1,11 @@
-"""What the commands share: the checks on option values, the shared options, reading a file,
-progress, and writing the outputs.
-
-Every value is checked when click parses it (a callback), so that a bad option is refused
-before any file is read or any work is done, with one line naming the option and the fix.
-hystcomp.io.records's readers, hystcomp.io.models and the models are imported where used: a
-command that needs no kernel (``excite``) then loads neither numba nor SciPy's sparse solvers.
+"""What the commands share: checks on option values, made when click parses them (before any
+file is read or any work done), the shared options, reading, progress and writing. Readers,
+models and figures are imported where used: ``excite`` loads neither numba nor SciPy's solvers.
 """
 
 from __future__ import annotations
 
 import math
-import sys
 
 import click
 
@@ -19,25 +14,22 @@ from hystcomp._notice import worded
 from hystcomp._progress import Progress
 from hystcomp._validation import MAX_MAGNITUDE
 from hystcomp.cli import TEXT, _say
-from hystcomp.errors import InvalidParameterError, OutputPathError
-from hystcomp.io.records import X_UNITS, format_csv  # light: no compiled code until used
+from hystcomp.errors import InvalidParameterError
+from hystcomp.io.records import X_UNITS  # light: no compiled code until used
 
 
-def _finite(value: float, param) -> float:
-    if not (math.isfinite(value) and abs(value) <= MAX_MAGNITUDE):
-        raise click.BadParameter(
-            f"must be a finite number of size at most {MAX_MAGNITUDE:g}; got {value!r}.",
-            param=param,
-        )
-    return value
-
-
-def check(test, words: str):
-    """A callback: a value given must pass ``test(value, param)``, else ``words`` (formatted
-    with it as ``v``) say what it must be."""
+def check(test, words: str, finite: bool = False):
+    """A callback: a value given must pass ``test(value)``, else ``words`` (formatted with it
+    as ``v``) say what it must be; with ``finite``, each of its numbers must be finite first."""
 
     def callback(ctx, param, value):
-        if value is not None and not test(value, param):
+        for number in (value if isinstance(value, tuple) else (value,)) if finite else ():
+            if number is not None and not (math.isfinite(number) and abs(number) <= MAX_MAGNITUDE):
+                raise click.BadParameter(
+                    f"must be a finite number of size at most {MAX_MAGNITUDE:g}; got {number!r}.",
+                    param=param,
+                )
+        if value is not None and not test(value):
             raise click.BadParameter(words.format(v=value), param=param)
         return value
 
@@ -46,21 +38,18 @@ def check(test, words: str):
 
 def positive(unit: str, strict: bool = True):
     """A callback: a finite number > 0 (>= 0 unless ``strict``) in ``unit``."""
-    return check(
-        lambda v, param: _finite(v, param) > 0 or (not strict and v == 0),
-        f"must be a number {'>' if strict else '>='} 0 ({unit}); got {{v!r}}.",
-    )
+    words = f"must be a number {'>' if strict else '>='} 0 ({unit}); got {{v!r}}."
+    return check(lambda v: v > 0 or (not strict and v == 0), words, finite=True)
 
 
-fraction = check(lambda v, _: 0.0 < v < 1.0, "must be between 0 and 1 (exclusive); got {v!r}.")
+fraction = check(lambda v: 0.0 < v < 1.0, "must be between 0 and 1 (exclusive); got {v!r}.")
 count = check(
-    lambda v, _: 1 <= v <= MAX_OPERATORS,
+    lambda v: 1 <= v <= MAX_OPERATORS,
     f"must be between 1 and {MAX_OPERATORS} (the paper uses 16; the fit grows as the cube of "
     "the count); got {v}.",
 )
 voltage_range = check(  # LO HI in V
-    lambda v, param: _finite(v[0], param) < _finite(v[1], param),
-    "must be LO HI with LO < HI (V); got {v[0]:g} {v[1]:g}.",
+    lambda v: v[0] < v[1], "must be LO HI with LO < HI (V); got {v[0]:g} {v[1]:g}.", finite=True
 )
 
 
@@ -81,10 +70,10 @@ def _columns(ctx, param, value):
         raise click.BadParameter(str(exc), param=param) from None
 
 
-#: ``--voltage-range LO HI`` of compensate and export-c: a clamp inside the model's range.
-narrow_range = click.option(
-    "--voltage-range", "narrow_range", nargs=2, type=float, metavar="LO HI", callback=voltage_range
-)
+#: ``--voltage-range LO HI`` (V): identify's and excite's range, compensate's and export-c's clamp.
+RANGE = {"nargs": 2, "type": float, "metavar": "LO HI", "callback": voltage_range}
+#: A rate in Hz (--fs, --frequency).
+HZ = {"type": float, "metavar": "HZ", "callback": positive("Hz")}
 
 
 def method_option(f):
@@ -100,7 +89,7 @@ quiet = click.option("--quiet", "-q", is_flag=True)
 def reading(f):
     """The options of a command that reads a data file: --columns, --fs, --x-unit, --quiet."""
     f = click.option("--x-unit", type=click.Choice(X_UNITS))(quiet(f))
-    f = click.option("--fs", "sample_rate", type=float, metavar="HZ", callback=positive("Hz"))(f)
+    f = click.option("--fs", "sample_rate", **HZ)(f)
     return click.option("--columns", metavar="SPEC", callback=_columns)(f)
 
 
@@ -112,33 +101,13 @@ def report(*results, lines: bool = True, warnings: bool = True) -> None:
         click.echo(f"hystcomp: warning: {_say(warning)}", err=True)
 
 
-def refuse(given: dict, why: str) -> None:
-    """Refuse, in the command's words, the first option given that ``why`` does not take."""
-    for option, value in given.items():
-        if value is not None and value is not False:
-            raise click.UsageError(f"{option} does not apply to {why}.")
-
-
 def read_options(given: dict, path="", *, reads: tuple[str, ...] | None = ("v", "x")) -> dict:
-    """Keyword arguments for :func:`hystcomp.io.records.read_table` from the shared options.
+    """Keyword arguments for :func:`hystcomp.io.records.read_table` from the shared options;
+    a ``--columns`` entry for a column but t and ``reads`` is refused (none: N axes)."""
+    from hystcomp.io.records import check_columns_read
 
-    ``reads`` are the columns the command reads besides t: a ``--columns`` entry for
-    another one is refused (it would be ignored, and was most likely meant for one read).
-    None (an N-axis file) checks nothing.
-    """
-    from hystcomp.io.records import MEANINGS
-
-    named = given.get("columns") or {}
-    unused = [key for key in named if reads is not None and key not in ("t", *reads)]
-    if reads is not None and unused:
-        key, spec = unused[0], named[unused[0]]
-        meant = next((k for k in reads if k not in named), reads[0])
-        raise click.BadParameter(
-            f"{key}={spec} names a column of {MEANINGS[key].split(' in ')[0]}, which this "
-            f"command does not read (it reads t and {' and '.join(reads)}); name the column "
-            f"of {MEANINGS[meant].split(' in ')[0]} instead, e.g. --columns {meant}={spec}.",
-            param_hint="'--columns'",
-        )
+    if reads is not None:
+        check_columns_read(given.get("columns"), reads)
     options = {k: given.get(k) for k in ("columns", "sample_rate", "x_unit")}
     if not given.get("quiet"):
         options["progress"] = Progress(f"reading {click.format_filename(str(path))}")
@@ -146,16 +115,13 @@ def read_options(given: dict, path="", *, reads: tuple[str, ...] | None = ("v", 
 
 
 def read_input(path, keys: tuple[str, ...], given: dict, *, multi: bool, optional=()) -> dict:
-    """The columns t and ``keys`` (one per axis if ``multi``) of the file at ``path``, read
-    with the shared options, and ``optional`` ones that it has (one axis)."""
-    from hystcomp.io.multiaxis import read_axes
-    from hystcomp.io.records import read_table
+    """:func:`hystcomp.io.multiaxis.read_columns` with the shared options; a displacement
+    read (one axis) is checked for its unit."""
+    from hystcomp.io.multiaxis import read_columns
 
-    options = read_options(given, path, reads=None if multi else (*keys, *optional))
-    if multi:
-        return read_axes(path, keys, **options)
-    table = read_table(path, keys, optional=optional, **options)
-    if "x" in table:  # a displacement, in µm like the model
+    options = read_options(given, path, reads=None)
+    table = read_columns(path, keys, axes=multi, optional=optional, **options)
+    if "x" in table and not multi:  # a displacement, in µm like the model
         warn_x_unit(table["x"], path, given)
     return table
 
@@ -172,13 +138,6 @@ def warn_x_unit(x, source, given: dict) -> None:
     message = x_unit_warning(x, str(source), given.get("x_unit"))
     if message and not given.get("quiet"):
         click.echo(f"hystcomp: warning: {message}", err=True)
-
-
-def check_plot(plot, *, inputs=(), output=None) -> None:
-    """Refuse, before any work, a figure the command cannot write (without matplotlib yet)."""
-    from hystcomp.experiment.fig_identification import check_figure_output
-
-    check_figure_output(plot, inputs=inputs, output=output)
 
 
 def wrote(paths) -> None:
@@ -199,18 +158,9 @@ def write_model(model, output, plot=None, draw=None) -> None:
 
 def write_signal(table: dict, output, quiet: bool, summary: str) -> None:
     """Write ``table`` to ``output`` and say ``summary``, or print it as CSV without one."""
-    from hystcomp.io.records import write_table
+    from hystcomp.io.records import print_table, write_table
 
-    if output is not None:
-        write_table(output, table, progress=progress(f"writing {output}", quiet))
-        return click.echo(f"wrote {output}: {summary}")
-    try:
-        click.echo(format_csv(table), nl=False)
-        sys.stdout.flush()
-    except BrokenPipeError:
-        raise  # the reader went away (| head): not an error
-    except OSError as exc:
-        raise OutputPathError(
-            f"Cannot write the signal to standard output: {exc.strerror or exc}. Give a "
-            "file with -o, or check where standard output goes."
-        ) from None
+    if output is None:
+        return print_table(table)
+    write_table(output, table, progress=progress(f"writing {output}", quiet))
+    click.echo(f"wrote {output}: {summary}")

@@ -1,5 +1,4 @@
-"""``hystcomp compare``: the paper's experiment (Section V) on the simulated axis
-(:func:`hystcomp.workflows.compare.compare_on_twin`)."""
+"""``hystcomp compare``: the paper's experiment (Section V) on the simulated axis."""
 
 from __future__ import annotations
 
@@ -18,16 +17,14 @@ from hystcomp.cli import command
 @click.option("--quick", is_flag=True)
 @click.option("--quiet", "-q", is_flag=True)
 def compare(out_dir: str, seed: int, periods: int | None, quick: bool, quiet: bool) -> None:
-    """``hystcomp compare``: parse, run the experiment (:mod:`hystcomp.workflows`), print."""
+    """Parse, run :func:`hystcomp.workflows.compare.compare_on_twin`, print."""
     from hystcomp.experiment.compare import CompareConfig
     from hystcomp.experiment.report import format_table
     from hystcomp.workflows.compare import compare_on_twin
 
     start = time.perf_counter()
-    changes: dict[str, Any] = {"seed": seed}
-    if periods is not None:
-        changes["periods"] = periods
-    config = CompareConfig.quick(**changes) if quick else CompareConfig(**changes)
+    changes: dict[str, Any] = {"seed": seed} | ({} if periods is None else {"periods": periods})
+    config = (CompareConfig.quick if quick else CompareConfig)(**changes)
 
     def progress(line: str) -> None:
         if not quiet:

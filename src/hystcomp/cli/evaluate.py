@@ -1,5 +1,4 @@
-"""``hystcomp evaluate``: how a measured run tracked its reference
-(:func:`hystcomp.workflows.evaluate.evaluate`, whose result words itself)."""
+"""``hystcomp evaluate``: how a measured run tracked its reference."""
 
 from __future__ import annotations
 
@@ -19,18 +18,18 @@ from hystcomp.cli import command
 @click.option("--skip", type=float, default=0.0, metavar="S", callback=opts.positive("s", False))
 @opts.reading
 def evaluate(reference, measured, as_json, plot, skip, **o):
-    """``hystcomp evaluate``: parse, evaluate (:mod:`hystcomp.workflows`), print."""
+    """Parse, run :func:`hystcomp.workflows.evaluate.evaluate` (its result words itself), print."""
     from hystcomp.workflows.evaluate import evaluate as run_evaluation
 
-    if plot is not None:
-        opts.check_plot(plot, inputs=(reference, measured))
-    reading = opts.read_options(o, measured, reads=("v", "x"))
-    result = run_evaluation(reference, measured, skip=skip, **reading)
+    if plot is not None:  # refused before any work
+        from hystcomp.experiment.fig_evaluate import plot_evaluation
+        from hystcomp.experiment.fig_identification import check_figure_output
+
+        check_figure_output(plot, inputs=(reference, measured))
+    result = run_evaluation(reference, measured, skip=skip, **opts.read_options(o, measured))
     opts.warn_x_unit(result.x, measured, o)
     opts.report(result, lines=False)
     if plot is not None:
-        from hystcomp.experiment.fig_evaluate import plot_evaluation
-
         plot_evaluation(result, plot)
     if as_json:
         out = result.to_dict()

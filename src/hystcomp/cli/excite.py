@@ -11,23 +11,13 @@ from hystcomp.identify.excitation import DEFAULT_SAMPLE_RATE, SIGNAL_KINDS, exci
 from hystcomp.io.multiaxis import axis_table
 from hystcomp.io.records import check_data_output
 
-HZ = {"type": float, "show_default": True, "metavar": "HZ", "callback": opts.positive("Hz")}
-
 
 @command("excite")
 @click.argument("model", type=click.Choice((*SIGNAL_KINDS, "multiaxis")))
 @click.option("-o", "--output", metavar="FILE")
-@click.option("--fs", "sample_rate", default=DEFAULT_SAMPLE_RATE, **HZ)
-@click.option(
-    "--voltage-range",
-    nargs=2,
-    type=float,
-    default=paper.VOLTAGE_RANGE,
-    show_default=True,
-    metavar="LO HI",
-    callback=opts.voltage_range,
-)
-@click.option("--frequency", default=1.0, **HZ)
+@click.option("--fs", "sample_rate", default=DEFAULT_SAMPLE_RATE, show_default=True, **opts.HZ)
+@click.option("--voltage-range", default=paper.VOLTAGE_RANGE, show_default=True, **opts.RANGE)
+@click.option("--frequency", default=1.0, show_default=True, **opts.HZ)
 @click.option("--axes", type=click.IntRange(1, 16))
 @opts.quiet
 def excite(model, output, axes, quiet, **signal):

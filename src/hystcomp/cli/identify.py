@@ -1,13 +1,10 @@
-"""``hystcomp identify``: a model from a measured record, with an optional hold-out test
-(:func:`hystcomp.workflows.record.identify_model`, or N axes'
-:func:`hystcomp.workflows.multiaxis.identify_axes`)."""
+"""``hystcomp identify``: a model from a measured record, with an optional hold-out test."""
 
 from __future__ import annotations
 
 import click
 
 from hystcomp._hyperparameters import EVERETT_KINDS, MAX_DEGREE
-from hystcomp._validation import MAX_MAGNITUDE
 from hystcomp.cli import _options as opts
 from hystcomp.cli import command
 from hystcomp.identify.preisach import FIT_METHODS
@@ -15,44 +12,8 @@ from hystcomp.identify.preisach_lsq import MAX_LSQ_GRID
 from hystcomp.io.atomic import check_output_path
 from hystcomp.io.multiaxis import is_multiaxis
 from hystcomp.io.records import read_record
-from hystcomp.workflows.identify import LABELS, SIZE_OPTIONS
-from hystcomp.workflows.record import identify_model
-
-#: The options that size or shape the hysteresis model, of every family.
-FAMILY = list(dict.fromkeys(name for names in SIZE_OPTIONS.values() for name in names))
-
-
-def _flags(options: dict) -> dict:
-    return {f"--{name.replace('_', '-')}": value for name, value in options.items()}
-
-
-def _check_options(kind: str, given: dict) -> None:
-    """Refuse, in the command's words, an option that --model (or --everett) does not take."""
-    if kind != "auto":
-        others = {k: v for k, v in given.items() if k not in SIZE_OPTIONS[kind]}
-        opts.refuse(_flags(others), f"--model {kind}")
-    if given["everett"] == "table" and given["degree"] is not None:
-        raise click.UsageError("--degree applies to --everett polynomial; a table has --grid.")
-    if given["grid"] is not None and given["everett"] == "polynomial":
-        raise click.UsageError("--grid applies to --everett table.")
-    if given["grid"] is not None and given["degree"] is not None:
-        raise click.UsageError(
-            "--grid and --degree exclude each other: --degree fits the polynomial of eq. 5, "
-            "--grid a table; give one of them."
-        )
-
-
-def _regularization(ctx, param, value):
-    """``--regularization``: ``auto`` or a number >= 0."""
-    try:
-        number = float(value) if value not in (None, "auto") else 0.0
-    except ValueError:
-        number = float("nan")
-    if not 0 <= number <= MAX_MAGNITUDE:
-        raise click.BadParameter(
-            f"must be 'auto' or a number from 0 to {MAX_MAGNITUDE:g}; got {value!r}.", param=param
-        )
-    return value if value in (None, "auto") else number
+from hystcomp.workflows.identify import LABELS
+from hystcomp.workflows.record import check_identification, identify_model
 
 
 @command("identify")
@@ -66,72 +27,47 @@ def _regularization(ctx, param, value):
 @click.option("--fit", "--fit-method", cls=opts.Alias, type=click.Choice(FIT_METHODS))
 @click.option("--everett", type=click.Choice(EVERETT_KINDS))
 @click.option("--grid", type=click.IntRange(2, MAX_LSQ_GRID))
-@click.option("--regularization", metavar="LAMBDA|auto", callback=_regularization)
+@click.option("--regularization", metavar="LAMBDA|auto")
 @click.option("--constraints", type=click.Choice(["physical", "paper"]))
 @click.option("--initial-memory", type=click.Choice(["auto", "virgin", "descended"]))
 @opts.reading
 @click.option("--transient", type=float, metavar="SECONDS", callback=opts.positive("s", False))
-@click.option("--voltage-range", nargs=2, type=float, metavar="LO HI", callback=opts.voltage_range)
+@click.option("--voltage-range", **opts.RANGE)
 @click.option("--allow-extrapolation", is_flag=True)
 @click.option("--holdout", type=float, metavar="FRACTION", callback=opts.fraction)
 @click.option("--dynamics-record", metavar="DYN")
 @click.option("--jobs", "n_jobs", type=int)
 @click.option("--plot", metavar="FILE")
 @click.option("-o", "--output", required=True, metavar="MODEL.json")
-def identify(data, kind, output, plot, dynamics_record, holdout, voltage_range, **o):
-    """``hystcomp identify``: parse, identify (:mod:`hystcomp.workflows`), print, write."""
+def identify(data, kind, output, plot, dynamics_record, holdout, **o):
+    """Parse, run :func:`hystcomp.workflows.record.identify_model` (N axes:
+    :func:`hystcomp.workflows.multiaxis.identify_axes`), print, write."""
     inputs = (data,) if dynamics_record is None else (data, dynamics_record)
     check_output_path(output, inputs=inputs, what="model file")
-    options = {name: o[name] for name in FAMILY}
     multi = is_multiaxis(data, o["columns"])
-    if multi:  # N coupled axes: each axis's model and the coupling
-        given = {"--model dynamics": kind == "dynamics" or None, "--holdout": holdout}
-        given.update({"--dynamics-record": dynamics_record, "--plot": plot})
-        opts.refuse(given, "an N-axis record")
-    elif kind == "dynamics":  # linear dynamics: a record of 'hystcomp excite dynamics'
-        given = {**_flags(options), "--transient": o["transient"], "--voltage-range": voltage_range}
-        given.update({"--holdout": holdout, "--dynamics-record": dynamics_record})
-        opts.refuse(given, "--model dynamics")
-    elif o["n_jobs"] is not None:
-        raise click.UsageError("--jobs applies to N-axis records (columns v1..vN, x1..xN).")
-    _check_options(kind, options)
-    if plot is not None:
-        opts.check_plot(plot, inputs=inputs, output=output)
-    fitting = {k: v for k, v in options.items() if v is not None}
-    fitting.update(voltage_range=voltage_range, allow_extrapolation=o["allow_extrapolation"])
-    fitting.update(transient=o["transient"], unit_check=False)  # checked here, before the fit
+    given = {"holdout": holdout, "dynamics_record": dynamics_record, "plot": plot, **o}
+    fitting = check_identification(kind, axes=multi, **given)  # before any record is read
+    if plot is not None:  # refused before any work
+        from hystcomp.experiment.fig_identification import check_figure_output, plot_identified
 
-    def ticking(what: str):
-        return opts.progress(f"identifying {what}", o["quiet"]).ticking()
-
+        check_figure_output(plot, inputs=inputs, output=output)
+    fitting.update({k: o[k] for k in ("voltage_range", "allow_extrapolation", "transient")})
+    fitting.update(unit_check=False, holdout=holdout)  # the unit checked here, before the fit
+    ticking = lambda what: opts.progress(f"identifying {what}", o["quiet"]).ticking()
     if multi:
         from hystcomp.workflows.multiaxis import identify_axes
 
-        table = opts.read_input(data, ("v", "x"), o, multi=True)
-        t, v, x = table["t"], table["v"], table["x"]
+        t, v, x = (opts.read_input(data, ("v", "x"), o, multi=True)[k] for k in "tvx")
         with ticking(f"{v.shape[1]} axes"):
-            axes = identify_axes(
-                t, v, x, kind=kind, n_jobs=o["n_jobs"], source=str(data), **fitting
-            )
+            axes = identify_axes(t, v, x, kind=kind, n_jobs=o["n_jobs"], source=data, **fitting)
         opts.report(axes)
         return opts.write_model(axes.model, output)
     plain = opts.read_options({**o, "x_unit": None, "quiet": True})  # a dynamics record
     rec = read_record(data, **(plain if kind == "dynamics" else opts.read_options(o, data)))
     if kind != "dynamics":
         opts.warn_x_unit(rec.x, data, o)
-    found = identify_model(
-        rec,
-        kind,
-        dynamics_record=None if dynamics_record is None else read_record(dynamics_record, **plain),
-        holdout=holdout,
-        progress=lambda k: ticking(f"the {LABELS[k]} model"),
-        **({} if kind == "dynamics" else fitting),
-    )
-    opts.report(found)
-
-    def draw(path):  # the fitted part and the hold-out as the model predicts it, or a Bode plot
-        from hystcomp.experiment.fig_identification import plot_identified
-
-        plot_identified(rec, found, path)
-
-    opts.write_model(found.model, output, plot, draw)
+    dyn = None if dynamics_record is None else read_record(dynamics_record, **plain)
+    progress = lambda k: ticking(f"the {LABELS[k]} model")
+    found = identify_model(rec, kind, dynamics_record=dyn, progress=progress, **fitting)
+    opts.report(found)  # a figure of the fit and the hold-out as predicted, or a Bode plot
+    opts.write_model(found.model, output, plot, lambda path: plot_identified(rec, found, path))

@@ -1,5 +1,4 @@
-"""``hystcomp raster``: an AFM raster on the simulated scanner, three ways
-(:mod:`hystcomp.experiment.raster`)."""
+"""``hystcomp raster``: an AFM raster on the simulated scanner, three ways."""
 
 from __future__ import annotations
 
@@ -19,7 +18,7 @@ FAMILIES = click.Choice(["auto", "pi", "mpi", "preisach"])
 @click.option("--jobs", "n_jobs", type=int)
 @opts.quiet
 def raster(out_dir, quiet, **experiment):
-    """``hystcomp raster``: parse, run the experiment, print, write."""
+    """Parse, run :func:`hystcomp.experiment.raster.raster_experiment`, print, write."""
     from hystcomp.experiment.raster import check_raster_folder, raster_experiment, write_raster
 
     if out_dir is not None:
@@ -27,7 +26,6 @@ def raster(out_dir, quiet, **experiment):
     label = f"identifying the {experiment['n_axes']}-axis scanner and scanning"
     with opts.progress(label, quiet).ticking():
         result = raster_experiment(**experiment)
-    for line in result.table():
-        click.echo(line)
+    click.echo("\n".join(result.table()))
     if out_dir is not None:
         opts.wrote(write_raster(result, out_dir))

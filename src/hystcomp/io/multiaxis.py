@@ -30,10 +30,19 @@ from hystcomp.io.records import (
     _Raw,
     _time,
     _units,
+    check_columns_read,
     parse_columns,
+    read_table,
 )
 
-__all__ = ["axis_key", "is_multiaxis", "parse_any_columns", "parse_axis_columns", "read_axes"]
+__all__ = [
+    "axis_key",
+    "is_multiaxis",
+    "parse_any_columns",
+    "parse_axis_columns",
+    "read_axes",
+    "read_columns",
+]
 
 _KEY = re.compile(r"^([vx])([1-9][0-9]*)$", re.IGNORECASE)
 #: Most axes of a file.
@@ -333,3 +342,35 @@ def parse_any_columns(text: str | None) -> dict[str, int | str] | None:
         if text is None or not any(c.isdigit() for c in str(text).split("=")[0]):
             raise
     return parse_axis_columns(text)
+
+
+def read_columns(path, keys=("v", "x"), *, axes: bool = False, optional=(), **options) -> dict:
+    """The columns t and ``keys`` of a data file, of every axis if ``axes``.
+
+    One axis: :func:`~hystcomp.io.records.read_table`, with the ``optional`` columns the
+    file has, and a column mapping that names another column refused
+    (:func:`~hystcomp.io.records.check_columns_read`). N axes: :func:`read_axes`.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The data file.
+    keys : sequence of {'v', 'x'}, default ('v', 'x')
+        The columns needed (of each axis).
+    axes : bool, default False
+        The file has N axes (columns v1..vN, x1..xN).
+    optional : sequence of str, optional
+        Columns read if the file has them (one axis).
+    **options
+        ``columns``, ``sample_rate``, ``x_unit`` and ``progress``, as
+        :func:`~hystcomp.io.records.read_table` takes them.
+
+    Returns
+    -------
+    dict of str to ndarray
+        ``t`` and each column read (of shape (n, N) with N axes).
+    """
+    if axes:
+        return read_axes(path, keys, **options)
+    check_columns_read(options.get("columns"), (*keys, *optional))
+    return read_table(path, keys, optional=optional, **options)

@@ -29,6 +29,7 @@ is reported as a corrupt file.
 
 from __future__ import annotations
 
+import sys
 from dataclasses import dataclass
 from io import BytesIO
 from pathlib import Path
@@ -38,7 +39,12 @@ import numpy as np
 
 from hystcomp._notice import Notice
 from hystcomp._validation import MAX_MAGNITUDE, as_path, as_signal, check_int, check_real
-from hystcomp.errors import DataFileError, InvalidParameterError, InvalidSignalError
+from hystcomp.errors import (
+    DataFileError,
+    InvalidParameterError,
+    InvalidSignalError,
+    OutputPathError,
+)
 from hystcomp.io._formats import read_raw
 from hystcomp.io._text import UNITS, write_csv
 from hystcomp.io.atomic import atomic_path, check_output_path
@@ -865,3 +871,88 @@ def check_data_output(path, *, inputs=(), what: str = "output") -> Path:
     """
     check_output_path(path, inputs=inputs, what=what)
     return check_writable(path)
+
+
+def check_columns_read(columns, reads: tuple[str, ...] = ("v", "x")) -> None:
+    """Refuse a column mapping that names a column of one not read (t and ``reads`` are).
+
+    Such an entry would be ignored, and was most likely meant for a column that is read.
+
+    Parameters
+    ----------
+    columns : dict or None
+        The column mapping (:func:`hystcomp.io.multiaxis.parse_any_columns`), such as
+        ``{'v': 2}``.
+    reads : tuple of str, default ('v', 'x')
+        The columns read besides t.
+
+    Returns
+    -------
+    None
+
+    Raises
+    ------
+    InvalidParameterError
+        An entry for another column than t and ``reads``.
+
+    Examples
+    --------
+    >>> check_columns_read({"x": 2}, ("x",))
+    >>> check_columns_read({"v": 2}, ("x",))
+    Traceback (most recent call last):
+    ...
+    hystcomp.errors.InvalidParameterError: The 'columns' argument of check_columns_read, v=2 \
+names a column of voltage, which is not read (it reads t and x); name the column of \
+displacement instead, e.g. columns='x=2'.
+    """
+    unused = [key for key in columns or {} if key not in ("t", *reads)]
+    if unused:
+        key, spec = unused[0], columns[unused[0]]
+        meant = next((k for k in reads if k not in columns), reads[0])
+        raise InvalidParameterError(
+            Notice(
+                "The 'columns' argument of check_columns_read, {key}={spec} names a column "
+                f"of {MEANINGS[key].split(' in ')[0]}, {{not_read}} (it reads t and "
+                f"{' and '.join(reads)}); name the column of "
+                f"{MEANINGS[meant].split(' in ')[0]} instead, e.g. {{columns_eg}}.",
+                key=key,
+                spec=spec,
+                eg=f"{meant}={spec}",
+            )
+        )
+
+
+def print_table(table: dict, stream=None) -> None:
+    """Print a table as CSV (:func:`format_csv`) on ``stream``, standard output by default.
+
+    Parameters
+    ----------
+    table : dict of str to ndarray
+        Equally long columns.
+    stream : file-like, optional
+        Where to write [``sys.stdout``, as it is when called].
+
+    Returns
+    -------
+    None
+
+    Raises
+    ------
+    OutputPathError
+        The stream refuses the text (a full disk, a closed file); a reader that went away
+        (``| head``) raises BrokenPipeError as it is.
+    """
+    out = sys.stdout if stream is None else stream
+    try:
+        out.write(format_csv(table))
+        out.flush()
+    except BrokenPipeError:
+        raise  # the reader went away (| head): not an error
+    except OSError as exc:
+        raise OutputPathError(
+            Notice(
+                "Cannot write the signal to standard output: {why}. {to_file}, or check "
+                "where standard output goes.",
+                why=exc.strerror or exc,
+            )
+        ) from None

@@ -22,6 +22,7 @@ import numpy as np
 from hystcomp import paper
 from hystcomp._hyperparameters import check_constraints
 from hystcomp._notice import Notice
+from hystcomp._validation import MAX_MAGNITUDE
 from hystcomp.errors import IdentificationError, InvalidParameterError, InvalidTypeError
 from hystcomp.identify.compensation import tracking_estimate
 from hystcomp.identify.outliers import check_isolated
@@ -40,6 +41,7 @@ from hystcomp.models.preisach import Preisach
 __all__ = [
     "IdentificationResult",
     "build_estimator",
+    "check_options",
     "identify_record",
 ]
 
@@ -134,8 +136,7 @@ def build_estimator(
     Raises
     ------
     InvalidParameterError
-        An unknown kind, an option the kind does not take (:data:`SIZE_OPTIONS`), ``degree``
-        with ``everett='table'`` or ``grid`` with ``everett='polynomial'``.
+        An unknown kind, or an option refused by :func:`check_options`.
 
     Examples
     --------
@@ -154,22 +155,7 @@ def build_estimator(
         "constraints": constraints,
         "initial_memory": initial_memory,
     }
-    for name, value in given.items():
-        if value is not None and name not in SIZE_OPTIONS[kind]:
-            raise InvalidParameterError(
-                f"The {name!r} option of build_estimator does not apply to kind {kind!r}, "
-                f"which takes {', '.join(SIZE_OPTIONS[kind])}; got {name}={value!r}. Leave it out."
-            )
-    for name, value, wants, other in (
-        ("degree", degree, "polynomial", "table"),
-        ("grid", grid, "table", "polynomial"),
-    ):
-        if value is not None and everett == other:
-            raise InvalidParameterError(
-                f"The {name!r} option of build_estimator applies to everett={wants!r}; got "
-                f"{name}={value!r} with everett={other!r}. A {other} takes "
-                f"{'grid' if name == 'degree' else 'degree'!r}."
-            )
+    given = check_options(kind, **given)
     if degree is not None and everett is None:
         given["everett"] = "polynomial"  # a degree names eq. 5's polynomial, not the table
     params = {"voltage_range": voltage_range}
@@ -181,6 +167,74 @@ def build_estimator(
         check_constraints(constraints, "build_estimator")
         params["zero_diagonal"] = params.pop("constraints") == "physical"
     return cls(**params)
+
+
+def check_options(kind: str = "auto", **options) -> dict:
+    """Refuse, before any work, the family options that ``kind`` does not take or that
+    contradict each other.
+
+    Parameters
+    ----------
+    kind : {'auto', 'pi', 'mpi', 'preisach', 'dynamics'}, default 'auto'
+        The model family (``'auto'``: each option goes to the families that take it).
+    **options
+        The options of :func:`build_estimator` (None: not given); ``regularization`` may
+        also be the text of a number.
+
+    Returns
+    -------
+    dict
+        ``options``, with ``regularization`` as a number or ``'auto'``.
+
+    Raises
+    ------
+    InvalidParameterError
+        An option that ``kind`` does not take (:data:`SIZE_OPTIONS`), ``degree`` with
+        ``everett='table'`` or with ``grid``, ``grid`` with ``everett='polynomial'``, or a
+        ``regularization`` other than ``'auto'`` or a number from 0 to ``MAX_MAGNITUDE``.
+
+    Examples
+    --------
+    >>> check_options("mpi", regularization="0.5", operators=None)
+    {'regularization': 0.5, 'operators': None}
+    """
+    takes = SIZE_OPTIONS.get(kind, [n for names in SIZE_OPTIONS.values() for n in names])
+    for name, value in options.items():
+        if value is not None and name not in takes:
+            which = ", which takes " + ", ".join(f"{{arg_{n}}}" for n in takes) if takes else ""
+            raise InvalidParameterError(
+                Notice(f"{{arg_{name}}} does not apply to {{set_kind}}{which}.", value=kind)
+            )
+    everett, grid, degree = (options.get(k) for k in ("everett", "grid", "degree"))
+    for name, value, wants, other in (
+        ("degree", degree, "polynomial", "table"),
+        ("grid", grid, "table", "polynomial"),
+    ):
+        if value is not None and everett == other:
+            has = f"; a {other} has {{arg_{'grid' if name == 'degree' else 'degree'}}}"
+            raise InvalidParameterError(
+                Notice(f"{{arg_{name}}} applies to {{set_everett}}{has}.", value=wants)
+            )
+    if grid is not None and degree is not None:
+        raise InvalidParameterError(
+            Notice(
+                "{arg_grid} and {arg_degree} exclude each other: {arg_degree} fits the "
+                "polynomial of eq. 5, {arg_grid} a table; give one of them."
+            )
+        )
+    penalty = options.get("regularization")
+    if penalty is not None and penalty != "auto":
+        try:
+            number = float(penalty)
+        except (TypeError, ValueError):
+            number = float("nan")
+        if not 0 <= number <= MAX_MAGNITUDE:
+            raise InvalidParameterError(
+                "The 'regularization' argument of build_estimator must be 'auto' or a number "
+                f"from 0 to {MAX_MAGNITUDE:g}; got {penalty!r}."
+            )
+        options["regularization"] = number
+    return options
 
 
 #: The estimator's name of an option where it is not the option's.
