@@ -111,13 +111,15 @@ def fixed_layout(fig: Figure, *, left, right, top, bottom, hgap=0.0, wgap=0.0, r
     )
 
 
-def check_figure_path(path) -> Path:
+def check_figure_path(path, *, argument: str = "path", owner: str = "check_figure_path") -> Path:
     """``path`` as a Path if a figure can be saved there (by its suffix), else raise.
 
     Parameters
     ----------
     path : str or os.PathLike
         The figure's file.
+    argument, owner : str
+        The argument and the function that the refusal names.
 
     Returns
     -------
@@ -127,7 +129,8 @@ def check_figure_path(path) -> Path:
     path = Path(os.fspath(path))
     if path.suffix.lower() not in FORMATS:
         raise InvalidParameterError(
-            f"Cannot save a figure as {str(path)!r}: use a name ending in {', '.join(FORMATS)}."
+            f"The {argument!r} argument of {owner} must end in {', '.join(FORMATS)}; "
+            f"got {str(path)!r}."
         )
     return path
 

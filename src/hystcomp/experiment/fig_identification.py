@@ -10,7 +10,6 @@ largest value), the hold-out in its own colour and the excerpts shaded.
 
 from __future__ import annotations
 
-import os
 from pathlib import Path
 
 import numpy as np
@@ -308,12 +307,7 @@ def check_figure_output(plot, *, inputs=(), output=None) -> Path:
     """
     from hystcomp.io.atomic import check_output_path
 
-    path = Path(os.fspath(plot))
-    if path.suffix.lower() not in FORMATS:
-        raise InvalidParameterError(
-            f"The 'plot' argument of check_figure_output must end in {', '.join(FORMATS)}; "
-            f"got {str(path)!r}."
-        )
+    path = check_figure_path(plot, argument="plot", owner="check_figure_output")
     check_output_path(path, inputs=inputs, what="figure")
     if output is not None and path.resolve() == Path(output).resolve():
         raise InvalidParameterError(
