@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import functools
 import inspect
+from abc import ABC, abstractmethod
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any, ClassVar, Self, TypeVar
 
@@ -261,7 +262,7 @@ def read_fit_report(model: Any, data: dict[str, Any]) -> None:
         model.fit_report_ = dict(data["fit_report"])
 
 
-class ModelFile:
+class ModelFile(ABC):
     """What a model file holds, written and read the same way for every kind of model.
 
     :meth:`to_dict` writes the model's ``kind``, its parts (:meth:`_document_parts`) and
@@ -276,14 +277,14 @@ class ModelFile:
     #: shape is checked by :func:`hystcomp.io.models.model_from_dict`).
     _document_entry: ClassVar[tuple[str, type] | None] = ("parameters", dict)
 
+    @abstractmethod
     def _document_parts(self) -> dict[str, Any]:
         """The document's entries after ``kind``, in their order."""
-        raise NotImplementedError
 
     @classmethod
+    @abstractmethod
     def _from_document(cls, data: dict[str, Any]) -> Self:
         """The model a checked document describes, every value validated."""
-        raise NotImplementedError
 
     def to_dict(self) -> dict[str, Any]:
         """The model file's dictionary: kind, parts and fit report, ready for JSON.

@@ -11,6 +11,8 @@ a sequence of experiments is reproducible from the seed.
 
 from __future__ import annotations
 
+from abc import ABC, abstractmethod
+
 import numpy as np
 
 from hystcomp._kernels import twin as k
@@ -43,13 +45,13 @@ def _pack(params: TwinParameters) -> np.ndarray:
     return packed
 
 
-class SampleClock:
+class SampleClock(ABC):
     """What a plant at a fixed ``sample_rate`` (Hz) shares: the times of its samples."""
 
     @property
+    @abstractmethod
     def sample_rate(self) -> float:
         """The sample rate, Hz (each plant says its own)."""
-        raise NotImplementedError
 
     def time(self, n_samples: int) -> np.ndarray:
         """Time of ``n_samples`` samples from 0, in s.
