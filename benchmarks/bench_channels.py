@@ -20,11 +20,15 @@ from __future__ import annotations
 import ctypes
 import shutil
 import subprocess
+import sys
 import tempfile
-import time
 from pathlib import Path
 
 import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+
+from benchmarks.bench_realtime import C_MATCHED, best_of
 
 import hystcomp
 from hystcomp._kernels import channels as ck
@@ -32,14 +36,6 @@ from hystcomp.models.channels import ChannelBank
 
 HERE = Path(__file__).resolve().parent
 CC = shutil.which("cc")
-C_FASTMATH = [
-    "-ffp-contract=fast",
-    "-fassociative-math",
-    "-fno-signed-zeros",
-    "-fno-trapping-math",
-    "-freciprocal-math",
-]
-C_MATCHED = ["-O3", "-march=native", *C_FASTMATH]
 N_CHANNELS = 1024
 N_SAMPLES = 4000
 N_STEPS = 2000
@@ -104,17 +100,6 @@ class CBank:
         )
 
 
-def best_of(funcs: dict, repeat: int = REPEAT) -> dict:
-    """The shortest time in s of each callable, over interleaved rounds."""
-    best = dict.fromkeys(funcs, np.inf)
-    for _ in range(repeat):
-        for name, func in funcs.items():
-            start = time.perf_counter()
-            func()
-            best[name] = min(best[name], time.perf_counter() - start)
-    return best
-
-
 def run() -> list[dict]:
     bank = mirror()
     x = references(N_SAMPLES)
@@ -153,7 +138,7 @@ def run() -> list[dict]:
             rows_c.append(
                 row("largest difference, kernel against C", np.abs(ours - c_out).max(), "V")
             )
-        t = best_of(funcs)
+        t = best_of(funcs, REPEAT)
     per = N_SAMPLES * N_CHANNELS
     ns = {
         "simulate": t["simulate"] / per * 1e9,
