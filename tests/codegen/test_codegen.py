@@ -120,6 +120,17 @@ def _run_c(drive, x, reset_at=-1):
     return v, held
 
 
+def _step_python(comp, x, reset_at=-1):
+    """What :func:`_run_c` asks of the C, asked of the Python stepper one sample at a time."""
+    s = comp.stepper()
+    v = []
+    for k, u in enumerate(x):
+        if k == reset_at:
+            s.reset()
+        v.append(s.step(u))
+    return np.asarray(v)
+
+
 @needs_cc
 @pytest.mark.parametrize("name", sorted(MODELS))
 @pytest.mark.parametrize("slewing", [False, True])

@@ -25,7 +25,7 @@ from hystcomp.models.dynamic_compensator import MAX_PREVIEW
 from hystcomp.models.dynamics import DynamicCompensator, LinearDynamics
 from hystcomp.models.hammerstein import HammersteinModel, fit_pair
 from hystcomp.plant import Twin, creep_twin
-from tests.codegen.test_codegen import CC, _compile, _run_c, needs_cc
+from tests.codegen.test_codegen import CC, _compile, _run_c, _step_python, needs_cc
 from tests.conftest import random_walk
 
 FS = 20_000.0
@@ -393,12 +393,7 @@ def test_c_matches_the_stepper(compensator, tmp_path):
     x[[100, 4100, 5000, 5001]] = [np.nan, np.nan, np.inf, -np.inf]
     drive = _compile(compensator, tmp_path, "stage_x")
     v_c, held = _run_c(drive, x, reset_at=4000)
-    s = compensator.stepper()
-    v_py = []
-    for k, u in enumerate(x):
-        if k == 4000:
-            s.reset()
-        v_py.append(s.step(u))
+    v_py = _step_python(compensator, x, reset_at=4000)
     np.testing.assert_allclose(v_c, v_py, rtol=0, atol=1e-9)
     assert held == 3
     header = (tmp_path / "stage_x.h").read_text()

@@ -12,7 +12,7 @@ from hystcomp._lti import modal_tf
 from hystcomp.errors import InvalidParameterError
 from hystcomp.models.dynamics import LinearDynamics
 from hystcomp.models.hammerstein import HammersteinModel
-from tests.codegen.test_codegen import _compile, _run_c, needs_cc
+from tests.codegen.test_codegen import _compile, _run_c, _step_python, needs_cc
 from tests.conftest import random_walk
 
 FS = 20_000.0
@@ -187,12 +187,7 @@ def test_c_matches_the_stepper_for_two_modes(tmp_path):
     x[[100, 4100, 5000]] = [np.nan, np.inf, -np.inf]
     drive = _compile(comp, tmp_path, "two_modes")
     v_c, held = _run_c(drive, x, reset_at=4000)
-    s = comp.stepper()
-    v_py = []
-    for k, u in enumerate(x):
-        if k == 4000:
-            s.reset()
-        v_py.append(s.step(u))
+    v_py = _step_python(comp, x, reset_at=4000)
     np.testing.assert_allclose(v_c, v_py, rtol=0, atol=1e-9)
     assert held == 2  # the non-finite samples after the reset, each held
     assert f"{comp.preview} samples ahead" in (tmp_path / "two_modes.h").read_text()
